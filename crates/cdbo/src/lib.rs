@@ -1,0 +1,16 @@
+//! # cdbo — Coordinate Descent Bayesian Optimisation for learning to race
+//!
+//! A toolkit that teaches a car (or any robot) a fast control policy in few trials, after
+//! Oliveira et al., "Learning to Race through Coordinate Descent Bayesian Optimisation".
+//!
+//! - [`track`]: race tracks from TORCS / Speed Dreams files, TUMFTM centre lines, built-ins.
+//! - [`car`]: vehicle parameters from TORCS car files.
+//! - [`sim`]: the vehicle model and the lap evaluator.
+//! - [`drive`]: the environment's controllers (steering, demonstrator).
+//! - [`limit`]: the quasi-steady-state minimum lap time.
+
+pub mod error;
+pub mod params;
+pub mod track;
+
+pub use error::{Error, Result};

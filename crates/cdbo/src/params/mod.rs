@@ -1,0 +1,423 @@
+//! Reader for TORCS / Speed Dreams parameter files (`<params>`, `<section>`, `<attnum>`,
+//! `<attstr>`), the format of every track and car file.
+//!
+//! External entities declared in the DOCTYPE (`<!ENTITY default-surfaces SYSTEM "...">`) are
+//! resolved relative to the file, as TORCS does; a missing entity file is skipped with a
+//! warning. Numbers are converted to SI through their `unit` attribute ([`units`]).
+
+pub mod units;
+
+use std::path::Path;
+
+use crate::error::{Error, Result};
+
+/// A value of an attribute, already converted to SI for numbers.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Value {
+    /// An `<attnum>`, in SI units.
+    Num(f64),
+    /// An `<attstr>`.
+    Str(String),
+}
+
+/// One `<attnum>` or `<attstr>`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Attr {
+    /// The `name` attribute.
+    pub name: String,
+    /// The value.
+    pub value: Value,
+    /// 1-based line in the file.
+    pub line: u32,
+}
+
+/// One `<section>` (or the `<params>` root), with its attributes and sub-sections in file order.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Section {
+    /// The `name` attribute.
+    pub name: String,
+    /// Slash-separated path from the root, used in error messages.
+    pub path: String,
+    /// 1-based line in the file.
+    pub line: u32,
+    /// Attributes in file order.
+    pub attrs: Vec<Attr>,
+    /// Sub-sections in file order.
+    pub sections: Vec<Section>,
+}
+
+/// A parsed parameter file.
+#[derive(Debug, Clone)]
+pub struct Params {
+    /// The file name used in messages.
+    pub file: String,
+    /// The `<params>` element.
+    pub root: Section,
+    /// Non-fatal problems met while reading (e.g. a missing entity file).
+    pub warnings: Vec<String>,
+}
+
+impl Params {
+    /// Reads and parses a file, resolving its external entities relative to its folder.
+    pub fn read(path: &Path) -> Result<Params> {
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            path: path.to_owned(),
+            source,
+        })?;
+        Params::parse(&text, &path.display().to_string(), path.parent())
+    }
+
+    /// Parses text; `dir` is where relative entity paths are resolved (`None`: skip them).
+    pub fn parse(text: &str, file: &str, dir: Option<&Path>) -> Result<Params> {
+        let mut warnings = Vec::new();
+        let expanded = expand_entities(text, file, dir, &mut warnings)?;
+        let doc = roxmltree::Document::parse(&expanded).map_err(|e| Error::Invalid {
+            file: file.to_owned(),
+            line: Some(e.pos().row),
+            element: "XML".to_owned(),
+            message: e.to_string(),
+        })?;
+        let root = doc.root_element();
+        if root.tag_name().name() != "params" {
+            return Err(Error::Invalid {
+                file: file.to_owned(),
+                line: Some(doc.text_pos_at(root.range().start).row),
+                element: format!("<{}>", root.tag_name().name()),
+                message: "the root element must be <params>".to_owned(),
+            });
+        }
+        let root = read_section(&doc, root, "", file)?;
+        Ok(Params {
+            file: file.to_owned(),
+            root,
+            warnings,
+        })
+    }
+
+    /// An error about an element of this file.
+    pub fn error(&self, element: &str, line: Option<u32>, message: impl Into<String>) -> Error {
+        Error::Invalid {
+            file: self.file.clone(),
+            line,
+            element: element.to_owned(),
+            message: message.into(),
+        }
+    }
+
+    /// The section at a slash-separated path below the root, e.g. `Main Track/Track Segments`.
+    pub fn section(&self, path: &str) -> Option<&Section> {
+        self.root.section(path)
+    }
+
+    /// A required section.
+    pub fn require_section(&self, path: &str) -> Result<&Section> {
+        self.section(path)
+            .ok_or_else(|| self.error(path, None, "missing section"))
+    }
+}
+
+impl Section {
+    /// The sub-section at a slash-separated path.
+    pub fn section(&self, path: &str) -> Option<&Section> {
+        let mut cur = self;
+        for part in path.split('/').filter(|p| !p.is_empty()) {
+            cur = cur.sections.iter().find(|s| s.name == part)?;
+        }
+        Some(cur)
+    }
+
+    /// The attribute called `name`, if any.
+    pub fn attr(&self, name: &str) -> Option<&Attr> {
+        self.attrs.iter().find(|a| a.name == name)
+    }
+
+    /// A number attribute in SI units, `Ok(None)` when absent, an error when it is a string.
+    pub fn num(&self, file: &str, name: &str) -> Result<Option<f64>> {
+        match self.attr(name) {
+            None => Ok(None),
+            Some(Attr {
+                value: Value::Num(v),
+                ..
+            }) => Ok(Some(*v)),
+            Some(
+                a @ Attr {
+                    value: Value::Str(s),
+                    ..
+                },
+            ) => Err(Error::Invalid {
+                file: file.to_owned(),
+                line: Some(a.line),
+                element: format!("{}/{}", self.path, name),
+                message: format!("expected a number (<attnum>), found the string {s:?}"),
+            }),
+        }
+    }
+
+    /// A number attribute, or `default` when absent.
+    pub fn num_or(&self, file: &str, name: &str, default: f64) -> Result<f64> {
+        Ok(self.num(file, name)?.unwrap_or(default))
+    }
+
+    /// A required number attribute.
+    pub fn require_num(&self, file: &str, name: &str) -> Result<f64> {
+        self.num(file, name)?.ok_or_else(|| Error::Invalid {
+            file: file.to_owned(),
+            line: Some(self.line),
+            element: format!("{}/{}", self.path, name),
+            message: "missing required attribute".to_owned(),
+        })
+    }
+
+    /// A string attribute (a number attribute is not accepted).
+    pub fn str(&self, name: &str) -> Option<&str> {
+        match self.attr(name) {
+            Some(Attr {
+                value: Value::Str(s),
+                ..
+            }) => Some(s),
+            _ => None,
+        }
+    }
+}
+
+fn read_section(
+    doc: &roxmltree::Document,
+    node: roxmltree::Node,
+    parent: &str,
+    file: &str,
+) -> Result<Section> {
+    let line = doc.text_pos_at(node.range().start).row;
+    let name = node.attribute("name").unwrap_or_default().to_owned();
+    let path = match (parent.is_empty(), node.tag_name().name() == "params") {
+        (_, true) => String::new(),
+        (true, false) => name.clone(),
+        (false, false) => format!("{parent}/{name}"),
+    };
+    let mut section = Section {
+        name,
+        path,
+        line,
+        ..Section::default()
+    };
+    for child in node.children().filter(|c| c.is_element()) {
+        let line = doc.text_pos_at(child.range().start).row;
+        let tag = child.tag_name().name();
+        let element = |n: &str| {
+            if section.path.is_empty() {
+                n.to_owned()
+            } else {
+                format!("{}/{}", section.path, n)
+            }
+        };
+        let invalid = |element: String, message: String| Error::Invalid {
+            file: file.to_owned(),
+            line: Some(line),
+            element,
+            message,
+        };
+        match tag {
+            "section" => {
+                let sub = read_section(doc, child, &section.path, file)?;
+                section.sections.push(sub);
+            }
+            "attnum" | "attstr" => {
+                let name = child.attribute("name").ok_or_else(|| {
+                    invalid(
+                        element(&format!("<{tag}>")),
+                        "missing the name attribute".to_owned(),
+                    )
+                })?;
+                let val = child.attribute("val").ok_or_else(|| {
+                    invalid(element(name), "missing the val attribute".to_owned())
+                })?;
+                let value = if tag == "attnum" {
+                    let v = parse_number(val).ok_or_else(|| {
+                        invalid(element(name), format!("val {val:?} is not a number"))
+                    })?;
+                    if !v.is_finite() {
+                        return Err(invalid(element(name), format!("val {val:?} is not finite")));
+                    }
+                    let unit = child.attribute("unit").unwrap_or("");
+                    let factor = units::si_factor(unit)
+                        .ok_or_else(|| invalid(element(name), format!("unknown unit {unit:?}")))?;
+                    Value::Num(v * factor)
+                } else {
+                    Value::Str(val.to_owned())
+                };
+                section.attrs.push(Attr {
+                    name: name.to_owned(),
+                    value,
+                    line,
+                });
+            }
+            _ => {} // unknown elements are ignored, as TORCS does
+        }
+    }
+    Ok(section)
+}
+
+/// Removes the DOCTYPE and substitutes its external entities.
+///
+/// Line numbers of the main file are kept: the DOCTYPE becomes as many blank lines, and an
+/// included file's line breaks become spaces.
+fn expand_entities(
+    text: &str,
+    file: &str,
+    dir: Option<&Path>,
+    warnings: &mut Vec<String>,
+) -> Result<String> {
+    let Some(start) = text.find("<!DOCTYPE") else {
+        return Ok(text.to_owned());
+    };
+    let end = doctype_end(text, start).ok_or_else(|| Error::Invalid {
+        file: file.to_owned(),
+        line: Some(line_of(text, start)),
+        element: "<!DOCTYPE>".to_owned(),
+        message: "unterminated DOCTYPE".to_owned(),
+    })?;
+    let doctype = &text[start..end];
+    let mut entities: Vec<(String, String)> = Vec::new();
+    let mut rest = doctype;
+    while let Some(i) = rest.find("<!ENTITY") {
+        let decl_end = rest[i..].find('>').map(|j| i + j).unwrap_or(rest.len());
+        let decl = &rest[i + "<!ENTITY".len()..decl_end];
+        let mut words = decl.split_whitespace();
+        let name = words.next().unwrap_or_default().to_owned();
+        let quoted: Vec<&str> = decl.split(['"', '\'']).collect();
+        let content = if decl.contains("SYSTEM") {
+            let rel = quoted.get(1).copied().unwrap_or_default();
+            match dir.map(|d| d.join(rel)) {
+                Some(p) if p.is_file() => {
+                    let body = std::fs::read_to_string(&p).map_err(|source| Error::Io {
+                        path: p.clone(),
+                        source,
+                    })?;
+                    strip_xml_decl(&body).replace(['\n', '\r'], " ")
+                }
+                Some(p) => {
+                    warnings.push(format!(
+                        "{file}: entity &{name}; file {} not found, skipped",
+                        p.display()
+                    ));
+                    String::new()
+                }
+                None => {
+                    warnings.push(format!(
+                        "{file}: entity &{name}; ({rel}) not resolved, skipped"
+                    ));
+                    String::new()
+                }
+            }
+        } else {
+            quoted.get(1).copied().unwrap_or_default().to_owned()
+        };
+        entities.push((name, content));
+        rest = &rest[decl_end..];
+    }
+    let mut out = String::with_capacity(text.len());
+    out.push_str(&text[..start]);
+    out.extend(std::iter::repeat_n('\n', doctype.matches('\n').count()));
+    let mut body = text[end..].to_owned();
+    for (name, content) in &entities {
+        body = body.replace(&format!("&{name};"), content);
+    }
+    out.push_str(&body);
+    Ok(out)
+}
+
+/// A decimal number, or a hexadecimal integer such as `0x00FF00` (C's `strtod` reads both).
+fn parse_number(text: &str) -> Option<f64> {
+    let t = text.trim();
+    match t.strip_prefix("0x").or_else(|| t.strip_prefix("0X")) {
+        Some(hex) => i64::from_str_radix(hex, 16).ok().map(|v| v as f64),
+        None => t.parse().ok(),
+    }
+}
+
+/// The byte just after the DOCTYPE starting at `start`, honouring an internal subset `[...]`.
+fn doctype_end(text: &str, start: usize) -> Option<usize> {
+    let mut depth = 0usize;
+    for (i, c) in text[start..].char_indices() {
+        match c {
+            '[' => depth += 1,
+            ']' => depth = depth.checked_sub(1)?,
+            '>' if depth == 0 => return Some(start + i + 1),
+            _ => {}
+        }
+    }
+    None
+}
+
+fn strip_xml_decl(body: &str) -> &str {
+    match (body.find("<?xml"), body.find("?>")) {
+        (Some(s), Some(e)) if s < e => &body[e + 2..],
+        _ => body,
+    }
+}
+
+fn line_of(text: &str, byte: usize) -> u32 {
+    text[..byte].matches('\n').count() as u32 + 1
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SAMPLE: &str = r#"<?xml version="1.0"?>
+<!DOCTYPE params SYSTEM "x.dtd" [
+<!ENTITY missing SYSTEM "does-not-exist.xml">
+]>
+<params name="t">
+  <section name="A">&missing;
+    <attnum name="len" unit="ft" val="10"/>
+    <attstr name="kind" val="str"/>
+    <section name="B"><attnum name="angle" unit="deg" val="90"/></section>
+  </section>
+</params>"#;
+
+    #[test]
+    fn reads_sections_units_and_lines() {
+        let p = Params::parse(SAMPLE, "sample.xml", Some(Path::new("/nonexistent"))).unwrap();
+        let a = p.section("A").unwrap();
+        assert_eq!(a.line, 6);
+        assert!((a.num("f", "len").unwrap().unwrap() - 3.048).abs() < 1e-12);
+        assert_eq!(a.str("kind"), Some("str"));
+        let b = p.section("A/B").unwrap();
+        assert_eq!(b.path, "A/B");
+        assert!((b.require_num("f", "angle").unwrap() - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+        assert_eq!(p.warnings.len(), 1, "{:?}", p.warnings);
+    }
+
+    #[test]
+    fn errors_name_file_line_and_element() {
+        let bad = SAMPLE.replace(r#"unit="ft""#, r#"unit="furlong""#);
+        let e = Params::parse(&bad, "sample.xml", None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("sample.xml:7") && e.contains("A/len") && e.contains("furlong"),
+            "{e}"
+        );
+        let bad = SAMPLE.replace(r#"val="10""#, r#"val="ten""#);
+        let e = Params::parse(&bad, "sample.xml", None)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("A/len") && e.contains("ten"), "{e}");
+        let truncated = &SAMPLE[..SAMPLE.len() - 40];
+        let e = Params::parse(truncated, "sample.xml", None)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("sample.xml:"), "{e}");
+        let e = p_missing();
+        assert!(e.contains("A/width") && e.contains("missing"), "{e}");
+    }
+
+    fn p_missing() -> String {
+        let p = Params::parse(SAMPLE, "sample.xml", None).unwrap();
+        p.section("A")
+            .unwrap()
+            .require_num(&p.file, "width")
+            .unwrap_err()
+            .to_string()
+    }
+}

@@ -1,0 +1,325 @@
+//! Race tracks: a closed centre line sampled at uniform arc length, with elevation, banking,
+//! width and road friction at every sample.
+//!
+//! Tracks come from TORCS / Speed Dreams XML files ([`torcs`]), TUMFTM racetrack-database
+//! centre lines ([`csv`]) or the built-in circuits ([`builtin`]); [`catalog`] resolves a name.
+
+pub mod builtin;
+pub mod catalog;
+pub mod csv;
+pub mod spline;
+pub mod torcs;
+
+use serde::Serialize;
+
+/// The track's state at one arc-length station of the centre line.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Sample {
+    /// Arc length from the start line (m).
+    pub s: f64,
+    /// Position (m), x east, y north.
+    pub x: f64,
+    /// Position (m).
+    pub y: f64,
+    /// Elevation of the centre line (m).
+    pub z: f64,
+    /// Heading of the centre line (rad, counter-clockwise from +x).
+    pub heading: f64,
+    /// Signed curvature κ = dθ/ds (1/m), positive for a left turn.
+    pub curvature: f64,
+    /// Grade dz/ds (fraction, positive uphill).
+    pub grade: f64,
+    /// Banking angle (rad), positive when the left edge is higher (helps left turns).
+    pub banking: f64,
+    /// Full width of the road (m).
+    pub width: f64,
+    /// Friction coefficient of the road surface (TORCS `friction`), scales the tyre grip.
+    pub friction: f64,
+}
+
+/// How far the centre line's end is from its start: a closed track has both near zero.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Closure {
+    /// Distance between end and start points (m).
+    pub gap_m: f64,
+    /// Difference between end and start headings, wrapped to [-180°, 180°] (deg).
+    pub heading_deg: f64,
+}
+
+/// A closed race track.
+#[derive(Debug, Clone)]
+pub struct Track {
+    /// Display name.
+    pub name: String,
+    /// Where it was loaded from (file path or `builtin:NAME`).
+    pub source: String,
+    /// Length of the centre line (m).
+    pub length: f64,
+    /// Closure error of the raw geometry before sampling.
+    pub closure: Closure,
+    /// Arc-length spacing of `samples` (m); `samples.len() as f64 * ds == length`.
+    pub ds: f64,
+    /// Samples at s = i·ds, i = 0..n; the track is periodic (sample n would be sample 0).
+    pub samples: Vec<Sample>,
+    /// Warnings met while loading (missing entity files, unknown surfaces, ...).
+    pub warnings: Vec<String>,
+}
+
+/// Where a point lies relative to the centre line.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Projection {
+    /// Index of the sample whose station is nearest.
+    pub index: usize,
+    /// Arc length of the foot point (m), in [0, length).
+    pub s: f64,
+    /// Signed lateral offset (m), positive to the left of the centre line.
+    pub lateral: f64,
+}
+
+impl Track {
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.samples.len()
+    }
+
+    /// Always false: a track has at least a few samples.
+    pub fn is_empty(&self) -> bool {
+        self.samples.is_empty()
+    }
+
+    /// The sample at index `i`, wrapping around the lap.
+    #[inline]
+    pub fn sample(&self, i: usize) -> &Sample {
+        &self.samples[i % self.samples.len()]
+    }
+
+    /// The index of the sample at or before arc length `s` (wrapped into the lap).
+    #[inline]
+    pub fn index_at(&self, s: f64) -> usize {
+        let s = s.rem_euclid(self.length);
+        ((s / self.ds) as usize).min(self.samples.len() - 1)
+    }
+
+    /// Projects (x, y) on the centre line, searching from `hint` (the last known index).
+    ///
+    /// Walks sample to sample while the point's tangential offset d = (p − cᵢ)·tᵢ lies outside
+    /// [−ds/2, ds/2]; O(1) when called every physics step with the previous index.
+    #[inline]
+    pub fn project(&self, x: f64, y: f64, hint: usize) -> Projection {
+        let n = self.samples.len();
+        let mut i = hint % n;
+        let half = 0.5 * self.ds;
+        for _ in 0..n {
+            let c = &self.samples[i];
+            let (sin, cos) = c.heading.sin_cos();
+            let (dx, dy) = (x - c.x, y - c.y);
+            let along = dx * cos + dy * sin;
+            if along > half {
+                i = (i + 1) % n;
+            } else if along < -half {
+                i = (i + n - 1) % n;
+            } else {
+                // Second-order correction for the arc between stations (κ·along ≪ 1):
+                // lateral = l − κa²/2, station offset = a(1 + κl).
+                let l = -dx * sin + dy * cos;
+                let lateral = l - 0.5 * c.curvature * along * along;
+                let s = (c.s + along * (1.0 + c.curvature * l)).rem_euclid(self.length);
+                return Projection {
+                    index: i,
+                    s,
+                    lateral,
+                };
+            }
+        }
+        self.project_global(x, y)
+    }
+
+    /// Projects (x, y) by scanning every sample (used when no hint is known).
+    pub fn project_global(&self, x: f64, y: f64) -> Projection {
+        let nearest = self
+            .samples
+            .iter()
+            .enumerate()
+            .map(|(i, c)| (i, (c.x - x).powi(2) + (c.y - y).powi(2)))
+            .fold(
+                (0, f64::INFINITY),
+                |best, cur| if cur.1 < best.1 { cur } else { best },
+            )
+            .0;
+        let c = &self.samples[nearest];
+        let (sin, cos) = c.heading.sin_cos();
+        let (dx, dy) = (x - c.x, y - c.y);
+        Projection {
+            index: nearest,
+            s: (c.s + dx * cos + dy * sin).rem_euclid(self.length),
+            lateral: -dx * sin + dy * cos,
+        }
+    }
+
+    /// Smallest radius of curvature along the lap (m).
+    pub fn min_radius(&self) -> f64 {
+        let k = self
+            .samples
+            .iter()
+            .map(|c| c.curvature.abs())
+            .fold(0.0, f64::max);
+        if k > 0.0 { 1.0 / k } else { f64::INFINITY }
+    }
+
+    /// Smallest road width along the lap (m).
+    pub fn min_width(&self) -> f64 {
+        self.samples
+            .iter()
+            .map(|c| c.width)
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// Lowest and highest elevation of the centre line (m).
+    pub fn z_range(&self) -> (f64, f64) {
+        self.samples
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), c| {
+                (lo.min(c.z), hi.max(c.z))
+            })
+    }
+
+    /// Builds a track by sampling a chain of constant-curvature pieces at uniform arc length.
+    pub fn from_pieces(name: &str, source: &str, pieces: &[Piece], warnings: Vec<String>) -> Track {
+        let length: f64 = pieces.iter().map(|p| p.length).sum();
+        let n = (length / TARGET_DS).round().max(8.0) as usize;
+        let ds = length / n as f64;
+        let mut samples = Vec::with_capacity(n);
+        let (mut x, mut y, mut heading, mut start) = (0.0, 0.0, 0.0, 0.0);
+        let mut pieces_iter = pieces.iter().filter(|p| p.length > 0.0).peekable();
+        let mut i = 0;
+        while let Some(p) = pieces_iter.next() {
+            let end = start + p.length;
+            let last = pieces_iter.peek().is_none();
+            while i < n && (i as f64 * ds < end || last) {
+                let s = i as f64 * ds;
+                let d = s - start;
+                let (px, py, ph) = advance(x, y, heading, p.curvature, d);
+                let t = d / p.length;
+                samples.push(Sample {
+                    s,
+                    x: px,
+                    y: py,
+                    z: p.z0 + (p.z1 - p.z0) * t,
+                    heading: ph,
+                    curvature: p.curvature,
+                    grade: (p.z1 - p.z0) / p.length,
+                    banking: p.banking0 + (p.banking1 - p.banking0) * t,
+                    width: p.width,
+                    friction: p.friction,
+                });
+                i += 1;
+            }
+            (x, y, heading) = advance(x, y, heading, p.curvature, p.length);
+            start = end;
+        }
+        let heading_err = (heading + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+            - std::f64::consts::PI;
+        let closure = Closure {
+            gap_m: x.hypot(y),
+            heading_deg: heading_err.to_degrees(),
+        };
+        Track {
+            name: name.to_owned(),
+            source: source.to_owned(),
+            length,
+            closure,
+            ds,
+            samples,
+            warnings,
+        }
+    }
+}
+
+/// Target spacing of the samples (m).
+pub const TARGET_DS: f64 = 1.0;
+
+/// A piece of centre line of constant curvature, the unit TORCS sub-divides segments into.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Piece {
+    /// Arc length (m).
+    pub length: f64,
+    /// Signed curvature (1/m), positive left.
+    pub curvature: f64,
+    /// Elevation at the start and end (m), linear in between.
+    pub z0: f64,
+    /// Elevation at the end (m).
+    pub z1: f64,
+    /// Banking at the start (rad).
+    pub banking0: f64,
+    /// Banking at the end (rad).
+    pub banking1: f64,
+    /// Road width (m).
+    pub width: f64,
+    /// Surface friction.
+    pub friction: f64,
+}
+
+/// Moves a pose along a circular arc of curvature `k` by arc length `d`:
+/// θ' = θ + k·d, x' = x + (sin θ' − sin θ)/k, y' = y − (cos θ' − cos θ)/k (a line when k = 0).
+#[inline]
+pub fn advance(x: f64, y: f64, heading: f64, k: f64, d: f64) -> (f64, f64, f64) {
+    let h1 = heading + k * d;
+    if (k * d).abs() < 1e-9 {
+        (x + d * heading.cos(), y + d * heading.sin(), h1)
+    } else {
+        (
+            x + (h1.sin() - heading.sin()) / k,
+            y - (h1.cos() - heading.cos()) / k,
+            h1,
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn circle(radius: f64) -> Track {
+        let p = Piece {
+            length: std::f64::consts::TAU * radius,
+            curvature: 1.0 / radius,
+            z0: 0.0,
+            z1: 0.0,
+            banking0: 0.0,
+            banking1: 0.0,
+            width: 10.0,
+            friction: 1.0,
+        };
+        Track::from_pieces("circle", "test", &[p], vec![])
+    }
+
+    #[test]
+    fn a_full_circle_closes_and_has_its_radius() {
+        let t = circle(100.0);
+        assert!(
+            t.closure.gap_m < 1e-9 && t.closure.heading_deg.abs() < 1e-9,
+            "{:?}",
+            t.closure
+        );
+        assert!((t.length - 200.0 * std::f64::consts::PI).abs() < 1e-9);
+        for c in &t.samples {
+            assert!((c.x.hypot(c.y - 100.0) - 100.0).abs() < 1e-9);
+        }
+        assert!((t.min_radius() - 100.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn projection_recovers_station_and_offset() {
+        let t = circle(100.0);
+        // A point 3 m outside the circle (to the right of a left turn) at angle 1 rad.
+        let (ang, r) = (1.0_f64, 103.0);
+        let (x, y) = (r * ang.sin(), 100.0 - r * ang.cos());
+        for hint in [0, 50, 300, t.len() - 1] {
+            let p = t.project(x, y, hint);
+            assert!((p.s - 100.0 * ang).abs() < 1e-4, "s {}", p.s);
+            assert!((p.lateral + 3.0).abs() < 1e-4, "lateral {}", p.lateral);
+        }
+        let g = t.project_global(x, y);
+        assert!((g.s - 100.0).abs() < 0.01 && (g.lateral + 3.0).abs() < 0.01);
+    }
+}

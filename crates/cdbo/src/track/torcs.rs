@@ -1,0 +1,379 @@
+//! TORCS / Speed Dreams track files (`tracks/road/NAME/NAME.xml`, version 4 segments).
+//!
+//! Follows TORCS's `track4.cpp` rules, so lengths equal the game's:
+//! - `str`: length `lg`. `lft` / `rgt`: radius r, `end radius` r₁ (default r), `arc` α;
+//!   nominal length (r + r₁)/2 · α.
+//! - Each segment is cut into `steps` = ⌊length / `profil steps length`⌋ + 1 sub-segments (or
+//!   `profil steps`). With r₁ ≠ r the radius grows linearly, rᵢ = r + i·(r₁ − r)/(steps − 1),
+//!   and the common sub-segment length ℓ is scaled so that Σ ℓ/rᵢ = α.
+//! - Heights: `z start` / `z end` (or left/right variants), else `grade` (kept from segment to
+//!   segment) gives z_end = z_start + length·grade; left and right edges follow cubic Hermite
+//!   profiles with `profil start/end tangent`; `banking start/end` override the edge heights.
+//!   Banking is atan((z_left − z_right) / width).
+//! - Road friction is the `friction` of the segment's `surface` in the `Surfaces` section.
+
+use std::path::Path;
+
+use super::{Piece, Track};
+use crate::error::Result;
+use crate::params::{Params, Section};
+
+/// Reads a TORCS track file.
+pub fn read(path: &Path) -> Result<Track> {
+    let params = Params::read(path)?;
+    from_params(&params, &path.display().to_string())
+}
+
+/// Builds a track from parsed parameters; `source` is recorded in the track.
+pub fn from_params(params: &Params, source: &str) -> Result<Track> {
+    let file = params.file.as_str();
+    let mut warnings = params.warnings.clone();
+    let main = params.require_section("Main Track")?;
+    let width = main.num_or(file, "width", 15.0)?;
+    if !(width > 0.0) {
+        return Err(params.error(
+            "Main Track/width",
+            Some(main.line),
+            format!("width must be positive, got {width} m"),
+        ));
+    }
+    let global_step = main.num_or(file, "profil steps length", 0.0)?;
+    let segments = params.require_section("Main Track/Track Segments")?;
+    if segments.sections.is_empty() {
+        return Err(params.error(&segments.path, Some(segments.line), "no segments"));
+    }
+    let mut surface = main.str("surface").unwrap_or("asphalt").to_owned();
+    let mut state = ProfileState::default();
+    let mut pieces = Vec::new();
+    for seg in &segments.sections {
+        if let Some(name) = seg.str("surface") {
+            surface = name.to_owned();
+        }
+        let friction = surface_friction(params, &surface, &mut warnings)?;
+        segment_pieces(
+            params,
+            seg,
+            width,
+            global_step,
+            friction,
+            &mut state,
+            &mut pieces,
+        )?;
+    }
+    let name = params
+        .section("Header")
+        .and_then(|h| h.str("name"))
+        .map(str::to_owned)
+        .unwrap_or_else(|| {
+            Path::new(source)
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default()
+        });
+    Ok(Track::from_pieces(&name, source, &pieces, warnings))
+}
+
+/// Friction of a named surface; 1.0 with a warning when the surface is not defined.
+fn surface_friction(params: &Params, surface: &str, warnings: &mut Vec<String>) -> Result<f64> {
+    match params.section("Surfaces").and_then(|s| s.section(surface)) {
+        Some(sec) => {
+            let f = sec.num_or(&params.file, "friction", 1.0)?;
+            if !(f > 0.0) {
+                return Err(params.error(
+                    &format!("{}/friction", sec.path),
+                    Some(sec.line),
+                    format!("friction must be positive, got {f}"),
+                ));
+            }
+            Ok(f)
+        }
+        None => {
+            let w = format!(
+                "{}: surface {surface:?} is not defined, friction 1.0 assumed",
+                params.file
+            );
+            if !warnings.contains(&w) {
+                warnings.push(w);
+            }
+            Ok(1.0)
+        }
+    }
+}
+
+/// Heights and tangents carried from one segment to the next, as TORCS does.
+#[derive(Debug, Default)]
+struct ProfileState {
+    /// Elevation of the left and right edges at the end of the previous segment.
+    zel: f64,
+    zer: f64,
+    /// End tangents of the left and right profiles (dz/ds).
+    etgtl: f64,
+    etgtr: f64,
+    /// The last `grade` given, if any.
+    grade: Option<f64>,
+}
+
+/// Cubic Hermite interpolation between heights p0, p1 with end slopes t0, t1 (scaled by the
+/// segment length), at t ∈ [0, 1]: p0(2t³−3t²+1) + p1(−2t³+3t²) + t0(t³−2t²+t) + t1(t³−t²).
+fn hermite(p0: f64, p1: f64, t0: f64, t1: f64, t: f64) -> f64 {
+    let (t2, t3) = (t * t, t * t * t);
+    p0 * (2.0 * t3 - 3.0 * t2 + 1.0)
+        + p1 * (-2.0 * t3 + 3.0 * t2)
+        + t0 * (t3 - 2.0 * t2 + t)
+        + t1 * (t3 - t2)
+}
+
+fn segment_pieces(
+    params: &Params,
+    seg: &Section,
+    width: f64,
+    global_step: f64,
+    friction: f64,
+    st: &mut ProfileState,
+    out: &mut Vec<Piece>,
+) -> Result<()> {
+    let file = params.file.as_str();
+    let err = |field: &str, msg: String| {
+        params.error(&format!("{}/{field}", seg.path), Some(seg.line), msg)
+    };
+    let kind = seg
+        .str("type")
+        .ok_or_else(|| err("type", "missing segment type (str, lft or rgt)".into()))?;
+    let (length, radius, radius_end, arc, sign) = match kind {
+        "str" => {
+            let lg = seg.require_num(file, "lg")?;
+            (lg, 0.0, 0.0, 0.0, 0.0)
+        }
+        "lft" | "rgt" => {
+            let r = seg.require_num(file, "radius")?;
+            let r1 = seg.num_or(file, "end radius", r)?;
+            let arc = seg.require_num(file, "arc")?;
+            if !(r > 0.0 && r1 > 0.0) {
+                return Err(err(
+                    "radius",
+                    format!("radii must be positive, got {r} m and {r1} m"),
+                ));
+            }
+            if !(arc > 0.0) {
+                return Err(err(
+                    "arc",
+                    format!("arc must be positive, got {} deg", arc.to_degrees()),
+                ));
+            }
+            (
+                0.5 * (r + r1) * arc,
+                r,
+                r1,
+                arc,
+                if kind == "lft" { 1.0 } else { -1.0 },
+            )
+        }
+        other => {
+            return Err(err(
+                "type",
+                format!("unknown segment type {other:?} (expected str, lft or rgt)"),
+            ));
+        }
+    };
+    if !(length > 0.0) {
+        return Err(err(
+            "lg",
+            format!("length must be positive, got {length} m"),
+        ));
+    }
+
+    // Elevation and banking (track4.cpp, "elevation and banking").
+    let mut zsl = seg.num_or(file, "z start left", st.zel)?;
+    let mut zsr = seg.num_or(file, "z start right", st.zer)?;
+    let mut zel = seg.num_or(file, "z end left", st.zel)?;
+    let mut zer = seg.num_or(file, "z end right", st.zer)?;
+    if let Some(g) = seg.num(file, "grade")? {
+        st.grade = Some(g);
+    }
+    let zs = match seg.num(file, "z start")? {
+        Some(z) => z,
+        None => 0.5 * (zsl + zsr),
+    };
+    let ze = match (seg.num(file, "z end")?, st.grade) {
+        (Some(z), _) => z,
+        (None, Some(g)) => zs + length * g,
+        (None, None) => 0.5 * (zel + zer),
+    };
+    let bank_s = seg.num_or(file, "banking start", (zsl - zsr).atan2(width))?;
+    let bank_e = seg.num_or(file, "banking end", (zel - zer).atan2(width))?;
+    let dz = bank_s.tan() * width / 2.0;
+    (zsl, zsr) = (zs + dz, zs - dz);
+    let dz = bank_e.tan() * width / 2.0;
+    (zel, zer) = (ze + dz, ze - dz);
+
+    // Profile (track4.cpp, "get segment profil").
+    let spline = seg.str("profil").unwrap_or("spline") == "spline";
+    let (steps, stgtl, etgtl, stgtr, etgtr);
+    if spline {
+        let mut n = seg.num_or(file, "profil steps", 1.0)? as usize;
+        if n <= 1 {
+            let step_len = seg.num_or(file, "profil steps length", global_step)?;
+            n = if step_len > 0.0 {
+                (length / step_len) as usize + 1
+            } else {
+                1
+            };
+        }
+        steps = n.clamp(1, 100_000);
+        // A common tangent overrides the left / right ones, which default to the previous end.
+        let tangent = |common: &str, side: &str, carried: f64| -> Result<f64> {
+            match seg.num(file, common)? {
+                Some(t) => Ok(t),
+                None => seg.num_or(file, &format!("{common} {side}"), carried),
+            }
+        };
+        stgtl = tangent("profil start tangent", "left", st.etgtl)?;
+        stgtr = tangent("profil start tangent", "right", st.etgtr)?;
+        etgtl = tangent("profil end tangent", "left", st.etgtl)?;
+        etgtr = tangent("profil end tangent", "right", st.etgtr)?;
+    } else {
+        steps = 1;
+        stgtl = (zel - zsl) / length;
+        etgtl = stgtl;
+        stgtr = (zer - zsr) / length;
+        etgtr = stgtr;
+    }
+    (st.zel, st.zer, st.etgtl, st.etgtr) = (zel, zer, etgtl, etgtr);
+
+    // Sub-segment lengths and radii (track4.cpp, "Compute the correct curLength").
+    let mut cur_length = length / steps as f64;
+    let mut dradius = (radius_end - radius) / steps as f64;
+    if radius_end != radius && steps != 1 {
+        dradius = (radius_end - radius) / (steps - 1) as f64;
+        let turned: f64 = (0..steps)
+            .map(|i| cur_length / (radius + i as f64 * dradius))
+            .sum();
+        cur_length *= arc / turned;
+    }
+    let (t1l, t2l, t1r, t2r) = (
+        stgtl * length,
+        etgtl * length,
+        stgtr * length,
+        etgtr * length,
+    );
+    let mut r = radius;
+    let (mut zl0, mut zr0) = (zsl, zsr);
+    for i in 0..steps {
+        let t = (i + 1) as f64 / steps as f64;
+        let zl1 = hermite(zsl, zel, t1l, t2l, t);
+        let zr1 = hermite(zsr, zer, t1r, t2r, t);
+        let curvature = if sign == 0.0 {
+            0.0
+        } else if dradius != 0.0 {
+            sign / r
+        } else {
+            // Constant radius: each step turns arc/steps exactly.
+            sign * (arc / steps as f64) / cur_length
+        };
+        out.push(Piece {
+            length: cur_length,
+            curvature,
+            z0: 0.5 * (zl0 + zr0),
+            z1: 0.5 * (zl1 + zr1),
+            banking0: (zl0 - zr0).atan2(width),
+            banking1: (zl1 - zr1).atan2(width),
+            width,
+            friction,
+        });
+        (zl0, zr0) = (zl1, zr1);
+        if sign != 0.0 {
+            r += dradius;
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hermite_meets_its_ends_and_slopes() {
+        let (p0, p1, t0, t1) = (1.0, 3.0, 0.5, -2.0);
+        assert!((hermite(p0, p1, t0, t1, 0.0) - p0).abs() < 1e-15);
+        assert!((hermite(p0, p1, t0, t1, 1.0) - p1).abs() < 1e-15);
+        let h = 1e-6;
+        let d0 = (hermite(p0, p1, t0, t1, h) - hermite(p0, p1, t0, t1, 0.0)) / h;
+        let d1 = (hermite(p0, p1, t0, t1, 1.0) - hermite(p0, p1, t0, t1, 1.0 - h)) / h;
+        assert!((d0 - t0).abs() < 1e-5 && (d1 - t1).abs() < 1e-5);
+    }
+
+    fn track_of(segments: &str) -> Result<Track> {
+        let xml = format!(
+            r#"<params name="t"><section name="Main Track"><attnum name="width" unit="m" val="10"/>
+            <attnum name="profil steps length" unit="m" val="4"/>
+            <section name="Track Segments">{segments}</section></section></params>"#
+        );
+        from_params(&Params::parse(&xml, "t.xml", None)?, "t.xml")
+    }
+
+    #[test]
+    fn a_stadium_of_straights_and_half_circles_closes() {
+        let half = r#"<attstr name="type" val="lft"/><attnum name="radius" unit="m" val="50"/><attnum name="arc" unit="deg" val="180"/>"#;
+        let straight = r#"<attstr name="type" val="str"/><attnum name="lg" unit="m" val="100"/>"#;
+        let t = track_of(&format!(
+            r#"<section name="a">{straight}</section><section name="b">{half}</section>
+               <section name="c">{straight}</section><section name="d">{half}</section>"#
+        ))
+        .unwrap();
+        assert!((t.length - (200.0 + 100.0 * std::f64::consts::PI)).abs() < 1e-9);
+        assert!(
+            t.closure.gap_m < 1e-9 && t.closure.heading_deg.abs() < 1e-9,
+            "{:?}",
+            t.closure
+        );
+        assert!((t.min_radius() - 50.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_spiral_turns_exactly_its_arc() {
+        // 90° left spiral 100 m → 200 m: TORCS keeps the arc and adjusts the length.
+        let t = track_of(
+            r#"<section name="s"><attstr name="type" val="lft"/><attnum name="radius" unit="m" val="100"/>
+               <attnum name="end radius" unit="m" val="200"/><attnum name="arc" unit="deg" val="90"/></section>"#,
+        )
+        .unwrap();
+        let turned: f64 = t.samples.iter().map(|c| c.curvature * t.ds).sum();
+        assert!(
+            (turned - std::f64::consts::FRAC_PI_2).abs() < 0.02,
+            "turned {turned}"
+        );
+        // The mean-radius length 150·π/2 ≈ 235.6 m is only approximate for a spiral.
+        assert!((t.length - 235.6).abs() < 10.0, "length {}", t.length);
+    }
+
+    #[test]
+    fn grade_carries_over_and_builds_height() {
+        let t = track_of(
+            r#"<section name="a"><attstr name="type" val="str"/><attnum name="lg" unit="m" val="100"/>
+               <attnum name="grade" unit="%" val="2"/></section>
+               <section name="b"><attstr name="type" val="str"/><attnum name="lg" unit="m" val="100"/></section>"#,
+        )
+        .unwrap();
+        let (lo, hi) = t.z_range();
+        assert!(lo.abs() < 1e-9);
+        assert!((hi - 4.0).abs() < 0.05, "z max {hi}");
+    }
+
+    #[test]
+    fn malformed_segments_name_their_element() {
+        let e = track_of(r#"<section name="bad one"><attstr name="type" val="lft"/><attnum name="arc" unit="deg" val="9"/></section>"#)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("t.xml") && e.contains("Main Track/Track Segments/bad one/radius"),
+            "{e}"
+        );
+        let e = track_of(r#"<section name="x"><attstr name="type" val="zigzag"/></section>"#)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("zigzag"), "{e}");
+        let e = track_of("").unwrap_err().to_string();
+        assert!(e.contains("no segments"), "{e}");
+    }
+}
