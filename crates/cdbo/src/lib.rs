@@ -9,6 +9,8 @@
 //! - [`drive`]: the environment's controllers (steering, demonstrator).
 //! - [`limit`]: the quasi-steady-state minimum lap time.
 
+pub mod car;
+pub mod data_path;
 pub mod error;
 pub mod params;
 pub mod track;

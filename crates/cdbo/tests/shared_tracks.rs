@@ -65,3 +65,107 @@ fn e_track_2_and_aalborg_match_torcs() {
     assert_eq!(t.samples[0].width, 10.0);
     assert_closed(&t);
 }
+
+#[test]
+fn monza_centre_line_is_closed_and_has_its_length() {
+    let t = cdbo::track::csv::read(&shared("tracks/csv/Monza.csv")).unwrap();
+    assert!((t.length - 5790.0).abs() < 10.0, "length {}", t.length);
+    assert!(t.min_radius() > 5.0, "min radius {}", t.min_radius());
+    eprintln!(
+        "Monza: {} m, min radius {} m, min width {} m",
+        t.length,
+        t.min_radius(),
+        t.min_width()
+    );
+}
+
+#[test]
+fn tracks_are_found_by_name_in_data_folders() {
+    use cdbo::data_path::DataPath;
+    let data = DataPath::with_env(&[shared("")], "");
+    let t = cdbo::track::catalog::find("forza", &data).unwrap();
+    assert!((t.length - 5784.1).abs() < 0.5);
+    let t = cdbo::track::catalog::find("allondaz", &data).unwrap();
+    assert!((t.length - 6355.6).abs() < 0.5);
+    let t = cdbo::track::catalog::find("monza", &data).unwrap();
+    assert!((t.length - 5790.0).abs() < 10.0);
+    let e = cdbo::track::catalog::find("nowhere-ring", &data)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("nowhere-ring") && e.contains("ridgeway") && e.contains("shared"),
+        "{e}"
+    );
+}
+
+#[test]
+fn spirit_300_from_its_files_equals_the_builtin_car() {
+    use cdbo::car::{Car, catalog, torcs};
+    let car = torcs::read(
+        &shared("speed-dreams/cars/models/sc-spirit-300/sc-spirit-300.xml"),
+        None,
+    )
+    .unwrap();
+    let builtin = Car::spirit_300();
+    assert_eq!(car.name, "Spirit 300");
+    for (a, b, what) in [
+        (car.mass, builtin.mass, "mass"),
+        (car.cg_height, builtin.cg_height, "cg"),
+        (car.front_weight, builtin.front_weight, "front weight"),
+        (car.wheelbase, builtin.wheelbase, "wheelbase"),
+        (car.cx, builtin.cx, "cx"),
+        (car.front_area, builtin.front_area, "area"),
+        (car.peak_torque(), builtin.peak_torque(), "torque"),
+        (car.rev_limiter, builtin.rev_limiter, "limiter"),
+        (car.final_drive, builtin.final_drive, "final drive"),
+        (car.shift_time, builtin.shift_time, "shift time"),
+        (
+            car.front_tyre.radius,
+            builtin.front_tyre.radius,
+            "front radius",
+        ),
+        (
+            car.rear_tyre.radius,
+            builtin.rear_tyre.radius,
+            "rear radius",
+        ),
+        (
+            car.front_tyre.dynamic_friction,
+            builtin.front_tyre.dynamic_friction,
+            "dyn friction",
+        ),
+        (
+            car.brake_torque(true),
+            builtin.brake_torque(true),
+            "front brake",
+        ),
+        (
+            car.brake_torque(false),
+            builtin.brake_torque(false),
+            "rear brake",
+        ),
+        (car.steer_lock, builtin.steer_lock, "steer lock"),
+    ] {
+        assert!(
+            (a - b).abs() <= 1e-9 * b.abs().max(1.0),
+            "{what}: {a} vs {b}"
+        );
+    }
+    assert_eq!(car.gears, builtin.gears);
+    // The category's curve runs on past the car's last point (above the limiter, unused).
+    assert_eq!(
+        car.torque_curve[..builtin.torque_curve.len()],
+        builtin.torque_curve[..]
+    );
+    assert_eq!(
+        car,
+        Car {
+            torque_curve: car.torque_curve.clone(),
+            ..builtin
+        }
+    );
+    let data = cdbo::data_path::DataPath::with_env(&[shared("")], "");
+    assert_eq!(catalog::find("sc-spirit-300", &data).unwrap().mass, 1440.0);
+    let trb1 = catalog::find("car1-trb1", &data).unwrap();
+    assert!(trb1.mass > 500.0 && !trb1.gears.is_empty());
+}

@@ -126,6 +126,23 @@ impl Section {
         Some(cur)
     }
 
+    /// Overlays `over` on this section, as TORCS merges a car file over its category file:
+    /// attributes of `over` replace those of the same name, sub-sections merge by name.
+    pub fn merge(&mut self, over: &Section) {
+        for a in &over.attrs {
+            match self.attrs.iter_mut().find(|b| b.name == a.name) {
+                Some(b) => *b = a.clone(),
+                None => self.attrs.push(a.clone()),
+            }
+        }
+        for s in &over.sections {
+            match self.sections.iter_mut().find(|t| t.name == s.name) {
+                Some(t) => t.merge(s),
+                None => self.sections.push(s.clone()),
+            }
+        }
+    }
+
     /// The attribute called `name`, if any.
     pub fn attr(&self, name: &str) -> Option<&Attr> {
         self.attrs.iter().find(|a| a.name == name)

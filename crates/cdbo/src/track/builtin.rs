@@ -1,1 +1,60 @@
+//! Built-in circuits, embedded in the binary so that every command works with no data files.
+//!
+//! They are written in the TORCS track format and read by [`super::torcs`], like real tracks.
 
+use super::Track;
+use crate::error::Result;
+use crate::params::Params;
+
+/// The default track of every command.
+pub const DEFAULT: &str = "ridgeway";
+
+/// (name, TORCS XML) of every built-in track.
+const TRACKS: &[(&str, &str)] = &[("ridgeway", include_str!("builtin/ridgeway.xml"))];
+
+/// The names of the built-in tracks.
+pub fn names() -> impl Iterator<Item = &'static str> {
+    TRACKS.iter().map(|(name, _)| *name)
+}
+
+/// Loads a built-in track, or `None` if no built-in track has this name.
+pub fn load(name: &str) -> Option<Result<Track>> {
+    let (name, xml) = TRACKS.iter().find(|(n, _)| *n == name)?;
+    let source = format!("builtin:{name}");
+    Some(Params::parse(xml, &source, None).and_then(|p| super::torcs::from_params(&p, &source)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_builtin_track_is_a_closed_circuit_of_3_to_6_km() {
+        for name in names() {
+            let t = load(name).unwrap().unwrap();
+            assert!(
+                (3000.0..6000.0).contains(&t.length),
+                "{name}: {} m",
+                t.length
+            );
+            assert!(
+                t.closure.gap_m < 0.01 && t.closure.heading_deg.abs() < 0.01,
+                "{name}: {:?}",
+                t.closure
+            );
+            assert!(t.warnings.is_empty(), "{:?}", t.warnings);
+            let (lo, hi) = t.z_range();
+            assert!(
+                hi - lo > 10.0,
+                "{name}: needs some elevation, has {} m",
+                hi - lo
+            );
+            assert!(
+                t.min_radius() < 60.0 && t.min_radius() > 30.0,
+                "{name}: slow corner {}",
+                t.min_radius()
+            );
+        }
+        assert!(load("nope").is_none());
+    }
+}

@@ -1,0 +1,270 @@
+//! Vehicle parameters, in SI units, as the simulator and the limit solver use them.
+//!
+//! Read from TORCS / Speed Dreams car files merged over their category ([`torcs`]); the
+//! built-in default is the paper's car, the Speed Dreams Spirit 300 ([`Car::spirit_300`]).
+
+pub mod catalog;
+pub mod torcs;
+
+use serde::Serialize;
+
+/// Which axle the engine drives.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum Drive {
+    /// Rear-wheel drive.
+    Rear,
+    /// Front-wheel drive.
+    Front,
+    /// Four-wheel drive, torque split evenly.
+    All,
+}
+
+/// One axle's tyres (both wheels alike) in the TORCS tyre model.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Tyre {
+    /// Rolling radius (m): rim diameter / 2 + tyre width × aspect ratio.
+    pub radius: f64,
+    /// Peak friction coefficient μ.
+    pub mu: f64,
+    /// Magic-Formula stiffness (TORCS `stiffness`, = B·C).
+    pub stiffness: f64,
+    /// Dynamic friction ratio (TORCS `dynamic friction`, a fraction) sets the shape C.
+    pub dynamic_friction: f64,
+    /// Curvature factor E (TORCS `elasticity factor`).
+    pub elasticity: f64,
+    /// Load at which μ is nominal (N).
+    pub operating_load: f64,
+    /// Rolling-resistance coefficient.
+    pub rolling_resistance: f64,
+    /// Rotational inertia of one wheel with its brake disc (kg·m²).
+    pub inertia: f64,
+}
+
+/// One axle's brakes (both wheels alike).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Brake {
+    /// Disc radius (m).
+    pub disc_radius: f64,
+    /// Piston area (m²).
+    pub piston_area: f64,
+    /// Pad friction coefficient.
+    pub pad_mu: f64,
+}
+
+/// A car.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Car {
+    /// Display name.
+    pub name: String,
+    /// Mass with driver and fuel (kg).
+    pub mass: f64,
+    /// Height of the centre of gravity (m).
+    pub cg_height: f64,
+    /// Fraction of the static weight on the front axle.
+    pub front_weight: f64,
+    /// Distance between the axles (m).
+    pub wheelbase: f64,
+    /// Yaw inertia factor k: I_z = k·m·a·b (TORCS `mass repartition coefficient`).
+    pub yaw_inertia_factor: f64,
+    /// Drag coefficient Cx.
+    pub cx: f64,
+    /// Frontal area (m²).
+    pub front_area: f64,
+    /// Lift coefficients of the front and rear axles (positive pushes down).
+    pub clift: [f64; 2],
+    /// Engine torque curve: (engine speed rad/s, torque N·m), increasing speed.
+    pub torque_curve: Vec<(f64, f64)>,
+    /// Rev limiter (rad/s): no torque above it.
+    pub rev_limiter: f64,
+    /// Idle speed (rad/s): the clutch slips below it.
+    pub tickover: f64,
+    /// Engine rotational inertia (kg·m²).
+    pub engine_inertia: f64,
+    /// Forward gear ratios, first gear first.
+    pub gears: Vec<f64>,
+    /// Final drive (differential) ratio.
+    pub final_drive: f64,
+    /// Time without drive during a gear change (s).
+    pub shift_time: f64,
+    /// Driven axle(s).
+    pub drive: Drive,
+    /// Front tyres.
+    pub front_tyre: Tyre,
+    /// Rear tyres.
+    pub rear_tyre: Tyre,
+    /// Maximum brake line pressure (Pa).
+    pub brake_pressure: f64,
+    /// Fraction of the pressure sent to the front brakes.
+    pub brake_front_share: f64,
+    /// Front brakes.
+    pub front_brake: Brake,
+    /// Rear brakes.
+    pub rear_brake: Brake,
+    /// Largest road-wheel steering angle (rad).
+    pub steer_lock: f64,
+}
+
+impl Car {
+    /// The Speed Dreams Spirit 300 (`sc-spirit-300.xml` over `Supercars.xml`), the paper's car.
+    pub fn spirit_300() -> Car {
+        let rpm = std::f64::consts::PI / 30.0;
+        let curve_rpm_nm = [
+            (0.0, 2000.0),
+            (500.0, 180.0),
+            (1000.0, 262.0),
+            (1500.0, 282.0),
+            (2000.0, 295.0),
+            (2500.0, 305.0),
+            (3000.0, 310.0),
+            (3500.0, 314.0),
+            (4000.0, 320.0),
+            (4500.0, 330.0),
+            (5000.0, 340.0),
+            (5500.0, 350.0),
+            (6000.0, 360.0),
+            (6500.0, 368.0),
+            (7000.0, 370.0),
+            (7500.0, 372.0),
+            (8000.0, 350.0),
+            (8500.0, 310.0),
+            (9000.0, 241.0),
+        ];
+        let tyre = |width: f64, aspect: f64, load: f64, inertia: f64| Tyre {
+            radius: 17.0 * 0.0254 / 2.0 + width * aspect,
+            mu: 1.3,
+            stiffness: 16.0,
+            dynamic_friction: 0.6,
+            elasticity: 0.86,
+            operating_load: load,
+            rolling_resistance: 0.01,
+            inertia,
+        };
+        Car {
+            name: "Spirit 300".into(),
+            mass: 1440.0,
+            cg_height: 0.285,
+            front_weight: 0.44,
+            wheelbase: 1.235 + 1.5,
+            yaw_inertia_factor: 0.62,
+            cx: 0.32,
+            front_area: 1.85,
+            clift: [0.65, 0.61],
+            torque_curve: curve_rpm_nm.iter().map(|&(r, t)| (r * rpm, t)).collect(),
+            rev_limiter: 8500.0 * rpm,
+            tickover: 2000.0 * rpm,
+            engine_inertia: 0.15,
+            gears: vec![3.66, 2.18, 1.4, 1.02, 0.85, 0.76],
+            final_drive: 4.5,
+            shift_time: 0.4,
+            drive: Drive::Rear,
+            front_tyre: tyre(0.255, 0.40, 3200.0, 1.283 + 0.1241),
+            rear_tyre: tyre(0.300, 0.37, 3800.0, 1.600 + 0.0714),
+            brake_pressure: 13_000.0e3,
+            brake_front_share: 0.52,
+            front_brake: Brake {
+                disc_radius: 0.190,
+                piston_area: 50.0e-4,
+                pad_mu: 0.45,
+            },
+            rear_brake: Brake {
+                disc_radius: 0.165,
+                piston_area: 30.0e-4,
+                pad_mu: 0.25,
+            },
+            steer_lock: 45f64.to_radians(),
+        }
+    }
+
+    /// Distance from the centre of gravity to the front axle, a = (1 − front_weight)·L (m).
+    pub fn cg_to_front(&self) -> f64 {
+        (1.0 - self.front_weight) * self.wheelbase
+    }
+
+    /// Distance from the centre of gravity to the rear axle, b = front_weight·L (m).
+    pub fn cg_to_rear(&self) -> f64 {
+        self.front_weight * self.wheelbase
+    }
+
+    /// Yaw inertia I_z = k·m·a·b (kg·m²).
+    pub fn yaw_inertia(&self) -> f64 {
+        self.yaw_inertia_factor * self.mass * self.cg_to_front() * self.cg_to_rear()
+    }
+
+    /// Engine torque at full throttle (N·m), linear between the curve's points, 0 past the
+    /// rev limiter.
+    pub fn engine_torque(&self, omega: f64) -> f64 {
+        if omega >= self.rev_limiter {
+            return 0.0;
+        }
+        let c = &self.torque_curve;
+        match c.iter().position(|&(w, _)| w > omega) {
+            Some(0) => c[0].1,
+            Some(i) => {
+                let ((w0, t0), (w1, t1)) = (c[i - 1], c[i]);
+                t0 + (t1 - t0) * (omega - w0) / (w1 - w0)
+            }
+            None => c.last().map_or(0.0, |p| p.1),
+        }
+    }
+
+    /// Largest full-throttle torque between idle and the rev limiter (N·m).
+    pub fn peak_torque(&self) -> f64 {
+        self.torque_curve
+            .iter()
+            .filter(|(w, _)| (self.tickover..=self.rev_limiter).contains(w))
+            .map(|p| p.1)
+            .fold(0.0, f64::max)
+    }
+
+    /// Brake torque of one wheel at full pedal (N·m): p·share·A_piston·μ_pad·r_disc.
+    pub fn brake_torque(&self, front: bool) -> f64 {
+        let (b, share) = if front {
+            (&self.front_brake, self.brake_front_share)
+        } else {
+            (&self.rear_brake, 1.0 - self.brake_front_share)
+        };
+        self.brake_pressure * share * b.piston_area * b.pad_mu * b.disc_radius
+    }
+
+    /// Aerodynamic drag force at speed v: F = 0.645·Cx·A·v² (N), 0.645 = ρ/2 with ρ = 1.29.
+    pub fn drag(&self, v: f64) -> f64 {
+        AIR_HALF_RHO * self.cx * self.front_area * v * v
+    }
+
+    /// Downforce on the front and rear axles at speed v: Fᵢ = 0.645·Clᵢ·A·v² (N).
+    pub fn downforce(&self, v: f64) -> [f64; 2] {
+        let q = AIR_HALF_RHO * self.front_area * v * v;
+        [q * self.clift[0], q * self.clift[1]]
+    }
+}
+
+/// Half the air density, ρ/2 (kg/m³), the 0.645 of TORCS's aerodynamics.
+pub const AIR_HALF_RHO: f64 = 0.645;
+
+/// Pad friction when a brake does not give one (TORCS's default).
+pub const DEFAULT_PAD_MU: f64 = 0.30;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spirit_300_has_the_papers_figures() {
+        let c = Car::spirit_300();
+        assert_eq!(c.mass, 1440.0);
+        assert!((c.peak_torque() - 372.0).abs() < 1e-9);
+        assert_eq!(c.gears.len(), 6);
+        assert!((c.front_tyre.radius - 0.3179).abs() < 1e-3);
+        // a + b = L, and the static front load fraction is b / L.
+        assert!((c.cg_to_front() + c.cg_to_rear() - c.wheelbase).abs() < 1e-12);
+        assert!((c.cg_to_rear() / c.wheelbase - 0.44).abs() < 1e-12);
+    }
+
+    #[test]
+    fn torque_curve_interpolates_and_cuts_at_the_limiter() {
+        let c = Car::spirit_300();
+        let rpm = std::f64::consts::PI / 30.0;
+        assert!((c.engine_torque(7250.0 * rpm) - 371.0).abs() < 1e-9);
+        assert_eq!(c.engine_torque(8600.0 * rpm), 0.0);
+    }
+}

@@ -1,0 +1,255 @@
+//! TORCS / Speed Dreams car files: the car's XML merged over its category's XML.
+//!
+//! Values missing from both take TORCS's defaults; required values (mass, torque curve, gear
+//! ratios) missing from both are an error naming the element.
+
+use std::path::{Path, PathBuf};
+
+use super::{Brake, Car, DEFAULT_PAD_MU, Drive, Tyre};
+use crate::error::{Error, Result};
+use crate::params::{Params, Section};
+
+/// Reads a car file and the category file it names (`Car/category`), found beside it in the
+/// TORCS layout (`cars/NAME/NAME.xml` → `categories/CAT.xml`) or the Speed Dreams layout
+/// (`cars/models/NAME/NAME.xml` → `cars/categories/CAT.xml`). A missing category file is an
+/// error; pass `category` explicitly to choose one.
+pub fn read(path: &Path, category: Option<&Path>) -> Result<Car> {
+    let car = Params::read(path)?;
+    let category_path = match category {
+        Some(c) => Some(c.to_owned()),
+        None => match car.section("Car").and_then(|c| c.str("category")) {
+            Some(cat) => Some(find_category(path, cat).ok_or_else(|| {
+                Error::invalid(
+                    car.file.clone(),
+                    "Car/category",
+                    format!("category file {cat}.xml not found in ../../categories or ../../../categories/../cars/categories; pass it explicitly"),
+                )
+            })?),
+            None => None,
+        },
+    };
+    let merged = match category_path {
+        Some(p) => {
+            let mut base = Params::read(&p)?;
+            base.root.merge(&car.root);
+            base.root.name = car.root.name.clone();
+            base.file = car.file.clone();
+            base
+        }
+        None => car,
+    };
+    from_params(&merged)
+}
+
+fn find_category(car: &Path, cat: &str) -> Option<PathBuf> {
+    let dir = car.parent()?;
+    let file = format!("{cat}.xml");
+    [
+        dir.join("../../categories"),
+        dir.join("../../../categories"),
+        dir.join("../../../cars/categories"),
+        dir.join("../categories"),
+    ]
+    .into_iter()
+    .map(|d| d.join(&file))
+    .find(|p| p.is_file())
+}
+
+/// Builds a car from (merged) parameters.
+pub fn from_params(p: &Params) -> Result<Car> {
+    let f = p.file.as_str();
+    let empty = Section::default();
+    let sec = |name: &str| p.section(name).unwrap_or(&empty);
+    let car = p.require_section("Car")?;
+    let positive = |s: &Section, name: &str, v: f64| -> Result<f64> {
+        if v > 0.0 && v.is_finite() {
+            Ok(v)
+        } else {
+            Err(p.error(
+                &format!("{}/{name}", s.path),
+                Some(s.line),
+                format!("must be positive, got {v}"),
+            ))
+        }
+    };
+    let fraction = |s: &Section, name: &str, v: f64| -> Result<f64> {
+        if (0.0..=1.0).contains(&v) {
+            Ok(v)
+        } else {
+            Err(p.error(
+                &format!("{}/{name}", s.path),
+                Some(s.line),
+                format!("must be in [0, 1], got {v}"),
+            ))
+        }
+    };
+
+    let mass = positive(car, "mass", car.require_num(f, "mass")?)?;
+    let cg_height = positive(car, "GC height", car.num_or(f, "GC height", 0.3)?)?;
+    let front_weight = fraction(
+        car,
+        "front-rear weight repartition",
+        car.num_or(f, "front-rear weight repartition", 0.5)?,
+    )?;
+    let yaw_inertia_factor = positive(
+        car,
+        "mass repartition coefficient",
+        car.num_or(f, "mass repartition coefficient", 1.0)?,
+    )?;
+    let (fa, ra) = (sec("Front Axle"), sec("Rear Axle"));
+    let wheelbase = positive(
+        fa,
+        "xpos",
+        fa.num_or(f, "xpos", 1.2)? - ra.num_or(f, "xpos", -1.4)?,
+    )?;
+
+    let aero = sec("Aerodynamics");
+    let cx = positive(aero, "Cx", aero.num_or(f, "Cx", 0.4)?)?;
+    let front_area = positive(aero, "front area", aero.num_or(f, "front area", 2.0)?)?;
+    let clift = [
+        aero.num_or(f, "front Clift", 0.0)?,
+        aero.num_or(f, "rear Clift", 0.0)?,
+    ];
+
+    let engine = p.require_section("Engine")?;
+    let points = engine.section("data points").ok_or_else(|| {
+        p.error(
+            "Engine/data points",
+            Some(engine.line),
+            "missing torque curve",
+        )
+    })?;
+    let mut torque_curve = Vec::new();
+    for pt in &points.sections {
+        let w = pt.require_num(f, "rpm")?;
+        let t = pt.require_num(f, "Tq")?;
+        if let Some(&(w0, _)) = torque_curve.last()
+            && w <= w0
+        {
+            return Err(p.error(
+                &format!("{}/rpm", pt.path),
+                Some(pt.line),
+                "engine speeds must increase",
+            ));
+        }
+        torque_curve.push((w, t));
+    }
+    if torque_curve.len() < 2 {
+        return Err(p.error(
+            &points.path,
+            Some(points.line),
+            "the torque curve needs at least 2 points",
+        ));
+    }
+    let rev_limiter = positive(
+        engine,
+        "revs limiter",
+        engine.num_or(f, "revs limiter", engine.num_or(f, "revs maxi", 800.0)?)?,
+    )?;
+    let tickover = engine.num_or(f, "tickover", 100.0)?;
+    let engine_inertia = positive(engine, "inertia", engine.num_or(f, "inertia", 0.2)?)?;
+
+    let gearbox = p.require_section("Gearbox")?;
+    let shift_time = gearbox.num_or(f, "shift time", 0.2)?;
+    let mut gears = Vec::new();
+    for i in 1..=10 {
+        match gearbox.section(&format!("gears/{i}")) {
+            Some(g) => gears.push(positive(g, "ratio", g.require_num(f, "ratio")?)?),
+            None => break,
+        }
+    }
+    if gears.is_empty() {
+        return Err(p.error(
+            "Gearbox/gears",
+            Some(gearbox.line),
+            "no forward gears (sections 1, 2, ...)",
+        ));
+    }
+    let drive = match sec("Drivetrain").str("type").unwrap_or("RWD") {
+        "RWD" => Drive::Rear,
+        "FWD" => Drive::Front,
+        "4WD" => Drive::All,
+        other => {
+            return Err(p.error(
+                "Drivetrain/type",
+                None,
+                format!("unknown drivetrain {other:?} (RWD, FWD or 4WD)"),
+            ));
+        }
+    };
+    let diff = |name: &str| sec(name).num_or(f, "ratio", 1.0);
+    let final_drive = match drive {
+        Drive::Rear => diff("Rear Differential")?,
+        Drive::Front => diff("Front Differential")?,
+        Drive::All => diff("Central Differential")? * diff("Rear Differential")?,
+    };
+
+    let tyre = |name: &str| -> Result<Tyre> {
+        let w = sec(name);
+        let rim = w.num_or(f, "rim diameter", 0.33)?;
+        let width = w.num_or(f, "tire width", 0.145)?;
+        let aspect = w.num_or(f, "tire height-width ratio", 0.75)?;
+        let brake = sec(&name.replace("Wheel", "Brake"));
+        Ok(Tyre {
+            radius: positive(w, "rim diameter", rim / 2.0 + width * aspect)?,
+            mu: positive(w, "mu", w.num_or(f, "mu", 1.0)?)?,
+            stiffness: positive(w, "stiffness", w.num_or(f, "stiffness", 30.0)?)?,
+            dynamic_friction: fraction(
+                w,
+                "dynamic friction",
+                w.num_or(f, "dynamic friction", 0.8)?,
+            )?,
+            elasticity: w.num_or(f, "elasticity factor", 0.7)?,
+            operating_load: positive(w, "operating load", w.num_or(f, "operating load", 5000.0)?)?,
+            rolling_resistance: w.num_or(f, "rolling resistance", 0.02)?,
+            inertia: w.num_or(f, "inertia", 1.5)? + brake.num_or(f, "inertia", 0.13)?,
+        })
+    };
+    let brake = |name: &str| -> Result<Brake> {
+        let b = sec(name);
+        Ok(Brake {
+            disc_radius: positive(b, "disk diameter", b.num_or(f, "disk diameter", 0.2)? / 2.0)?,
+            piston_area: positive(b, "piston area", b.num_or(f, "piston area", 0.002)?)?,
+            pad_mu: positive(b, "mu", b.num_or(f, "mu", DEFAULT_PAD_MU)?)?,
+        })
+    };
+    let brakes = sec("Brake System");
+    Ok(Car {
+        name: p.root.name.clone(),
+        mass,
+        cg_height,
+        front_weight,
+        wheelbase,
+        yaw_inertia_factor,
+        cx,
+        front_area,
+        clift,
+        torque_curve,
+        rev_limiter,
+        tickover,
+        engine_inertia,
+        gears,
+        final_drive: positive(sec("Rear Differential"), "ratio", final_drive)?,
+        shift_time,
+        drive,
+        front_tyre: tyre("Front Right Wheel")?,
+        rear_tyre: tyre("Rear Right Wheel")?,
+        brake_pressure: positive(
+            brakes,
+            "max pressure",
+            brakes.num_or(f, "max pressure", 1.0e7)?,
+        )?,
+        brake_front_share: fraction(
+            brakes,
+            "front-rear brake repartition",
+            brakes.num_or(f, "front-rear brake repartition", 0.5)?,
+        )?,
+        front_brake: brake("Front Right Brake")?,
+        rear_brake: brake("Rear Right Brake")?,
+        steer_lock: positive(
+            sec("Steer"),
+            "steer lock",
+            sec("Steer").num_or(f, "steer lock", 0.43)?,
+        )?,
+    })
+}
