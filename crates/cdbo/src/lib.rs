@@ -11,8 +11,10 @@
 
 pub mod car;
 pub mod data_path;
+pub mod drive;
 pub mod error;
 pub mod params;
+pub mod sim;
 pub mod track;
 
 pub use error::{Error, Result};

@@ -1,0 +1,45 @@
+//! The driver: the environment's controllers and the pedal command they follow.
+//!
+//! A lap is driven by a [`Pedal`] (the optimised policy, the demonstrator or a constant), which
+//! maps the observation — chiefly x, the fraction of the lap — to a ∈ [−1, 1] (throttle > 0,
+//! brake < 0). Steering is the environment's [`steering::Steering`] controller, never optimised.
+
+pub mod demo;
+pub mod steering;
+
+/// What the driver sees at each driver step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Observation {
+    /// Position along the centre line as a fraction of the lap, x ∈ [0, 1].
+    pub x: f64,
+    /// Speed over ground (m/s).
+    pub speed: f64,
+    /// Time since the start (s).
+    pub time: f64,
+}
+
+/// A throttle/brake command source.
+pub trait Pedal {
+    /// The command a ∈ [−1, 1] for this observation.
+    fn pedal(&mut self, obs: &Observation) -> f64;
+}
+
+/// The same command everywhere (`cdbo lap --throttle A`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ConstantPedal(pub f64);
+
+impl Pedal for ConstantPedal {
+    fn pedal(&mut self, _: &Observation) -> f64 {
+        self.0.clamp(-1.0, 1.0)
+    }
+}
+
+/// Any function of the lap fraction x is a pedal (e.g. a policy π(x)).
+#[derive(Debug, Clone, Copy)]
+pub struct PolicyPedal<F: Fn(f64) -> f64>(pub F);
+
+impl<F: Fn(f64) -> f64> Pedal for PolicyPedal<F> {
+    fn pedal(&mut self, obs: &Observation) -> f64 {
+        (self.0)(obs.x).clamp(-1.0, 1.0)
+    }
+}

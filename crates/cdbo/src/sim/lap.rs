@@ -1,0 +1,290 @@
+//! One lap: the expensive evaluation of the paper, reward R = L/T, or 0 if the lap fails.
+//!
+//! The car starts standing on the start line, on the centre line, facing along it. Every
+//! physics step (2 ms) the car is projected on the centre line; every driver step (20 ms) the
+//! pedal and the steering controller update their commands, which are held in between. The lap
+//! ends when the car has covered the track's length, or fails when:
+//! - **off track**: the car's centre is more than width/2 + 1 m from the centre line;
+//! - **spun**: the car faces more than 90° away from the track, or slides with a body slip
+//!   angle above 60° at more than 3 m/s;
+//! - **backwards**: the car has moved 10 m back from the farthest point it reached;
+//! - **stalled**: slower than 0.5 m/s for 5 s;
+//! - **time limit**: the lap takes longer than its limit.
+//!
+//! Nothing else ends a lap: whether these happen follows from speed, grip and steering.
+
+use serde::Serialize;
+
+use super::vehicle::{Controls, State, Vehicle};
+use crate::car::Car;
+use crate::drive::steering::{Steering, wrap_angle};
+use crate::drive::{Observation, Pedal};
+use crate::track::Track;
+
+/// Why a lap failed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FailureReason {
+    /// The car left the road.
+    OffTrack,
+    /// The car spun.
+    Spun,
+    /// The car drove backwards.
+    Backwards,
+    /// The car stopped.
+    Stalled,
+    /// The lap took too long.
+    TimeLimit,
+}
+
+/// Where and when a lap failed.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Failure {
+    /// Why.
+    pub reason: FailureReason,
+    /// Lap fraction of the car's station.
+    pub x: f64,
+    /// Distance covered (m).
+    pub distance_m: f64,
+    /// Time since the start (s).
+    pub time_s: f64,
+}
+
+/// One driver step of a lap, recorded when a trace is asked for.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct TracePoint {
+    /// Time (s).
+    pub t: f64,
+    /// Distance covered along the centre line (m).
+    pub distance_m: f64,
+    /// Lap fraction x.
+    pub x: f64,
+    /// Speed (m/s).
+    pub speed: f64,
+    /// Pedal command a ∈ [−1, 1].
+    pub pedal: f64,
+    /// Steering angle (rad).
+    pub steer: f64,
+    /// Offset from the centre line (m), positive left.
+    pub lateral: f64,
+    /// Angle between the car's heading and the centre line's (rad).
+    pub heading_error: f64,
+    /// Body slip angle atan(v_y / vₓ) (rad).
+    pub slip_angle: f64,
+    /// Gear (1 = first).
+    pub gear: usize,
+    /// Engine speed (rpm).
+    pub rpm: f64,
+    /// Position (m).
+    pub pos_x: f64,
+    /// Position (m).
+    pub pos_y: f64,
+}
+
+/// The outcome of a lap.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LapResult {
+    /// Whether the car completed the lap.
+    pub completed: bool,
+    /// Lap time (s) when completed.
+    pub lap_time_s: Option<f64>,
+    /// Reward R = L/T (m/s), 0 when the lap failed.
+    pub reward_mps: f64,
+    /// Why and where the lap failed, if it did.
+    pub failure: Option<Failure>,
+    /// Simulated time (s).
+    pub simulated_s: f64,
+    /// The driver steps, when asked for.
+    #[serde(skip)]
+    pub trace: Vec<TracePoint>,
+}
+
+/// Settings of a lap.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LapConfig {
+    /// Physics step (s): TORCS's 2 ms.
+    pub dt: f64,
+    /// Physics steps per driver step: 10, i.e. the driver at 50 Hz.
+    pub driver_every: usize,
+    /// Extra distance beyond half the width before the car is off track (m).
+    pub off_track_margin: f64,
+    /// Time limit (s); `None`: 30 s + L / (4 m/s).
+    pub time_limit: Option<f64>,
+    /// Record a trace of every driver step.
+    pub trace: bool,
+    /// The steering controller (its gains; its memory starts empty each lap).
+    pub steering: Steering,
+}
+
+impl Default for LapConfig {
+    fn default() -> Self {
+        LapConfig {
+            dt: 0.002,
+            driver_every: 10,
+            off_track_margin: 1.0,
+            time_limit: None,
+            trace: false,
+            steering: Steering::new(),
+        }
+    }
+}
+
+const SPIN_HEADING: f64 = std::f64::consts::FRAC_PI_2;
+const SPIN_SLIP_ANGLE: f64 = std::f64::consts::FRAC_PI_3;
+const SPIN_MIN_SPEED: f64 = 3.0;
+const BACKWARDS_DISTANCE: f64 = 10.0;
+const STALL_SPEED: f64 = 0.5;
+const STALL_TIME: f64 = 5.0;
+
+/// A track and a car, ready to run laps.
+#[derive(Debug, Clone)]
+pub struct Simulator {
+    /// The track.
+    pub track: Track,
+    /// The car, prepared for simulation.
+    pub vehicle: Vehicle,
+    /// Lap settings.
+    pub config: LapConfig,
+}
+
+impl Simulator {
+    /// A simulator with the default settings.
+    pub fn new(track: Track, car: &Car) -> Simulator {
+        Simulator {
+            track,
+            vehicle: Vehicle::new(car),
+            config: LapConfig::default(),
+        }
+    }
+
+    /// The time limit of a lap (s).
+    pub fn time_limit(&self) -> f64 {
+        self.config
+            .time_limit
+            .unwrap_or(30.0 + self.track.length / 4.0)
+    }
+
+    /// Drives one lap with `pedal` and the steering controller.
+    pub fn lap(&self, pedal: &mut dyn Pedal) -> LapResult {
+        let track = &self.track;
+        let cfg = &self.config;
+        let car = &self.vehicle.car;
+        let start = track.sample(0);
+        let mut state: State = self.vehicle.at_rest(start.x, start.y, start.heading);
+        let mut steering = cfg.steering.clone();
+        let mut controls = Controls::default();
+        let mut proj = track.project(state.x, state.y, 0);
+        let (mut distance, mut farthest, mut slow_for) = (0.0, 0.0, 0.0);
+        let mut trace = Vec::new();
+        let limit = self.time_limit();
+        let driver_dt = cfg.dt * cfg.driver_every as f64;
+        let mut step = 0usize;
+        let fail = |reason, distance: f64, t: f64| LapResult {
+            completed: false,
+            lap_time_s: None,
+            reward_mps: 0.0,
+            failure: Some(Failure {
+                reason,
+                x: (distance / track.length).clamp(0.0, 1.0),
+                distance_m: distance,
+                time_s: t,
+            }),
+            simulated_s: t,
+            trace: Vec::new(),
+        };
+        loop {
+            let t = step as f64 * cfg.dt;
+            if step % cfg.driver_every == 0 {
+                let x = (distance / track.length).clamp(0.0, 1.0);
+                let a = pedal
+                    .pedal(&Observation {
+                        x,
+                        speed: state.speed(),
+                        time: t,
+                    })
+                    .clamp(-1.0, 1.0);
+                let a = if a.is_nan() { 0.0 } else { a };
+                controls.throttle = a.max(0.0);
+                controls.brake = (-a).max(0.0);
+                controls.steer = steering.update(
+                    track,
+                    car.wheelbase,
+                    car.steer_lock,
+                    &state,
+                    &proj,
+                    driver_dt,
+                );
+                self.vehicle.shift(&mut state);
+                if cfg.trace {
+                    trace.push(TracePoint {
+                        t,
+                        distance_m: distance,
+                        x,
+                        speed: state.speed(),
+                        pedal: a,
+                        steer: controls.steer,
+                        lateral: proj.lateral,
+                        heading_error: wrap_angle(state.yaw - track.sample(proj.index).heading),
+                        slip_angle: state.vy.atan2(state.vx.abs().max(1e-9)),
+                        gear: state.gearbox.gear + 1,
+                        rpm: state.engine_speed * 30.0 / std::f64::consts::PI,
+                        pos_x: state.x,
+                        pos_y: state.y,
+                    });
+                }
+            }
+            let road = track.sample(proj.index);
+            self.vehicle.step(&mut state, &controls, road, cfg.dt);
+            step += 1;
+            let t = step as f64 * cfg.dt;
+            let prev_s = proj.s;
+            proj = track.project(state.x, state.y, proj.index);
+            let mut ds = proj.s - prev_s;
+            if ds > track.length / 2.0 {
+                ds -= track.length;
+            } else if ds < -track.length / 2.0 {
+                ds += track.length;
+            }
+            let before = distance;
+            distance += ds;
+            if distance >= track.length {
+                let lap_time = t - cfg.dt + cfg.dt * (track.length - before) / ds;
+                return LapResult {
+                    completed: true,
+                    lap_time_s: Some(lap_time),
+                    reward_mps: track.length / lap_time,
+                    failure: None,
+                    simulated_s: t,
+                    trace,
+                };
+            }
+            farthest = f64::max(farthest, distance);
+            let road = track.sample(proj.index);
+            let half_width = 0.5 * road.width + cfg.off_track_margin;
+            let failure = if proj.lateral.abs() > half_width {
+                Some(super::FailureReason::OffTrack)
+            } else if wrap_angle(state.yaw - road.heading).abs() > SPIN_HEADING
+                || (state.speed() > SPIN_MIN_SPEED
+                    && state.vy.atan2(state.vx).abs() > SPIN_SLIP_ANGLE)
+            {
+                Some(super::FailureReason::Spun)
+            } else if distance < farthest - BACKWARDS_DISTANCE {
+                Some(super::FailureReason::Backwards)
+            } else if t > limit {
+                Some(super::FailureReason::TimeLimit)
+            } else {
+                slow_for = if state.speed() < STALL_SPEED {
+                    slow_for + cfg.dt
+                } else {
+                    0.0
+                };
+                (slow_for > STALL_TIME).then_some(super::FailureReason::Stalled)
+            };
+            if let Some(reason) = failure {
+                let mut r = fail(reason, distance.max(0.0), t);
+                r.trace = trace;
+                return r;
+            }
+        }
+    }
+}

@@ -1,0 +1,150 @@
+//! Engine, clutch and automatic gearbox.
+//!
+//! Wheel torque at full throttle in gear i: T_w = T_e(ω_e)·gᵢ·g_f with engine speed
+//! ω_e = ω_wheel·gᵢ·g_f (efficiency 1, as the Spirit 300's file gives). Below idle the clutch
+//! slips and the engine delivers T_e(ω_idle). The gearbox shifts up when the next gear gives
+//! more wheel torque at the same road speed (or at the rev limiter) and down when the lower
+//! gear would still be below its own up-shift speed; each shift cuts the drive for the car's
+//! `shift time`.
+
+use crate::car::Car;
+
+/// Hysteresis between the up-shift speed of gear i−1 and the down-shift into it.
+const DOWNSHIFT_MARGIN: f64 = 0.85;
+
+/// Gearbox state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Gearbox {
+    /// Current gear, 0-based (0 = first).
+    pub gear: usize,
+    /// Time left in the current shift (s); no drive while positive.
+    pub shifting: f64,
+}
+
+/// Shift points of a car, computed once.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ShiftMap {
+    /// Engine speed at which to leave gear i for gear i+1 (rad/s).
+    pub upshift: Vec<f64>,
+}
+
+impl ShiftMap {
+    /// The engine speed in each gear above which the next gear gives more wheel torque.
+    pub fn new(car: &Car) -> ShiftMap {
+        let g = &car.gears;
+        let upshift = (0..g.len())
+            .map(|i| {
+                if i + 1 == g.len() {
+                    return car.rev_limiter;
+                }
+                let ratio = g[i + 1] / g[i];
+                let steps = 400;
+                (0..=steps)
+                    .map(|k| {
+                        car.tickover + (car.rev_limiter - car.tickover) * k as f64 / steps as f64
+                    })
+                    .find(|&w| {
+                        car.engine_torque(w * ratio) * g[i + 1] > car.engine_torque(w) * g[i]
+                    })
+                    .unwrap_or(car.rev_limiter)
+                    .min(car.rev_limiter * 0.995)
+            })
+            .collect();
+        ShiftMap { upshift }
+    }
+}
+
+impl Gearbox {
+    /// Standing in first gear.
+    pub fn new() -> Gearbox {
+        Gearbox {
+            gear: 0,
+            shifting: 0.0,
+        }
+    }
+
+    /// Chooses the gear for a driven-wheel speed ω (rad/s); starts a shift when it changes.
+    pub fn update(&mut self, car: &Car, map: &ShiftMap, wheel_omega: f64) {
+        if self.shifting > 0.0 {
+            return;
+        }
+        let fd = car.final_drive;
+        let engine = |gear: usize| wheel_omega * car.gears[gear] * fd;
+        if self.gear + 1 < car.gears.len() && engine(self.gear) >= map.upshift[self.gear] {
+            self.gear += 1;
+            self.shifting = car.shift_time;
+        } else if self.gear > 0
+            && engine(self.gear - 1) < DOWNSHIFT_MARGIN * map.upshift[self.gear - 1]
+        {
+            self.gear -= 1;
+            self.shifting = car.shift_time;
+        }
+    }
+
+    /// Total ratio engine → wheel in the current gear.
+    #[inline]
+    pub fn ratio(&self, car: &Car) -> f64 {
+        car.gears[self.gear] * car.final_drive
+    }
+
+    /// Drive torque at the driven wheels (N·m) for a throttle in [0, 1], and the engine speed.
+    #[inline]
+    pub fn wheel_torque(&self, car: &Car, throttle: f64, wheel_omega: f64) -> (f64, f64) {
+        let ratio = self.ratio(car);
+        let engine = (wheel_omega * ratio).max(car.tickover);
+        if self.shifting > 0.0 {
+            return (0.0, engine);
+        }
+        (throttle * car.engine_torque(engine) * ratio, engine)
+    }
+}
+
+impl Default for Gearbox {
+    fn default() -> Self {
+        Gearbox::new()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn upshift_points_maximise_wheel_torque() {
+        let car = Car::spirit_300();
+        let map = ShiftMap::new(&car);
+        assert_eq!(map.upshift.len(), car.gears.len());
+        for i in 0..car.gears.len() - 1 {
+            let w = map.upshift[i];
+            let ratio = car.gears[i + 1] / car.gears[i];
+            // Just past the point the next gear is better, just before it the current one is.
+            assert!(
+                car.engine_torque(w * ratio) * car.gears[i + 1]
+                    >= car.engine_torque(w) * car.gears[i] * 0.999
+                    || w >= car.rev_limiter * 0.99
+            );
+            assert!(
+                w > 6000.0 * std::f64::consts::PI / 30.0,
+                "gear {i} shifts at {} rpm",
+                w * 30.0 / std::f64::consts::PI
+            );
+        }
+    }
+
+    #[test]
+    fn the_gearbox_climbs_and_descends_through_the_gears() {
+        let car = Car::spirit_300();
+        let map = ShiftMap::new(&car);
+        let mut g = Gearbox::new();
+        for v in 1..90 {
+            g.shifting = 0.0;
+            g.update(&car, &map, v as f64 / car.rear_tyre.radius);
+        }
+        assert_eq!(g.gear, car.gears.len() - 1);
+        for v in (1..90).rev() {
+            g.shifting = 0.0;
+            g.update(&car, &map, v as f64 / car.rear_tyre.radius);
+        }
+        assert_eq!(g.gear, 0);
+    }
+}

@@ -1,0 +1,134 @@
+//! The TORCS tyre: a Magic-Formula shape with load sensitivity and combined slip.
+//!
+//! For a slip vector (sₓ, s_y) with magnitude s = √(sₓ² + s_y²), the force magnitude is
+//!
+//! F = F_z · μ · μ_surface · λ(F_z) · sin(C·atan(B·s·(1 − E) + E·atan(B·s)))
+//!
+//! with C = 2 − (2/π)·asin(dynamic friction), B = stiffness / C, E = elasticity factor, and the
+//! load sensitivity λ(F_z) = λ_min + (λ_max − λ_min)·exp(k·F_z / F_op), k = ln((1 − λ_min) /
+//! (λ_max − λ_min)), which is 1 at the operating load F_op and rises to λ_max at zero load.
+//! Longitudinal and lateral forces share this one budget along the slip vector:
+//! Fₓ = F·sₓ/s, F_y = F·s_y/s (the friction ellipse of combined slip).
+
+use crate::car::Tyre;
+
+/// λ_min of the load sensitivity (TORCS default).
+pub const LOAD_FACTOR_MIN: f64 = 0.8;
+/// λ_max of the load sensitivity (TORCS default).
+pub const LOAD_FACTOR_MAX: f64 = 1.6;
+
+/// Pre-computed Magic-Formula constants of one tyre.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TyreModel {
+    /// Peak friction μ.
+    pub mu: f64,
+    /// Shape factor C.
+    pub c: f64,
+    /// Stiffness factor B.
+    pub b: f64,
+    /// Curvature factor E.
+    pub e: f64,
+    /// Operating load F_op (N).
+    pub operating_load: f64,
+    /// k of the load sensitivity.
+    load_k: f64,
+    /// Slip magnitude at which the force peaks.
+    pub peak_slip: f64,
+}
+
+impl TyreModel {
+    /// The model of a car's tyre.
+    pub fn new(t: &Tyre) -> TyreModel {
+        let c = 2.0 - t.dynamic_friction.clamp(0.0, 1.0).asin() * 2.0 / std::f64::consts::PI;
+        let b = t.stiffness / c;
+        let load_k = ((1.0 - LOAD_FACTOR_MIN) / (LOAD_FACTOR_MAX - LOAD_FACTOR_MIN)).ln();
+        let mut m = TyreModel {
+            mu: t.mu,
+            c,
+            b,
+            e: t.elasticity,
+            operating_load: t.operating_load,
+            load_k,
+            peak_slip: 0.0,
+        };
+        m.peak_slip = m.find_peak_slip();
+        m
+    }
+
+    /// Load sensitivity λ(F_z).
+    #[inline]
+    pub fn load_factor(&self, fz: f64) -> f64 {
+        LOAD_FACTOR_MIN
+            + (LOAD_FACTOR_MAX - LOAD_FACTOR_MIN) * (self.load_k * fz / self.operating_load).exp()
+    }
+
+    /// Largest force the tyre can give under load `fz` on a surface of friction `surface` (N).
+    #[inline]
+    pub fn max_force(&self, fz: f64, surface: f64) -> f64 {
+        fz * self.mu * surface * self.load_factor(fz)
+    }
+
+    /// The Magic-Formula shape f(s) = sin(C·atan(B·s·(1 − E) + E·atan(B·s))) and its
+    /// derivative df/ds.
+    #[inline]
+    pub fn shape(&self, s: f64) -> (f64, f64) {
+        let bs = self.b * s;
+        let inner = bs * (1.0 - self.e) + self.e * bs.atan();
+        let arg = self.c * inner.atan();
+        let (sin, cos) = arg.sin_cos();
+        let dinner = self.b * ((1.0 - self.e) + self.e / (1.0 + bs * bs));
+        (sin, cos * self.c / (1.0 + inner * inner) * dinner)
+    }
+
+    fn find_peak_slip(&self) -> f64 {
+        // The shape rises monotonically to its peak: bisect on the sign of df/ds.
+        let (mut lo, mut hi) = (0.0, 5.0);
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if self.shape(mid).1 > 0.0 {
+                lo = mid
+            } else {
+                hi = mid
+            }
+        }
+        0.5 * (lo + hi)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::car::Car;
+
+    #[test]
+    fn shape_constants_follow_torcs() {
+        let m = TyreModel::new(&Car::spirit_300().rear_tyre);
+        let c = 2.0 - 0.6f64.asin() * 2.0 / std::f64::consts::PI;
+        assert!((m.c - c).abs() < 1e-12 && (m.b - 16.0 / c).abs() < 1e-12);
+        // The peak is 1 (sin = 1) and beyond it the force falls to the dynamic level.
+        assert!((m.shape(m.peak_slip).0 - 1.0).abs() < 1e-9);
+        assert!(m.shape(1.0).0 < 0.95);
+    }
+
+    #[test]
+    fn load_sensitivity_is_one_at_the_operating_load() {
+        let m = TyreModel::new(&Car::spirit_300().rear_tyre);
+        assert!((m.load_factor(m.operating_load) - 1.0).abs() < 1e-12);
+        assert!((m.load_factor(0.0) - LOAD_FACTOR_MAX).abs() < 1e-12);
+        assert!(m.load_factor(2.0 * m.operating_load) < 1.0);
+    }
+
+    #[test]
+    fn shape_derivative_matches_finite_differences() {
+        let m = TyreModel::new(&Car::spirit_300().front_tyre);
+        for s in [0.0, 0.01, 0.05, 0.1, 0.3, 1.0] {
+            let h = 1e-7;
+            let fd = (m.shape(s + h).0 - m.shape(s - h).0) / (2.0 * h);
+            assert!(
+                (fd - m.shape(s).1).abs() < 1e-5 * fd.abs().max(1.0),
+                "s {s}: {fd} vs {}",
+                m.shape(s).1
+            );
+        }
+    }
+}

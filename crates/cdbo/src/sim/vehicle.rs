@@ -1,0 +1,274 @@
+//! The dynamic single-track ("bicycle") model with longitudinal load transfer, wheel spin
+//! dynamics and the TORCS tyre, integrated at a fixed step.
+//!
+//! State: position (X, Y), yaw ψ, body velocities (vₓ, v_y), yaw rate r, and the spin ω of
+//! each axle's wheels. With a = CG→front axle, b = CG→rear axle, L = a + b, h = CG height:
+//!
+//! - Loads: F_zf = m·g·cos φ·b/L − m·aₓ·h/L + D_f, F_zr = m·g·cos φ·a/L + m·aₓ·h/L + D_r,
+//!   with aₓ the last step's longitudinal acceleration, φ the grade and D the downforce.
+//! - Wheel slip: for the wheel-frame velocity (v_t, v_l), sₓ = (ωR − v_t)/max(|v_t|, v₀),
+//!   s_y = −v_l/max(|v_t|, v₀) with v₀ = [`SLIP_SPEED_FLOOR`]; the tyre ([`super::tyre`])
+//!   gives (Fₓ, F_y).
+//! - Wheels: I·dω/dt = T_drive − T_brake·sgn ω − R·Fₓ(ω), integrated implicitly in ω (Fₓ
+//!   linearised), so that the stiff slip dynamics stay stable at 2 ms. When the clutch is
+//!   engaged the engine inertia adds I_e·(gᵢg_f)² to the driven axle.
+//! - Body: m(v̇ₓ − v_y r) = F_xf cos δ − F_yf sin δ + F_xr − F_drag − F_roll − m g sin φ,
+//!   m(v̇_y + vₓ r) = F_xf sin δ + F_yf cos δ + F_yr − m g sin β,
+//!   I_z ṙ = a(F_xf sin δ + F_yf cos δ) − b F_yr, with β the banking.
+//! - Drag F = 0.645·Cx·A·v², downforce Dᵢ = 0.645·Clᵢ·A·v², rolling resistance
+//!   F = c_rr·(F_zf + F_zr).
+//! - Brakes: T = p·share·A_piston·μ_pad·r_disc per wheel, with ABS easing the pressure while an
+//!   axle's slip exceeds half the tyre's peak slip; traction control eases the throttle
+//!   likewise (the Spirit 300 has both; TORCS robots implement them in the driver).
+
+use super::powertrain::{Gearbox, ShiftMap};
+use super::tyre::TyreModel;
+use crate::car::{Car, Drive};
+use crate::track::Sample;
+
+/// Gravity (m/s²).
+pub const G: f64 = 9.81;
+/// Floor of the speed that normalises slip (m/s): keeps slip finite when standing.
+pub const SLIP_SPEED_FLOOR: f64 = 2.0;
+/// ABS and traction control start easing at this fraction of the tyre's peak slip, and
+/// release fully at twice it.
+const AID_SLIP_RATIO: f64 = 0.5;
+
+/// The driver's commands, held between driver updates.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Controls {
+    /// Road-wheel steering angle (rad), positive left.
+    pub steer: f64,
+    /// Throttle in [0, 1].
+    pub throttle: f64,
+    /// Brake pedal in [0, 1].
+    pub brake: f64,
+}
+
+/// The state of the car.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct State {
+    /// Position (m).
+    pub x: f64,
+    /// Position (m).
+    pub y: f64,
+    /// Yaw (rad).
+    pub yaw: f64,
+    /// Longitudinal velocity in the body frame (m/s).
+    pub vx: f64,
+    /// Lateral velocity in the body frame (m/s), positive left.
+    pub vy: f64,
+    /// Yaw rate (rad/s).
+    pub yaw_rate: f64,
+    /// Spin of the front and rear wheels (rad/s).
+    pub omega: [f64; 2],
+    /// Longitudinal acceleration of the last step (m/s²), for load transfer.
+    pub ax: f64,
+    /// Gearbox.
+    pub gearbox: Gearbox,
+    /// Engine speed (rad/s).
+    pub engine_speed: f64,
+}
+
+impl State {
+    /// Speed over ground (m/s).
+    pub fn speed(&self) -> f64 {
+        self.vx.hypot(self.vy)
+    }
+}
+
+/// A car ready to be simulated: its parameters and the derived constants.
+#[derive(Debug, Clone)]
+pub struct Vehicle {
+    /// The car.
+    pub car: Car,
+    tyres: [TyreModel; 2],
+    radius: [f64; 2],
+    wheel_inertia: [f64; 2],
+    max_brake: [f64; 2],
+    driven: [f64; 2],
+    shift_map: ShiftMap,
+    a: f64,
+    b: f64,
+    yaw_inertia: f64,
+    rolling: f64,
+}
+
+impl Vehicle {
+    /// Prepares a car for simulation.
+    pub fn new(car: &Car) -> Vehicle {
+        let driven = match car.drive {
+            Drive::Rear => [0.0, 1.0],
+            Drive::Front => [1.0, 0.0],
+            Drive::All => [0.5, 0.5],
+        };
+        Vehicle {
+            tyres: [
+                TyreModel::new(&car.front_tyre),
+                TyreModel::new(&car.rear_tyre),
+            ],
+            radius: [car.front_tyre.radius, car.rear_tyre.radius],
+            wheel_inertia: [2.0 * car.front_tyre.inertia, 2.0 * car.rear_tyre.inertia],
+            max_brake: [2.0 * car.brake_torque(true), 2.0 * car.brake_torque(false)],
+            driven,
+            shift_map: ShiftMap::new(car),
+            a: car.cg_to_front(),
+            b: car.cg_to_rear(),
+            yaw_inertia: car.yaw_inertia(),
+            rolling: 0.5 * (car.front_tyre.rolling_resistance + car.rear_tyre.rolling_resistance),
+            car: car.clone(),
+        }
+    }
+
+    /// The tyre models of the front and rear axles.
+    pub fn tyres(&self) -> &[TyreModel; 2] {
+        &self.tyres
+    }
+
+    /// Standing still at (x, y) facing `yaw`, in first gear.
+    pub fn at_rest(&self, x: f64, y: f64, yaw: f64) -> State {
+        State {
+            x,
+            y,
+            yaw,
+            engine_speed: self.car.tickover,
+            ..State::default()
+        }
+    }
+
+    /// The automatic gearbox's decision, taken at the driver's rate.
+    pub fn shift(&self, s: &mut State) {
+        let w = self.driven_omega(s);
+        s.gearbox.update(&self.car, &self.shift_map, w);
+    }
+
+    fn driven_omega(&self, s: &State) -> f64 {
+        self.driven[0] * s.omega[0] + self.driven[1] * s.omega[1]
+    }
+
+    /// Advances the state by `dt` seconds on the road described by `road`.
+    pub fn step(&self, s: &mut State, c: &Controls, road: &Sample, dt: f64) {
+        let car = &self.car;
+        let m = car.mass;
+        let l = self.a + self.b;
+        let v = s.speed();
+        let (cos_grade, sin_grade) = (
+            1.0 / (1.0 + road.grade * road.grade).sqrt(),
+            road.grade / (1.0 + road.grade * road.grade).sqrt(),
+        );
+        let down = car.downforce(v);
+        let weight = m * G * cos_grade * road.banking.cos();
+        let transfer = m * s.ax * car.cg_height / l;
+        let fz = [
+            (weight * self.b / l - transfer + down[0]).max(0.0),
+            (weight * self.a / l + transfer + down[1]).max(0.0),
+        ];
+
+        // Wheel-frame velocities of the front (steered) and rear axles.
+        let (sin_d, cos_d) = c.steer.sin_cos();
+        let front_lat = s.vy + self.a * s.yaw_rate;
+        let vt = [s.vx * cos_d + front_lat * sin_d, s.vx];
+        let vl = [
+            -s.vx * sin_d + front_lat * cos_d,
+            s.vy - self.b * s.yaw_rate,
+        ];
+
+        // Drive torque. Traction control eases the throttle while the driven axle's combined
+        // slip, with the wheel spinning faster than the road, passes the aid threshold.
+        let mut throttle = c.throttle;
+        let k = if self.driven[1] > 0.0 { 1 } else { 0 };
+        let denom = vt[k].abs().max(SLIP_SPEED_FLOOR);
+        let spin = (s.omega[k] * self.radius[k] - vt[k]) / denom;
+        let combined = spin.hypot(vl[k] / denom);
+        let threshold = self.tyres[k].peak_slip * AID_SLIP_RATIO;
+        if spin > 0.0 && combined > threshold {
+            throttle *= (1.0 - (combined - threshold) / threshold).clamp(0.0, 1.0);
+        }
+        let (drive_torque, engine_speed) =
+            s.gearbox.wheel_torque(car, throttle, self.driven_omega(s));
+        s.engine_speed = engine_speed;
+        let engine_inertia = if s.gearbox.shifting > 0.0 {
+            0.0
+        } else {
+            car.engine_inertia * s.gearbox.ratio(car).powi(2)
+        };
+        s.gearbox.shifting = (s.gearbox.shifting - dt).max(0.0);
+
+        let mut fx = [0.0; 2];
+        let mut fy = [0.0; 2];
+        for k in 0..2 {
+            let tyre = &self.tyres[k];
+            let r = self.radius[k];
+            let denom = vt[k].abs().max(SLIP_SPEED_FLOOR);
+            let fmax = tyre.max_force(fz[k], road.friction);
+            // ABS: ease the pressure while the wheel slides backwards past the peak slip.
+            let lock = (vt[k] - s.omega[k] * r) / denom;
+            let mut brake = c.brake * self.max_brake[k];
+            let abs_peak = tyre.peak_slip * AID_SLIP_RATIO;
+            if lock > abs_peak {
+                brake *= (1.0 - (lock - abs_peak) / abs_peak).clamp(0.0, 1.0);
+            }
+            let sy = -vl[k] / denom;
+            let force_at = |omega: f64| -> (f64, f64, f64) {
+                let sx = (omega * r - vt[k]) / denom;
+                let slip = sx.hypot(sy);
+                if slip < 1e-12 {
+                    // Linear region: F ≈ f′(0)·s along each axis.
+                    let k0 = tyre.shape(0.0).1 * fmax;
+                    return (k0 * sx, k0 * sy, k0 * r / denom);
+                }
+                let (f, df) = tyre.shape(slip);
+                let fx = fmax * f * sx / slip;
+                // ∂Fₓ/∂ω = fmax·[f′·sₓ²/s² + f·s_y²/s³]·R/denom.
+                let dfx =
+                    fmax * (df * sx * sx / (slip * slip) + f * sy * sy / (slip * slip * slip)) * r
+                        / denom;
+                (fx, fmax * f * sy / slip, dfx)
+            };
+            let (fx0, _, dfx) = force_at(s.omega[k]);
+            let inertia = self.wheel_inertia[k] + self.driven[k] * engine_inertia;
+            let torque = self.driven[k] * drive_torque - r * fx0;
+            let brake_dir = if s.omega[k] > 0.0 {
+                1.0
+            } else if s.omega[k] < 0.0 {
+                -1.0
+            } else {
+                0.0
+            };
+            let free = torque - brake * brake_dir;
+            let mut new_omega = s.omega[k] + dt * free / (inertia + dt * r * dfx.max(0.0));
+            // Brakes can stop a wheel but never spin it backwards.
+            if brake > 0.0 && new_omega * s.omega[k] < 0.0 {
+                new_omega = 0.0;
+            } else if s.omega[k] == 0.0 && brake > (torque).abs() {
+                new_omega = 0.0;
+            }
+            s.omega[k] = new_omega;
+            let (f_x, f_y, _) = force_at(new_omega);
+            fx[k] = f_x;
+            fy[k] = f_y;
+        }
+
+        // Body forces and moments.
+        let roll = self.rolling * (fz[0] + fz[1]) * (s.vx / 0.5).tanh();
+        let drag = car.drag(v) * if v > 1e-9 { s.vx / v } else { 0.0 };
+        let force_x = fx[0] * cos_d - fy[0] * sin_d + fx[1] - drag - roll - m * G * sin_grade;
+        let force_y = fx[0] * sin_d + fy[0] * cos_d + fy[1]
+            - m * G * road.banking.sin() * (s.yaw - road.heading).cos();
+        let moment = self.a * (fx[0] * sin_d + fy[0] * cos_d) - self.b * fy[1];
+
+        let ax = force_x / m;
+        s.vx += dt * (ax + s.vy * s.yaw_rate);
+        s.vy += dt * (force_y / m - s.vx * s.yaw_rate);
+        s.yaw_rate += dt * moment / self.yaw_inertia;
+        s.yaw += dt * s.yaw_rate;
+        let (sin_y, cos_y) = s.yaw.sin_cos();
+        s.x += dt * (s.vx * cos_y - s.vy * sin_y);
+        s.y += dt * (s.vx * sin_y + s.vy * cos_y);
+        // Load transfer follows the acceleration with a short lag (suspension pitch).
+        s.ax += (ax - s.ax) * (dt / PITCH_TIME_CONSTANT).min(1.0);
+    }
+}
+
+/// Time constant of the longitudinal load transfer (s), standing in for pitch dynamics.
+const PITCH_TIME_CONSTANT: f64 = 0.05;
