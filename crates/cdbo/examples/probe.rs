@@ -1,7 +1,19 @@
 use cdbo::car::Car;
-use cdbo::drive::{ConstantPedal, demo::SpeedHold};
+use cdbo::drive::{Observation, Pedal, demo::SpeedHold};
 use cdbo::sim::Simulator;
 use std::path::Path;
+
+struct Follow {
+    profile: Vec<f64>,
+    scale: f64,
+}
+impl Pedal for Follow {
+    fn pedal(&mut self, o: &Observation) -> f64 {
+        let i = ((o.x * (self.profile.len() - 1) as f64) as usize + 25).min(self.profile.len() - 1);
+        let target = self.profile[i] * self.scale;
+        (2.0 * (target - o.speed)).clamp(-1.0, 1.0)
+    }
+}
 
 fn main() {
     let car = Car::spirit_300();
@@ -14,33 +26,33 @@ fn main() {
     ] {
         tracks.push(cdbo::track::torcs::read(&Path::new("/work/shared").join(p)).unwrap());
     }
-    tracks.push(cdbo::track::csv::read(Path::new("/work/shared/tracks/csv/Monza.csv")).unwrap());
     for t in tracks {
-        let mut sim = Simulator::new(t, &car);
-        sim.config.trace = true;
-        for (name, r) in [
-            ("demo15", {
-                let t0 = std::time::Instant::now();
-                let r = sim.lap(&mut SpeedHold::new(15.0));
-                eprintln!("  wall {:?}", t0.elapsed());
-                r
-            }),
-            ("demo25", sim.lap(&mut SpeedHold::new(25.0))),
-            ("full", sim.lap(&mut ConstantPedal(1.0))),
-        ] {
-            let maxlat = r.trace.iter().map(|p| p.lateral.abs()).fold(0.0, f64::max);
-            let maxv = r.trace.iter().map(|p| p.speed).fold(0.0, f64::max);
-            println!(
-                "{:10} {:7} completed {} time {:?} reward {:.2} fail {:?} maxlat {:.2} maxv {:.1}",
-                sim.track.name,
-                name,
-                r.completed,
-                r.lap_time_s,
-                r.reward_mps,
-                r.failure,
-                maxlat,
-                maxv
-            );
+        let lim = cdbo::limit::limit_lap(&t, &car);
+        let sim = Simulator::new(t, &car);
+        let t0 = std::time::Instant::now();
+        let d = sim.lap(&mut SpeedHold::new(15.0));
+        let wall = t0.elapsed().as_secs_f64();
+        let mut best = (0.0, 0.0);
+        for scale in [0.6, 0.7, 0.8, 0.85, 0.9, 0.95, 1.0, 1.05] {
+            let r = sim.lap(&mut Follow {
+                profile: lim.speed.clone(),
+                scale,
+            });
+            if r.reward_mps > best.0 {
+                best = (r.reward_mps, scale);
+            }
         }
+        println!(
+            "{:10} L {:.1} limit {:.1}s {:.2} m/s | demo {:.2} m/s rtf {:.0} | follower best {:.2} m/s ({:.0}%) at scale {}",
+            sim.track.name,
+            sim.track.length,
+            lim.lap_time_s,
+            lim.reward_mps,
+            d.reward_mps,
+            d.simulated_s / wall,
+            best.0,
+            100.0 * best.0 / lim.reward_mps,
+            best.1
+        );
     }
 }

@@ -197,13 +197,13 @@ impl Car {
             return 0.0;
         }
         let c = &self.torque_curve;
-        match c.iter().position(|&(w, _)| w > omega) {
-            Some(0) => c[0].1,
-            Some(i) => {
+        match c.partition_point(|&(w, _)| w <= omega) {
+            0 => c[0].1,
+            i if i == c.len() => c[i - 1].1,
+            i => {
                 let ((w0, t0), (w1, t1)) = (c[i - 1], c[i]);
                 t0 + (t1 - t0) * (omega - w0) / (w1 - w0)
             }
-            None => c.last().map_or(0.0, |p| p.1),
         }
     }
 

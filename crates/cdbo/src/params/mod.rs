@@ -86,7 +86,8 @@ impl Params {
                 message: "the root element must be <params>".to_owned(),
             });
         }
-        let root = read_section(&doc, root, "", file)?;
+        let lines = LineIndex::new(&expanded);
+        let root = read_section(&lines, root, "", file)?;
         Ok(Params {
             file: file.to_owned(),
             root,
@@ -198,12 +199,12 @@ impl Section {
 }
 
 fn read_section(
-    doc: &roxmltree::Document,
+    lines: &LineIndex,
     node: roxmltree::Node,
     parent: &str,
     file: &str,
 ) -> Result<Section> {
-    let line = doc.text_pos_at(node.range().start).row;
+    let line = lines.line(node.range().start);
     let name = node.attribute("name").unwrap_or_default().to_owned();
     let path = match (parent.is_empty(), node.tag_name().name() == "params") {
         (_, true) => String::new(),
@@ -217,7 +218,7 @@ fn read_section(
         ..Section::default()
     };
     for child in node.children().filter(|c| c.is_element()) {
-        let line = doc.text_pos_at(child.range().start).row;
+        let line = lines.line(child.range().start);
         let tag = child.tag_name().name();
         let element = |n: &str| {
             if section.path.is_empty() {
@@ -234,7 +235,7 @@ fn read_section(
         };
         match tag {
             "section" => {
-                let sub = read_section(doc, child, &section.path, file)?;
+                let sub = read_section(lines, child, &section.path, file)?;
                 section.sections.push(sub);
             }
             "attnum" | "attstr" => {
@@ -271,6 +272,24 @@ fn read_section(
         }
     }
     Ok(section)
+}
+
+/// Byte offsets of line starts, for O(log n) line numbers (roxmltree's own is O(n)).
+struct LineIndex(Vec<usize>);
+
+impl LineIndex {
+    fn new(text: &str) -> LineIndex {
+        LineIndex(
+            std::iter::once(0)
+                .chain(text.match_indices('\n').map(|(i, _)| i + 1))
+                .collect(),
+        )
+    }
+
+    /// The 1-based line of a byte offset.
+    fn line(&self, byte: usize) -> u32 {
+        self.0.partition_point(|&start| start <= byte) as u32
+    }
 }
 
 /// Removes the DOCTYPE and substitutes its external entities.

@@ -19,7 +19,7 @@ use super::vehicle::{Controls, State, Vehicle};
 use crate::car::Car;
 use crate::drive::steering::{Steering, wrap_angle};
 use crate::drive::{Observation, Pedal};
-use crate::track::Track;
+use crate::track::{Frame, Track};
 
 /// Why a lap failed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -129,12 +129,18 @@ impl Default for LapConfig {
     }
 }
 
-const SPIN_HEADING: f64 = std::f64::consts::FRAC_PI_2;
 const SPIN_SLIP_ANGLE: f64 = std::f64::consts::FRAC_PI_3;
 const SPIN_MIN_SPEED: f64 = 3.0;
 const BACKWARDS_DISTANCE: f64 = 10.0;
 const STALL_SPEED: f64 = 0.5;
 const STALL_TIME: f64 = 5.0;
+
+/// Whether the car faces more than 90° away from the road: cos(ψ − θ) < 0.
+#[inline]
+fn facing_away(state: &State, frame: &Frame) -> bool {
+    let (sy, cy) = state.yaw_sin_cos;
+    cy * frame.cos_heading + sy * frame.sin_heading < 0.0
+}
 
 /// A track and a car, ready to run laps.
 #[derive(Debug, Clone)]
@@ -233,8 +239,13 @@ impl Simulator {
                     });
                 }
             }
-            let road = track.sample(proj.index);
-            self.vehicle.step(&mut state, &controls, road, cfg.dt);
+            self.vehicle.step(
+                &mut state,
+                &controls,
+                track.sample(proj.index),
+                track.frame(proj.index),
+                cfg.dt,
+            );
             step += 1;
             let t = step as f64 * cfg.dt;
             let prev_s = proj.s;
@@ -263,9 +274,9 @@ impl Simulator {
             let half_width = 0.5 * road.width + cfg.off_track_margin;
             let failure = if proj.lateral.abs() > half_width {
                 Some(super::FailureReason::OffTrack)
-            } else if wrap_angle(state.yaw - road.heading).abs() > SPIN_HEADING
+            } else if facing_away(&state, track.frame(proj.index))
                 || (state.speed() > SPIN_MIN_SPEED
-                    && state.vy.atan2(state.vx).abs() > SPIN_SLIP_ANGLE)
+                    && state.vx < state.vy.abs() / SPIN_SLIP_ANGLE.tan())
             {
                 Some(super::FailureReason::Spun)
             } else if distance < farthest - BACKWARDS_DISTANCE {

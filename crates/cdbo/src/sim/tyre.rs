@@ -80,6 +80,34 @@ impl TyreModel {
         (sin, cos * self.c / (1.0 + inner * inner) * dinner)
     }
 
+    /// Forces for slip (sₓ, s_y) with grip budget `fmax` = F_z·μ·μ_r·λ, and their
+    /// derivatives with respect to sₓ:
+    /// Fₓ = fmax·f(s)·sₓ/s, F_y = fmax·f(s)·s_y/s,
+    /// ∂Fₓ/∂sₓ = fmax·[f′·sₓ²/s² + f·s_y²/s³], ∂F_y/∂sₓ = fmax·sₓs_y·[f′/s² − f/s³].
+    #[inline]
+    pub fn forces(&self, sx: f64, sy: f64, fmax: f64) -> Forces {
+        let s2 = sx * sx + sy * sy;
+        if s2 < 1e-24 {
+            let k0 = self.b * self.c * fmax; // f′(0) = B·C
+            return Forces {
+                fx: k0 * sx,
+                fy: k0 * sy,
+                dfx_dsx: k0,
+                dfy_dsx: 0.0,
+            };
+        }
+        let s = s2.sqrt();
+        let (f, df) = self.shape(s);
+        let (fs, dfs2) = (f / s, df / s2);
+        let fs3 = fs / s2;
+        Forces {
+            fx: fmax * fs * sx,
+            fy: fmax * fs * sy,
+            dfx_dsx: fmax * (dfs2 * sx * sx + fs3 * sy * sy),
+            dfy_dsx: fmax * sx * sy * (dfs2 - fs3),
+        }
+    }
+
     fn find_peak_slip(&self) -> f64 {
         // The shape rises monotonically to its peak: bisect on the sign of df/ds.
         let (mut lo, mut hi) = (0.0, 5.0);
@@ -95,6 +123,19 @@ impl TyreModel {
     }
 }
 
+/// Tyre forces (N) and their sensitivity to longitudinal slip.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Forces {
+    /// Longitudinal force, along the wheel.
+    pub fx: f64,
+    /// Lateral force.
+    pub fy: f64,
+    /// ∂Fₓ/∂sₓ.
+    pub dfx_dsx: f64,
+    /// ∂F_y/∂sₓ.
+    pub dfy_dsx: f64,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -108,6 +149,29 @@ mod tests {
         // The peak is 1 (sin = 1) and beyond it the force falls to the dynamic level.
         assert!((m.shape(m.peak_slip).0 - 1.0).abs() < 1e-9);
         assert!(m.shape(1.0).0 < 0.95);
+    }
+
+    #[test]
+    fn force_derivatives_match_finite_differences_and_share_one_budget() {
+        let m = TyreModel::new(&Car::spirit_300().rear_tyre);
+        for (sx, sy) in [
+            (0.02, 0.0),
+            (0.1, 0.05),
+            (-0.3, 0.2),
+            (0.5, -0.4),
+            (0.0, 0.1),
+        ] {
+            let f = m.forces(sx, sy, 5000.0);
+            let h = 1e-7;
+            let (p, q) = (m.forces(sx + h, sy, 5000.0), m.forces(sx - h, sy, 5000.0));
+            assert!(
+                (f.dfx_dsx - (p.fx - q.fx) / (2.0 * h)).abs() < 1e-3 * f.dfx_dsx.abs().max(1.0)
+            );
+            assert!(
+                (f.dfy_dsx - (p.fy - q.fy) / (2.0 * h)).abs() < 1e-3 * f.dfx_dsx.abs().max(1.0)
+            );
+            assert!(f.fx.hypot(f.fy) <= 5000.0 + 1e-9);
+        }
     }
 
     #[test]

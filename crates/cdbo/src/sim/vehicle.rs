@@ -24,7 +24,7 @@
 use super::powertrain::{Gearbox, ShiftMap};
 use super::tyre::TyreModel;
 use crate::car::{Car, Drive};
-use crate::track::Sample;
+use crate::track::{Frame, Sample};
 
 /// Gravity (m/s²).
 pub const G: f64 = 9.81;
@@ -35,7 +35,7 @@ pub const SLIP_SPEED_FLOOR: f64 = 2.0;
 const AID_SLIP_RATIO: f64 = 0.5;
 
 /// The driver's commands, held between driver updates.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Controls {
     /// Road-wheel steering angle (rad), positive left.
     pub steer: f64,
@@ -43,6 +43,26 @@ pub struct Controls {
     pub throttle: f64,
     /// Brake pedal in [0, 1].
     pub brake: f64,
+    /// (sin, cos) of the steering angle.
+    steer_sin_cos: (f64, f64),
+}
+
+impl Controls {
+    /// Commands for a steering angle (rad), a throttle and a brake in [0, 1].
+    pub fn new(steer: f64, throttle: f64, brake: f64) -> Controls {
+        Controls {
+            steer,
+            throttle,
+            brake,
+            steer_sin_cos: steer.sin_cos(),
+        }
+    }
+}
+
+impl Default for Controls {
+    fn default() -> Self {
+        Controls::new(0.0, 0.0, 0.0)
+    }
 }
 
 /// The state of the car.
@@ -68,12 +88,14 @@ pub struct State {
     pub gearbox: Gearbox,
     /// Engine speed (rad/s).
     pub engine_speed: f64,
+    /// (sin, cos) of the yaw.
+    pub yaw_sin_cos: (f64, f64),
 }
 
 impl State {
     /// Speed over ground (m/s).
     pub fn speed(&self) -> f64 {
-        self.vx.hypot(self.vy)
+        (self.vx * self.vx + self.vy * self.vy).sqrt()
     }
 }
 
@@ -146,18 +168,14 @@ impl Vehicle {
         self.driven[0] * s.omega[0] + self.driven[1] * s.omega[1]
     }
 
-    /// Advances the state by `dt` seconds on the road described by `road`.
-    pub fn step(&self, s: &mut State, c: &Controls, road: &Sample, dt: f64) {
+    /// Advances the state by `dt` seconds on the road described by `road` and its `frame`.
+    pub fn step(&self, s: &mut State, c: &Controls, road: &Sample, frame: &Frame, dt: f64) {
         let car = &self.car;
         let m = car.mass;
         let l = self.a + self.b;
         let v = s.speed();
-        let (cos_grade, sin_grade) = (
-            1.0 / (1.0 + road.grade * road.grade).sqrt(),
-            road.grade / (1.0 + road.grade * road.grade).sqrt(),
-        );
         let down = car.downforce(v);
-        let weight = m * G * cos_grade * road.banking.cos();
+        let weight = m * G * frame.cos_pitch * frame.cos_banking;
         let transfer = m * s.ax * car.cg_height / l;
         let fz = [
             (weight * self.b / l - transfer + down[0]).max(0.0),
@@ -165,7 +183,7 @@ impl Vehicle {
         ];
 
         // Wheel-frame velocities of the front (steered) and rear axles.
-        let (sin_d, cos_d) = c.steer.sin_cos();
+        let (sin_d, cos_d) = c.steer_sin_cos;
         let front_lat = s.vy + self.a * s.yaw_rate;
         let vt = [s.vx * cos_d + front_lat * sin_d, s.vx];
         let vl = [
@@ -179,7 +197,7 @@ impl Vehicle {
         let k = if self.driven[1] > 0.0 { 1 } else { 0 };
         let denom = vt[k].abs().max(SLIP_SPEED_FLOOR);
         let spin = (s.omega[k] * self.radius[k] - vt[k]) / denom;
-        let combined = spin.hypot(vl[k] / denom);
+        let combined = (spin * spin + (vl[k] / denom).powi(2)).sqrt();
         let threshold = self.tyres[k].peak_slip * AID_SLIP_RATIO;
         if spin > 0.0 && combined > threshold {
             throttle *= (1.0 - (combined - threshold) / threshold).clamp(0.0, 1.0);
@@ -201,60 +219,49 @@ impl Vehicle {
             let r = self.radius[k];
             let denom = vt[k].abs().max(SLIP_SPEED_FLOOR);
             let fmax = tyre.max_force(fz[k], road.friction);
-            // ABS: ease the pressure while the wheel slides backwards past the peak slip.
+            // ABS: ease the pressure while the wheel slides backwards past the threshold.
             let lock = (vt[k] - s.omega[k] * r) / denom;
             let mut brake = c.brake * self.max_brake[k];
-            let abs_peak = tyre.peak_slip * AID_SLIP_RATIO;
-            if lock > abs_peak {
-                brake *= (1.0 - (lock - abs_peak) / abs_peak).clamp(0.0, 1.0);
+            let threshold = tyre.peak_slip * AID_SLIP_RATIO;
+            if lock > threshold {
+                brake *= (1.0 - (lock - threshold) / threshold).clamp(0.0, 1.0);
             }
+            let sx = (s.omega[k] * r - vt[k]) / denom;
             let sy = -vl[k] / denom;
-            let force_at = |omega: f64| -> (f64, f64, f64) {
-                let sx = (omega * r - vt[k]) / denom;
-                let slip = sx.hypot(sy);
-                if slip < 1e-12 {
-                    // Linear region: F ≈ f′(0)·s along each axis.
-                    let k0 = tyre.shape(0.0).1 * fmax;
-                    return (k0 * sx, k0 * sy, k0 * r / denom);
-                }
-                let (f, df) = tyre.shape(slip);
-                let fx = fmax * f * sx / slip;
-                // ∂Fₓ/∂ω = fmax·[f′·sₓ²/s² + f·s_y²/s³]·R/denom.
-                let dfx =
-                    fmax * (df * sx * sx / (slip * slip) + f * sy * sy / (slip * slip * slip)) * r
-                        / denom;
-                (fx, fmax * f * sy / slip, dfx)
-            };
-            let (fx0, _, dfx) = force_at(s.omega[k]);
+            let f = tyre.forces(sx, sy, fmax);
+            // Implicit step of I·dω/dt = T − T_b·sgn ω − R·Fₓ(ω), with Fₓ linear in ω.
+            let dfx_domega = f.dfx_dsx * r / denom;
             let inertia = self.wheel_inertia[k] + self.driven[k] * engine_inertia;
-            let torque = self.driven[k] * drive_torque - r * fx0;
-            let brake_dir = if s.omega[k] > 0.0 {
-                1.0
-            } else if s.omega[k] < 0.0 {
-                -1.0
-            } else {
-                0.0
-            };
-            let free = torque - brake * brake_dir;
-            let mut new_omega = s.omega[k] + dt * free / (inertia + dt * r * dfx.max(0.0));
+            let torque = self.driven[k] * drive_torque - r * f.fx;
+            let free = torque - brake * s.omega[k].signum() * f64::from(s.omega[k] != 0.0);
+            let mut new_omega = s.omega[k] + dt * free / (inertia + dt * r * dfx_domega.max(0.0));
             // Brakes can stop a wheel but never spin it backwards.
-            if brake > 0.0 && new_omega * s.omega[k] < 0.0 {
-                new_omega = 0.0;
-            } else if s.omega[k] == 0.0 && brake > (torque).abs() {
+            if (brake > 0.0 && new_omega * s.omega[k] < 0.0)
+                || (s.omega[k] == 0.0 && brake > torque.abs())
+            {
                 new_omega = 0.0;
             }
+            let dsx = (new_omega - s.omega[k]) * r / denom;
             s.omega[k] = new_omega;
-            let (f_x, f_y, _) = force_at(new_omega);
-            fx[k] = f_x;
-            fy[k] = f_y;
+            // Forces at the new spin, to first order, kept inside the grip budget.
+            let (mut x, mut y) = (f.fx + f.dfx_dsx * dsx, f.fy + f.dfy_dsx * dsx);
+            let norm2 = x * x + y * y;
+            if norm2 > fmax * fmax {
+                let scale = fmax / norm2.sqrt();
+                (x, y) = (x * scale, y * scale);
+            }
+            fx[k] = x;
+            fy[k] = y;
         }
 
         // Body forces and moments.
         let roll = self.rolling * (fz[0] + fz[1]) * (s.vx / 0.5).tanh();
         let drag = car.drag(v) * if v > 1e-9 { s.vx / v } else { 0.0 };
-        let force_x = fx[0] * cos_d - fy[0] * sin_d + fx[1] - drag - roll - m * G * sin_grade;
-        let force_y = fx[0] * sin_d + fy[0] * cos_d + fy[1]
-            - m * G * road.banking.sin() * (s.yaw - road.heading).cos();
+        let force_x = fx[0] * cos_d - fy[0] * sin_d + fx[1] - drag - roll - m * G * frame.sin_pitch;
+        // cos(ψ − θ) of the car's yaw against the road's heading.
+        let (sy, cy) = s.yaw_sin_cos;
+        let along = cy * frame.cos_heading + sy * frame.sin_heading;
+        let force_y = fx[0] * sin_d + fy[0] * cos_d + fy[1] - m * G * frame.sin_banking * along;
         let moment = self.a * (fx[0] * sin_d + fy[0] * cos_d) - self.b * fy[1];
 
         let ax = force_x / m;
@@ -262,7 +269,8 @@ impl Vehicle {
         s.vy += dt * (force_y / m - s.vx * s.yaw_rate);
         s.yaw_rate += dt * moment / self.yaw_inertia;
         s.yaw += dt * s.yaw_rate;
-        let (sin_y, cos_y) = s.yaw.sin_cos();
+        s.yaw_sin_cos = s.yaw.sin_cos();
+        let (sin_y, cos_y) = s.yaw_sin_cos;
         s.x += dt * (s.vx * cos_y - s.vy * sin_y);
         s.y += dt * (s.vx * sin_y + s.vy * cos_y);
         // Load transfer follows the acceleration with a short lag (suspension pitch).

@@ -182,18 +182,17 @@ fn build(rows: &[[f64; 4]], name: &str, file: &str) -> Track {
         &mut samples,
         (0.5 * CURVATURE_WINDOW_M / ds).round() as usize,
     );
-    Track {
-        name: name.to_owned(),
-        source: file.to_owned(),
+    Track::new(
+        name,
+        file,
         length,
-        closure: Closure {
+        Closure {
             gap_m: 0.0,
             heading_deg: 0.0,
         },
-        ds,
         samples,
-        warnings: Vec::new(),
-    }
+        Vec::new(),
+    )
 }
 
 /// Replaces each curvature by its mean over samples i−half..=i+half (periodic).

@@ -63,6 +63,41 @@ pub struct Track {
     pub samples: Vec<Sample>,
     /// Warnings met while loading (missing entity files, unknown surfaces, ...).
     pub warnings: Vec<String>,
+    /// Trigonometry of each sample, pre-computed for the physics step.
+    frames: Vec<Frame>,
+}
+
+/// Sines and cosines of a sample's angles, pre-computed once per track.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Frame {
+    /// sin and cos of the heading.
+    pub sin_heading: f64,
+    /// cos of the heading.
+    pub cos_heading: f64,
+    /// sin and cos of the road's pitch atan(grade).
+    pub sin_pitch: f64,
+    /// cos of the pitch.
+    pub cos_pitch: f64,
+    /// sin of the banking.
+    pub sin_banking: f64,
+    /// cos of the banking.
+    pub cos_banking: f64,
+}
+
+impl Frame {
+    fn of(c: &Sample) -> Frame {
+        let (sin_heading, cos_heading) = c.heading.sin_cos();
+        let (sin_pitch, cos_pitch) = c.grade.atan().sin_cos();
+        let (sin_banking, cos_banking) = c.banking.sin_cos();
+        Frame {
+            sin_heading,
+            cos_heading,
+            sin_pitch,
+            cos_pitch,
+            sin_banking,
+            cos_banking,
+        }
+    }
 }
 
 /// Where a point lies relative to the centre line.
@@ -77,6 +112,29 @@ pub struct Projection {
 }
 
 impl Track {
+    /// A track from samples at s = i·ds, ds = length / samples.len().
+    pub fn new(
+        name: &str,
+        source: &str,
+        length: f64,
+        closure: Closure,
+        samples: Vec<Sample>,
+        warnings: Vec<String>,
+    ) -> Track {
+        let frames = samples.iter().map(Frame::of).collect();
+        let ds = length / samples.len() as f64;
+        Track {
+            name: name.to_owned(),
+            source: source.to_owned(),
+            length,
+            closure,
+            ds,
+            samples,
+            warnings,
+            frames,
+        }
+    }
+
     /// Number of samples.
     pub fn len(&self) -> usize {
         self.samples.len()
@@ -91,6 +149,12 @@ impl Track {
     #[inline]
     pub fn sample(&self, i: usize) -> &Sample {
         &self.samples[i % self.samples.len()]
+    }
+
+    /// The pre-computed trigonometry of sample `i` (wrapping around the lap).
+    #[inline]
+    pub fn frame(&self, i: usize) -> &Frame {
+        &self.frames[i % self.frames.len()]
     }
 
     /// The index of the sample at or before arc length `s` (wrapped into the lap).
@@ -111,7 +175,7 @@ impl Track {
         let half = 0.5 * self.ds;
         for _ in 0..n {
             let c = &self.samples[i];
-            let (sin, cos) = c.heading.sin_cos();
+            let (sin, cos) = (self.frames[i].sin_heading, self.frames[i].cos_heading);
             let (dx, dy) = (x - c.x, y - c.y);
             let along = dx * cos + dy * sin;
             if along > half {
@@ -223,15 +287,8 @@ impl Track {
             gap_m: x.hypot(y),
             heading_deg: heading_err.to_degrees(),
         };
-        Track {
-            name: name.to_owned(),
-            source: source.to_owned(),
-            length,
-            closure,
-            ds,
-            samples,
-            warnings,
-        }
+        debug_assert!((ds - length / samples.len() as f64).abs() < 1e-9);
+        Track::new(name, source, length, closure, samples, warnings)
     }
 }
 

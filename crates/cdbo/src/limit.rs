@@ -1,0 +1,219 @@
+//! The physical limit: the quasi-steady-state (QSS) minimum lap time along the centre line.
+//!
+//! At every station sᵢ of the centre line (curvature κᵢ, grade φᵢ, banking βᵢ, road friction
+//! μ_rᵢ) the car is treated as a point mass m with the axles' grip
+//! F_max(v) = Σ_axles F_z·μ·μ_r·λ(F_z/2), F_z = static load + downforce 0.645·Cl·A·v².
+//!
+//! 1. **Cornering cap**: the largest v with m·(v²|κ| − g·sin β·sgn κ) ≤ F_max(v) (bisection).
+//! 2. **Forward pass** from a standing start, v₀ = 0:
+//!    v²ᵢ₊₁ = min(cap²ᵢ₊₁, v²ᵢ + 2·Δs·a⁺), with the acceleration
+//!    a⁺ = min(F_engine(v), F_traction)·e/m − F_drag/m − c_rr·g − g·sin φ, where F_engine is the
+//!    best gear's wheel force T_e(ω)·gᵢg_f/R below the limiter, F_traction the driven axle's
+//!    grip (with longitudinal load transfer), and e = √(1 − (a_lat/a_lat,max)²) the friction
+//!    ellipse.
+//! 3. **Backward pass** from the finish: v²ᵢ = min(v²ᵢ, v²ᵢ₊₁ + 2·Δs·a⁻), with the deceleration
+//!    a⁻ = min(F_max·e, F_brakes)/m + F_drag/m + c_rr·g + g·sin φ.
+//! 4. T = Σ 2Δs/(vᵢ + vᵢ₊₁).
+//!
+//! It ignores rotating inertia, gear-shift time and the driver's reaction, and grants both
+//! axles their full grip at once, so no lap of the simulator can beat it.
+
+use serde::Serialize;
+
+use crate::car::{Car, Drive};
+use crate::sim::tyre::TyreModel;
+use crate::sim::vehicle::G;
+use crate::track::Track;
+
+/// The limit lap.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Limit {
+    /// Minimum lap time (s).
+    pub lap_time_s: f64,
+    /// L / T (m/s).
+    pub reward_mps: f64,
+    /// Limit speed at each track sample (m/s), plus the finish.
+    #[serde(skip)]
+    pub speed: Vec<f64>,
+}
+
+/// Computes the QSS limit lap of `car` on `track`.
+pub fn limit_lap(track: &Track, car: &Car) -> Limit {
+    let n = track.len();
+    let ds = track.ds;
+    let m = car.mass;
+    let tyres = [
+        TyreModel::new(&car.front_tyre),
+        TyreModel::new(&car.rear_tyre),
+    ];
+    let (a, b, l) = (car.cg_to_front(), car.cg_to_rear(), car.wheelbase);
+    let static_load = [m * G * b / l, m * G * a / l];
+    let rolling = 0.5 * (car.front_tyre.rolling_resistance + car.rear_tyre.rolling_resistance);
+    let grip = |axle: usize, fz: f64, friction: f64| {
+        fz * tyres[axle].mu * friction * tyres[axle].load_factor(fz / 2.0)
+    };
+    let total_grip = |v: f64, friction: f64| {
+        let d = car.downforce(v);
+        grip(0, static_load[0] + d[0], friction) + grip(1, static_load[1] + d[1], friction)
+    };
+    let driven_radius = match car.drive {
+        Drive::Front => car.front_tyre.radius,
+        _ => car.rear_tyre.radius,
+    };
+    let engine_force = |v: f64| {
+        car.gears
+            .iter()
+            .map(|g| {
+                let ratio = g * car.final_drive;
+                let w = v / driven_radius * ratio;
+                if w > car.rev_limiter {
+                    0.0
+                } else {
+                    car.engine_torque(w.max(car.tickover)) * ratio / driven_radius
+                }
+            })
+            .fold(0.0, f64::max)
+    };
+    let traction = |v: f64, friction: f64| {
+        let d = car.downforce(v);
+        let h = car.cg_height;
+        // Driven-axle grip with the load it gains while accelerating at F/m: F = μ(F_z0 + F·h/L)
+        // ⇒ F = μF_z0 / (1 − μh/L) (rear), F = μF_z0 / (1 + μh/L) (front).
+        match car.drive {
+            Drive::Rear => {
+                let mu = grip(1, static_load[1] + d[1], friction) / (static_load[1] + d[1]);
+                mu * (static_load[1] + d[1]) / (1.0 - mu * h / l).max(0.1)
+            }
+            Drive::Front => {
+                let mu = grip(0, static_load[0] + d[0], friction) / (static_load[0] + d[0]);
+                mu * (static_load[0] + d[0]) / (1.0 + mu * h / l)
+            }
+            Drive::All => total_grip(v, friction),
+        }
+    };
+    let brake_force = 2.0
+        * (car.brake_torque(true) / car.front_tyre.radius
+            + car.brake_torque(false) / car.rear_tyre.radius);
+    let v_max = car.rev_limiter / (car.gears.last().copied().unwrap_or(1.0) * car.final_drive)
+        * driven_radius;
+
+    // 1. Cornering cap.
+    let cap: Vec<f64> = (0..=n)
+        .map(|i| {
+            let c = track.sample(i);
+            let need =
+                |v: f64| v * v * c.curvature.abs() - G * c.banking.sin() * c.curvature.signum();
+            let ok = |v: f64| m * need(v) <= total_grip(v, c.friction);
+            if ok(v_max) {
+                return v_max;
+            }
+            let (mut lo, mut hi) = (0.0, v_max);
+            for _ in 0..50 {
+                let mid = 0.5 * (lo + hi);
+                if ok(mid) { lo = mid } else { hi = mid }
+            }
+            lo
+        })
+        .collect();
+    let ellipse = |v: f64, i: usize| {
+        let c = track.sample(i);
+        let lat = m * v * v * c.curvature.abs();
+        let max = total_grip(v, c.friction);
+        (1.0 - (lat / max).powi(2)).max(0.0).sqrt()
+    };
+
+    // 2. Forward pass from standing.
+    let mut v = vec![0.0; n + 1];
+    for i in 0..n {
+        let c = track.sample(i);
+        let vi = v[i];
+        let push = engine_force(vi).min(traction(vi, c.friction) * ellipse(vi, i));
+        let acc = push / m - car.drag(vi) / m - rolling * G - G * c.grade;
+        let next = (vi * vi + 2.0 * ds * acc).max(0.0).sqrt();
+        v[i + 1] = next.min(cap[i + 1]);
+    }
+    // 3. Backward pass from the finish.
+    for i in (0..n).rev() {
+        let c = track.sample(i);
+        let vn = v[i + 1];
+        let stop = (total_grip(vn, c.friction) * ellipse(vn, i)).min(brake_force);
+        let dec = stop / m + car.drag(vn) / m + rolling * G + G * c.grade;
+        let allowed = (vn * vn + 2.0 * ds * dec.max(0.0)).sqrt();
+        v[i] = v[i].min(allowed);
+    }
+    // 4. Lap time.
+    let lap_time: f64 = (0..n).map(|i| 2.0 * ds / (v[i] + v[i + 1]).max(1e-9)).sum();
+    Limit {
+        lap_time_s: lap_time,
+        reward_mps: track.length / lap_time,
+        speed: v,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::track::{Piece, Track};
+
+    fn straight(length: f64) -> Track {
+        let p = Piece {
+            length,
+            curvature: 0.0,
+            z0: 0.0,
+            z1: 0.0,
+            banking0: 0.0,
+            banking1: 0.0,
+            width: 12.0,
+            friction: 1.0,
+        };
+        Track::from_pieces("straight", "test", &[p], vec![])
+    }
+
+    #[test]
+    fn a_flat_circle_is_driven_at_the_grip_limit() {
+        let r = 100.0;
+        let p = Piece {
+            length: std::f64::consts::TAU * r,
+            curvature: 1.0 / r,
+            z0: 0.0,
+            z1: 0.0,
+            banking0: 0.0,
+            banking1: 0.0,
+            width: 12.0,
+            friction: 1.0,
+        };
+        let t = Track::from_pieces("circle", "test", &[p], vec![]);
+        let car = Car::spirit_300();
+        let lim = limit_lap(&t, &car);
+        // Past the launch the speed settles just below m v²/r = grip (with downforce): at the cap
+        // the friction ellipse leaves nothing to overcome drag.
+        let v = lim.speed[t.len() / 2];
+        let tyres = [
+            TyreModel::new(&car.front_tyre),
+            TyreModel::new(&car.rear_tyre),
+        ];
+        let d = car.downforce(v);
+        let loads = [
+            car.mass * G * car.cg_to_rear() / car.wheelbase + d[0],
+            car.mass * G * car.cg_to_front() / car.wheelbase + d[1],
+        ];
+        let grip: f64 = (0..2)
+            .map(|k| loads[k] * tyres[k].mu * tyres[k].load_factor(loads[k] / 2.0))
+            .sum();
+        let lateral = car.mass * v * v / r;
+        assert!(
+            lateral <= grip && lateral > 0.97 * grip,
+            "v {v}: {lateral} vs {grip}"
+        );
+    }
+
+    #[test]
+    fn a_straight_is_a_standing_start_acceleration_run() {
+        let car = Car::spirit_300();
+        let lim = limit_lap(&straight(400.0), &car);
+        // A quarter mile in about 11-13 s for a 290 kW, 1440 kg car (ignoring inertia).
+        assert!((9.0..13.0).contains(&lim.lap_time_s), "{}", lim.lap_time_s);
+        assert_eq!(lim.speed[0], 0.0);
+        assert!(lim.speed.windows(2).all(|w| w[1] >= w[0]));
+    }
+}
