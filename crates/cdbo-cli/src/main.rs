@@ -1,1 +1,56 @@
-fn main() {}
+//! `cdbo`: learn a fast racing policy in few laps with Coordinate Descent Bayesian Optimisation.
+
+mod commands;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// Learn to race in few laps: Coordinate Descent Bayesian Optimisation on real TORCS tracks.
+#[derive(Debug, Parser)]
+#[command(name = "cdbo", version, about, propagate_version = true)]
+struct Cli {
+    /// A folder to search for tracks and cars by name (repeatable; also CDBO_DATA_PATH and the
+    /// TORCS / Speed Dreams install folders).
+    #[arg(long = "data-dir", global = true, value_name = "DIR")]
+    data_dirs: Vec<PathBuf>,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Drive one lap and report its time, reward and the physical limit.
+    Lap(commands::lap::LapArgs),
+    /// The quasi-steady-state minimum lap time of a car on a track.
+    Limit(commands::limit::LimitArgs),
+    /// Inspect tracks.
+    #[command(subcommand)]
+    Track(commands::track::TrackCommand),
+    /// Plot tracks.
+    #[command(subcommand)]
+    Plot(commands::plot::PlotCommand),
+    /// Measure speed.
+    #[command(subcommand)]
+    Bench(commands::bench::BenchCommand),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let data = cdbo::data_path::DataPath::new(&cli.data_dirs);
+    let result = match cli.command {
+        Command::Lap(args) => commands::lap::run(&args, &data),
+        Command::Limit(args) => commands::limit::run(&args, &data),
+        Command::Track(cmd) => commands::track::run(&cmd, &data),
+        Command::Plot(cmd) => commands::plot::run(&cmd, &data),
+        Command::Bench(cmd) => commands::bench::run(&cmd, &data),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}

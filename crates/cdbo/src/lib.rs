@@ -15,6 +15,7 @@ pub mod drive;
 pub mod error;
 pub mod limit;
 pub mod params;
+pub mod policy;
 pub mod sim;
 pub mod track;
 

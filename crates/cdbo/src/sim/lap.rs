@@ -210,16 +210,8 @@ impl Simulator {
                     })
                     .clamp(-1.0, 1.0);
                 let a = if a.is_nan() { 0.0 } else { a };
-                controls.throttle = a.max(0.0);
-                controls.brake = (-a).max(0.0);
-                controls.steer = steering.update(
-                    track,
-                    car.wheelbase,
-                    car.steer_lock,
-                    &state,
-                    &proj,
-                    driver_dt,
-                );
+                let steer = steering.update(track, car.wheelbase, car.steer_lock, &state, &proj, driver_dt);
+                controls = Controls::new(steer, a.max(0.0), (-a).max(0.0));
                 self.vehicle.shift(&mut state);
                 if cfg.trace {
                     trace.push(TracePoint {
@@ -228,7 +220,7 @@ impl Simulator {
                         x,
                         speed: state.speed(),
                         pedal: a,
-                        steer: controls.steer,
+                        steer: controls.steer(),
                         lateral: proj.lateral,
                         heading_error: wrap_angle(state.yaw - track.sample(proj.index).heading),
                         slip_angle: state.vy.atan2(state.vx.abs().max(1e-9)),

@@ -37,25 +37,33 @@ const AID_SLIP_RATIO: f64 = 0.5;
 /// The driver's commands, held between driver updates.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Controls {
-    /// Road-wheel steering angle (rad), positive left.
-    pub steer: f64,
-    /// Throttle in [0, 1].
-    pub throttle: f64,
-    /// Brake pedal in [0, 1].
-    pub brake: f64,
-    /// (sin, cos) of the steering angle.
+    steer: f64,
+    throttle: f64,
+    brake: f64,
+    /// (sin, cos) of the steering angle, computed once per driver step.
     steer_sin_cos: (f64, f64),
 }
 
 impl Controls {
-    /// Commands for a steering angle (rad), a throttle and a brake in [0, 1].
+    /// Commands for a road-wheel steering angle (rad, positive left), a throttle and a brake
+    /// pedal in [0, 1].
     pub fn new(steer: f64, throttle: f64, brake: f64) -> Controls {
-        Controls {
-            steer,
-            throttle,
-            brake,
-            steer_sin_cos: steer.sin_cos(),
-        }
+        Controls { steer, throttle, brake, steer_sin_cos: steer.sin_cos() }
+    }
+
+    /// Steering angle (rad).
+    pub fn steer(&self) -> f64 {
+        self.steer
+    }
+
+    /// Throttle in [0, 1].
+    pub fn throttle(&self) -> f64 {
+        self.throttle
+    }
+
+    /// Brake pedal in [0, 1].
+    pub fn brake(&self) -> f64 {
+        self.brake
     }
 }
 
@@ -193,7 +201,7 @@ impl Vehicle {
 
         // Drive torque. Traction control eases the throttle while the driven axle's combined
         // slip, with the wheel spinning faster than the road, passes the aid threshold.
-        let mut throttle = c.throttle;
+        let mut throttle = c.throttle();
         let k = if self.driven[1] > 0.0 { 1 } else { 0 };
         let denom = vt[k].abs().max(SLIP_SPEED_FLOOR);
         let spin = (s.omega[k] * self.radius[k] - vt[k]) / denom;
@@ -221,7 +229,7 @@ impl Vehicle {
             let fmax = tyre.max_force(fz[k], road.friction);
             // ABS: ease the pressure while the wheel slides backwards past the threshold.
             let lock = (vt[k] - s.omega[k] * r) / denom;
-            let mut brake = c.brake * self.max_brake[k];
+            let mut brake = c.brake() * self.max_brake[k];
             let threshold = tyre.peak_slip * AID_SLIP_RATIO;
             if lock > threshold {
                 brake *= (1.0 - (lock - threshold) / threshold).clamp(0.0, 1.0);

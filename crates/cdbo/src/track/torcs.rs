@@ -30,7 +30,7 @@ pub fn from_params(params: &Params, source: &str) -> Result<Track> {
     let mut warnings = params.warnings.clone();
     let main = params.require_section("Main Track")?;
     let width = main.num_or(file, "width", 15.0)?;
-    if !(width > 0.0) {
+    if width <= 0.0 {
         return Err(params.error(
             "Main Track/width",
             Some(main.line),
@@ -78,7 +78,7 @@ fn surface_friction(params: &Params, surface: &str, warnings: &mut Vec<String>) 
     match params.section("Surfaces").and_then(|s| s.section(surface)) {
         Some(sec) => {
             let f = sec.num_or(&params.file, "friction", 1.0)?;
-            if !(f > 0.0) {
+            if f <= 0.0 {
                 return Err(params.error(
                     &format!("{}/friction", sec.path),
                     Some(sec.line),
@@ -148,13 +148,13 @@ fn segment_pieces(
             let r = seg.require_num(file, "radius")?;
             let r1 = seg.num_or(file, "end radius", r)?;
             let arc = seg.require_num(file, "arc")?;
-            if !(r > 0.0 && r1 > 0.0) {
+            if r <= 0.0 || r1 <= 0.0 {
                 return Err(err(
                     "radius",
                     format!("radii must be positive, got {r} m and {r1} m"),
                 ));
             }
-            if !(arc > 0.0) {
+            if arc <= 0.0 {
                 return Err(err(
                     "arc",
                     format!("arc must be positive, got {} deg", arc.to_degrees()),
@@ -175,7 +175,7 @@ fn segment_pieces(
             ));
         }
     };
-    if !(length > 0.0) {
+    if length <= 0.0 {
         return Err(err(
             "lg",
             format!("length must be positive, got {length} m"),

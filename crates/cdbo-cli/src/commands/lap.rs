@@ -1,0 +1,124 @@
+//! `cdbo lap`: drive one lap.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use serde::Serialize;
+
+use super::{CliResult, Setup, print_json};
+use cdbo::data_path::DataPath;
+use cdbo::drive::demo::{DEFAULT_TARGET_SPEED, SpeedHold};
+use cdbo::drive::{ConstantPedal, Pedal};
+use cdbo::limit::limit_lap;
+use cdbo::policy::PolicyTable;
+use cdbo::sim::{Failure, Simulator};
+
+#[derive(Debug, Args)]
+#[command(group(clap::ArgGroup::new("driver").args(["demo", "throttle", "policy"])))]
+pub struct LapArgs {
+    #[command(flatten)]
+    setup: Setup,
+    /// Drive the demonstrator: a PI controller holding this speed (m/s). The default.
+    #[arg(long, value_name = "SPEED", allow_negative_numbers = true)]
+    demo: Option<f64>,
+    /// Hold this pedal command everywhere (1 = full throttle, -1 = full brake).
+    #[arg(long, value_name = "A", allow_negative_numbers = true)]
+    throttle: Option<f64>,
+    /// Drive a policy table: CSV rows `x,a`.
+    #[arg(long, value_name = "FILE")]
+    policy: Option<PathBuf>,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
+    /// Write every driver step (50 Hz) as CSV.
+    #[arg(long, value_name = "FILE.csv")]
+    trace: Option<PathBuf>,
+    /// Plot the speed along the lap against the limit (PNG or SVG).
+    #[arg(long, value_name = "FILE.png|.svg")]
+    plot: Option<PathBuf>,
+}
+
+#[derive(Debug, Serialize)]
+struct LapReport {
+    track: String,
+    car: String,
+    completed: bool,
+    lap_time_s: Option<f64>,
+    reward_mps: f64,
+    failure: Option<Failure>,
+    limit_lap_time_s: f64,
+    limit_reward_mps: f64,
+    fraction_of_limit: f64,
+}
+
+pub fn run(args: &LapArgs, data: &DataPath) -> CliResult {
+    let (track, car) = args.setup.load(data)?;
+    let mut pedal: Box<dyn Pedal> = match (args.demo, args.throttle, &args.policy) {
+        (_, Some(a), _) => {
+            if !(-1.0..=1.0).contains(&a) {
+                return Err(format!("--throttle {a}: must be in [-1, 1]").into());
+            }
+            Box::new(ConstantPedal(a))
+        }
+        (_, _, Some(path)) => Box::new(PolicyTable::read_csv(path)?),
+        (speed, _, _) => {
+            let speed = speed.unwrap_or(DEFAULT_TARGET_SPEED);
+            if !(speed > 0.0 && speed.is_finite()) {
+                return Err(format!("--demo {speed}: the target speed must be positive (m/s)").into());
+            }
+            Box::new(SpeedHold::new(speed))
+        }
+    };
+    let limit = limit_lap(&track, &car);
+    let mut sim = Simulator::new(track, &car);
+    sim.config.trace = args.trace.is_some() || args.plot.is_some();
+    let lap = sim.lap(pedal.as_mut());
+    if let Some(path) = &args.trace {
+        write_trace(path, &lap.trace)?;
+    }
+    if let Some(path) = &args.plot {
+        super::plot::lap_speed(path, &sim.track, &lap, &limit)?;
+    }
+    let report = LapReport {
+        track: sim.track.name.clone(),
+        car: car.name.clone(),
+        completed: lap.completed,
+        lap_time_s: lap.lap_time_s,
+        reward_mps: lap.reward_mps,
+        failure: lap.failure,
+        limit_lap_time_s: limit.lap_time_s,
+        limit_reward_mps: limit.reward_mps,
+        fraction_of_limit: lap.reward_mps / limit.reward_mps,
+    };
+    if args.json {
+        return print_json(&report);
+    }
+    match (report.lap_time_s, report.failure) {
+        (Some(t), _) => println!(
+            "{} on {}: lap {:.2} s, reward {:.2} m/s ({:.1} % of the limit {:.2} s, {:.2} m/s)",
+            report.car, report.track, t, report.reward_mps, 100.0 * report.fraction_of_limit, report.limit_lap_time_s, report.limit_reward_mps
+        ),
+        (None, Some(f)) => println!(
+            "{} on {}: failed ({:?}) at x = {:.4} ({:.1} m, {:.2} s); reward 0 (limit {:.2} s, {:.2} m/s)",
+            report.car, report.track, f.reason, f.x, f.distance_m, f.time_s, report.limit_lap_time_s, report.limit_reward_mps
+        ),
+        (None, None) => unreachable!("a lap either completes or fails"),
+    }
+    Ok(())
+}
+
+fn write_trace(path: &std::path::Path, trace: &[cdbo::sim::TracePoint]) -> CliResult {
+    use std::io::Write;
+    let file = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut w = std::io::BufWriter::new(file);
+    writeln!(w, "t_s,distance_m,x,speed_mps,pedal,steer_rad,lateral_m,heading_error_rad,slip_angle_rad,gear,rpm,pos_x_m,pos_y_m")?;
+    for p in trace {
+        writeln!(
+            w,
+            "{:.3},{:.3},{:.6},{:.4},{:.4},{:.5},{:.4},{:.5},{:.5},{},{:.0},{:.3},{:.3}",
+            p.t, p.distance_m, p.x, p.speed, p.pedal, p.steer, p.lateral, p.heading_error, p.slip_angle, p.gear, p.rpm, p.pos_x, p.pos_y
+        )?;
+    }
+    w.flush()?;
+    Ok(())
+}

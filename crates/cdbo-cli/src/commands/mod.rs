@@ -1,0 +1,53 @@
+//! One module per sub-command; shared argument groups here.
+
+pub mod bench;
+pub mod lap;
+pub mod limit;
+pub mod plot;
+pub mod track;
+
+use clap::Args;
+
+use cdbo::car::{Car, catalog as cars};
+use cdbo::data_path::DataPath;
+use cdbo::track::{Track, builtin, catalog as tracks};
+
+/// The boxed error every command returns; printed as one line by `main`.
+pub type CliResult = Result<(), Box<dyn std::error::Error>>;
+
+/// `--track` and `--car`.
+#[derive(Debug, Args, Clone)]
+pub struct Setup {
+    /// Track: a built-in name (ridgeway), a TORCS .xml or TUMFTM .csv file, or a track name in
+    /// the data folders (forza, allondaz, ...).
+    #[arg(long, default_value = builtin::DEFAULT)]
+    pub track: String,
+    /// Car: built-in spirit-300, a TORCS / Speed Dreams car .xml, or a car name in the data
+    /// folders.
+    #[arg(long, default_value = cars::DEFAULT)]
+    pub car: String,
+}
+
+impl Setup {
+    /// Loads the track and the car, printing the track's warnings to stderr.
+    pub fn load(&self, data: &DataPath) -> Result<(Track, Car), cdbo::Error> {
+        let track = load_track(&self.track, data)?;
+        let car = cars::find(&self.car, data)?;
+        Ok((track, car))
+    }
+}
+
+/// Loads a track, printing its warnings to stderr.
+pub fn load_track(spec: &str, data: &DataPath) -> Result<Track, cdbo::Error> {
+    let track = tracks::find(spec, data)?;
+    for w in &track.warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok(track)
+}
+
+/// Prints a value as pretty JSON on stdout.
+pub fn print_json<T: serde::Serialize>(value: &T) -> CliResult {
+    println!("{}", serde_json::to_string_pretty(value)?);
+    Ok(())
+}

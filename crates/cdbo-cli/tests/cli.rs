@@ -1,0 +1,136 @@
+//! The command line as a user meets it: outputs, JSON keys, and one clear error line.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn cdbo(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_cdbo")).args(args).env("CDBO_DATA_PATH", shared()).output().expect("runs")
+}
+
+fn shared() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared")
+}
+
+fn json(args: &[&str]) -> serde_json::Value {
+    let out = cdbo(args);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).expect("JSON")
+}
+
+/// A scratch file with `content`, unique to this test.
+fn scratch(name: &str, content: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("cdbo-cli-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join(name);
+    std::fs::write(&p, content).unwrap();
+    p
+}
+
+/// Runs, expects failure with exactly one `error:` line containing every `needle`.
+fn fails_with(args: &[&str], needles: &[&str]) {
+    let out = cdbo(args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{args:?} succeeded");
+    let errors: Vec<&str> = err.lines().filter(|l| l.starts_with("error:")).collect();
+    assert_eq!(errors.len(), 1, "{err}");
+    for n in needles {
+        assert!(errors[0].contains(n), "{:?} lacks {n:?}", errors[0]);
+    }
+    assert!(!err.contains("panicked"), "{err}");
+}
+
+#[test]
+fn track_info_reports_the_papers_lengths() {
+    let v = json(&["track", "info", "forza", "--json"]);
+    assert!((v["length_m"].as_f64().unwrap() - 5784.1).abs() < 0.5);
+    assert_eq!(v["width_m"].as_f64(), Some(11.0));
+    for key in ["name", "min_radius_m", "z_min_m", "z_max_m"] {
+        assert!(v.get(key).is_some(), "{key}");
+    }
+}
+
+#[test]
+fn a_demo_lap_reports_reward_and_limit() {
+    let v = json(&["lap", "--demo", "15", "--json"]);
+    assert_eq!(v["completed"], true);
+    assert!(v["failure"].is_null());
+    let (reward, limit) = (v["reward_mps"].as_f64().unwrap(), v["limit_reward_mps"].as_f64().unwrap());
+    assert!((14.0..15.5).contains(&reward) && limit > reward);
+    let t = v["lap_time_s"].as_f64().unwrap();
+    assert!((t * reward - 3595.9).abs() < 1.0, "L = R·T");
+    assert!(v["limit_lap_time_s"].as_f64().unwrap() < t);
+}
+
+#[test]
+fn full_throttle_on_forza_names_where_it_failed() {
+    let v = json(&["lap", "--track", "forza", "--throttle", "1", "--json"]);
+    assert_eq!(v["completed"], false);
+    assert_eq!(v["reward_mps"].as_f64(), Some(0.0));
+    let x = v["failure"]["x"].as_f64().unwrap();
+    assert!(x > 0.0 && x < 1.0);
+    assert!(v["failure"]["reason"].is_string() && v["failure"]["distance_m"].is_number());
+}
+
+#[test]
+fn limit_and_bench_print_their_keys() {
+    let v = json(&["limit", "--json"]);
+    assert!(v["lap_time_s"].as_f64().unwrap() > 0.0 && v["reward_mps"].as_f64().unwrap() > 0.0);
+    let v = json(&["bench", "sim", "--laps", "1", "--json"]);
+    for key in ["laps", "simulated_s", "wall_s", "realtime_factor"] {
+        assert!(v[key].as_f64().unwrap() > 0.0, "{key}");
+    }
+}
+
+#[test]
+fn traces_and_plots_are_written() {
+    let trace = scratch("lap.csv", "");
+    let png = scratch("lap.png", "");
+    let svg = scratch("map.svg", "");
+    let out = cdbo(&["lap", "--trace", trace.to_str().unwrap(), "--plot", png.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = std::fs::read_to_string(&trace).unwrap();
+    assert!(text.starts_with("t_s,distance_m,x,speed_mps") && text.lines().count() > 1000);
+    assert_eq!(&std::fs::read(&png).unwrap()[1..4], b"PNG");
+    let out = cdbo(&["plot", "track", "ridgeway", "-o", svg.to_str().unwrap(), "--trace", trace.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(std::fs::read_to_string(&svg).unwrap().contains("<svg"));
+}
+
+const TRACK: &str = r#"<?xml version="1.0"?>
+<params name="t">
+  <section name="Main Track">
+    <attnum name="width" unit="m" val="10"/>
+    <section name="Track Segments">
+      <section name="s1"><attstr name="type" val="str"/><attnum name="lg" unit="m" val="100"/></section>
+      <section name="c1"><attstr name="type" val="lft"/><attnum name="radius" unit="m" val="50"/><attnum name="arc" unit="deg" val="180"/></section>
+      <section name="s2"><attstr name="type" val="str"/><attnum name="lg" unit="m" val="100"/></section>
+      <section name="c2"><attstr name="type" val="lft"/><attnum name="radius" unit="m" val="50"/><attnum name="arc" unit="deg" val="180"/></section>
+    </section>
+  </section>
+</params>
+"#;
+
+#[test]
+fn a_hand_written_track_file_loads() {
+    let p = scratch("oval.xml", TRACK);
+    let v = json(&["track", "info", p.to_str().unwrap(), "--json"]);
+    assert!((v["length_m"].as_f64().unwrap() - (200.0 + 100.0 * std::f64::consts::PI)).abs() < 1e-6);
+}
+
+#[test]
+fn bad_track_files_give_one_clear_error() {
+    let truncated = scratch("truncated.xml", &TRACK[..TRACK.len() / 2]);
+    fails_with(&["track", "info", truncated.to_str().unwrap()], &["truncated.xml"]);
+    let no_radius = scratch("noradius.xml", &TRACK.replacen(r#"<attnum name="radius" unit="m" val="50"/>"#, "", 1));
+    fails_with(&["track", "info", no_radius.to_str().unwrap()], &["noradius.xml", "Main Track/Track Segments/c1/radius", "missing"]);
+    let bad_unit = scratch("badunit.xml", &TRACK.replacen(r#"unit="deg""#, r#"unit="gradians""#, 1));
+    fails_with(&["track", "info", bad_unit.to_str().unwrap()], &["badunit.xml", "c1/arc", "gradians"]);
+    let nan = scratch("nan.csv", "# x_m,y_m,w_tr_right_m,w_tr_left_m\n0,0,5,5\n1,NaN,5,5\n");
+    fails_with(&["track", "info", nan.to_str().unwrap()], &["nan.csv:3", "NaN"]);
+    let few = scratch("few.csv", "0,0,5,5\n10,0,5,5\n10,10,5,5\n");
+    fails_with(&["track", "info", few.to_str().unwrap()], &["few.csv", "at least 10 points"]);
+    fails_with(&["track", "info", "atlantis"], &["unknown track", "atlantis", "ridgeway"]);
+    fails_with(&["lap", "--car", "no-such-car"], &["unknown car", "no-such-car"]);
+    fails_with(&["lap", "--throttle", "3"], &["--throttle"]);
+    fails_with(&["lap", "--demo", "-5"], &["--demo"]);
+}

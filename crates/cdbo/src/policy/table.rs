@@ -1,0 +1,93 @@
+//! A policy as an (x, a) table, linear between points: the form a real car's controller
+//! loads, and what `cdbo lap --policy FILE.csv` drives.
+
+use std::path::Path;
+
+use crate::drive::{Observation, Pedal};
+use crate::error::{Error, Result};
+
+/// Points (xᵢ, aᵢ) with increasing x; π(x) is linear in between and constant beyond the ends.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PolicyTable {
+    points: Vec<(f64, f64)>,
+}
+
+impl PolicyTable {
+    /// A table from points; x must increase strictly and a lie in [−1, 1].
+    pub fn new(points: Vec<(f64, f64)>) -> Result<PolicyTable> {
+        if points.is_empty() {
+            return Err(Error::Domain("a policy table needs at least one point".into()));
+        }
+        for (i, &(x, a)) in points.iter().enumerate() {
+            if !x.is_finite() || !a.is_finite() || !(-1.0..=1.0).contains(&a) {
+                return Err(Error::Domain(format!("policy point {i}: (x {x}, a {a}) must be finite with a in [-1, 1]")));
+            }
+            if i > 0 && x <= points[i - 1].0 {
+                return Err(Error::Domain(format!("policy point {i}: x {x} does not increase")));
+            }
+        }
+        Ok(PolicyTable { points })
+    }
+
+    /// Reads `x,a` rows (a header line and `#` comments are skipped).
+    pub fn read_csv(path: &Path) -> Result<PolicyTable> {
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: path.to_owned(), source })?;
+        let file = path.display().to_string();
+        let mut points = Vec::new();
+        for (i, line) in text.lines().enumerate() {
+            let line = line.trim();
+            if line.is_empty() || line.starts_with('#') || (i == 0 && line.chars().next().is_some_and(char::is_alphabetic)) {
+                continue;
+            }
+            let err = |m: String| Error::Invalid { file: file.clone(), line: Some(i as u32 + 1), element: "row".into(), message: m };
+            let cols: Vec<&str> = line.split(',').map(str::trim).collect();
+            if cols.len() != 2 {
+                return Err(err(format!("expected 2 columns x,a, found {}", cols.len())));
+            }
+            let num = |s: &str| s.parse::<f64>().map_err(|_| err(format!("{s:?} is not a number")));
+            points.push((num(cols[0])?, num(cols[1])?));
+        }
+        PolicyTable::new(points).map_err(|e| Error::invalid(file, "rows", e.to_string()))
+    }
+
+    /// π(x).
+    pub fn action(&self, x: f64) -> f64 {
+        let p = &self.points;
+        match p.partition_point(|&(xi, _)| xi <= x) {
+            0 => p[0].1,
+            i if i == p.len() => p[i - 1].1,
+            i => {
+                let ((x0, a0), (x1, a1)) = (p[i - 1], p[i]);
+                a0 + (a1 - a0) * (x - x0) / (x1 - x0)
+            }
+        }
+    }
+}
+
+impl Pedal for PolicyTable {
+    fn pedal(&mut self, obs: &Observation) -> f64 {
+        self.action(obs.x)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn interpolates_linearly_and_holds_the_ends() {
+        let t = PolicyTable::new(vec![(0.0, -1.0), (0.5, 1.0), (1.0, 0.0)]).unwrap();
+        assert_eq!(t.action(-0.1), -1.0);
+        assert_eq!(t.action(0.25), 0.0);
+        assert_eq!(t.action(0.75), 0.5);
+        assert_eq!(t.action(2.0), 0.0);
+    }
+
+    #[test]
+    fn rejects_bad_points() {
+        assert!(PolicyTable::new(vec![]).is_err());
+        assert!(PolicyTable::new(vec![(0.0, 2.0)]).is_err());
+        assert!(PolicyTable::new(vec![(0.5, 0.0), (0.5, 0.1)]).is_err());
+        assert!(PolicyTable::new(vec![(f64::NAN, 0.0)]).is_err());
+    }
+}

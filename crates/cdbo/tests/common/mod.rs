@@ -1,0 +1,23 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+
+use cdbo::data_path::DataPath;
+use cdbo::track::Track;
+
+/// `../shared` beside the repository root.
+pub fn shared(rel: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared").join(rel)
+}
+
+/// A track from ../shared, found by name.
+pub fn shared_track(name: &str) -> Track {
+    let data = DataPath::with_env(&[shared("")], "");
+    cdbo::track::catalog::find(name, &data).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// A built-in track.
+pub fn builtin(name: &str) -> Track {
+    cdbo::track::builtin::load(name).expect("built-in").expect("loads")
+}

@@ -1,0 +1,146 @@
+//! The lap evaluator against the acceptance lines and against closed forms.
+
+mod common;
+
+use cdbo::car::Car;
+use cdbo::drive::demo::SpeedHold;
+use cdbo::drive::{ConstantPedal, Observation, Pedal};
+use cdbo::limit::limit_lap;
+use cdbo::sim::vehicle::{Controls, G, Vehicle};
+use cdbo::sim::{FailureReason, Simulator};
+use cdbo::track::{Piece, Track};
+use common::{builtin, shared_track};
+
+fn demo(track: Track) -> cdbo::sim::LapResult {
+    Simulator::new(track, &Car::spirit_300()).lap(&mut SpeedHold::new(15.0))
+}
+
+#[test]
+fn the_15_mps_demonstration_completes_every_required_track() {
+    let mut tracks: Vec<Track> = ["forza", "allondaz", "e-track-2", "aalborg"].iter().map(|n| shared_track(n)).collect();
+    tracks.extend(cdbo::track::builtin::names().map(builtin));
+    for t in tracks {
+        let name = t.name.clone();
+        let r = demo(t);
+        assert!(r.completed, "{name}: {:?}", r.failure);
+        assert!((13.5..15.5).contains(&r.reward_mps), "{name}: {} m/s", r.reward_mps);
+    }
+}
+
+#[test]
+fn full_throttle_fails_on_forza_and_says_where() {
+    let sim = Simulator::new(shared_track("forza"), &Car::spirit_300());
+    let r = sim.lap(&mut ConstantPedal(1.0));
+    let f = r.failure.expect("full throttle must not complete Forza");
+    assert!(!r.completed && r.reward_mps == 0.0);
+    assert!(matches!(f.reason, FailureReason::OffTrack | FailureReason::Spun), "{f:?}");
+    assert!(f.x > 0.0 && f.x < 1.0 && f.distance_m > 100.0, "{f:?}");
+}
+
+/// Follows the limit's speed profile, scaled, with a look-ahead: a near-ideal pedal.
+struct LimitFollower {
+    profile: Vec<f64>,
+    scale: f64,
+}
+
+impl Pedal for LimitFollower {
+    fn pedal(&mut self, o: &Observation) -> f64 {
+        let i = ((o.x * (self.profile.len() - 1) as f64) as usize + 25).min(self.profile.len() - 1);
+        (2.0 * (self.profile[i] * self.scale - o.speed)).clamp(-1.0, 1.0)
+    }
+}
+
+#[test]
+fn no_lap_beats_the_limit_and_the_limit_is_plausible() {
+    let car = Car::spirit_300();
+    for (name, lo, hi) in [("forza", 100.0, 150.0), ("allondaz", 150.0, 230.0)] {
+        let t = shared_track(name);
+        let limit = limit_lap(&t, &car);
+        assert!((lo..hi).contains(&limit.lap_time_s), "{name}: limit {} s", limit.lap_time_s);
+        let sim = Simulator::new(t, &car);
+        for scale in [0.6, 0.7, 0.8, 0.9, 1.0, 1.1] {
+            let r = sim.lap(&mut LimitFollower { profile: limit.speed.clone(), scale });
+            assert!(r.reward_mps < limit.reward_mps, "{name}: a lap at {} m/s beat the limit {}", r.reward_mps, limit.reward_mps);
+        }
+        assert!(demo(sim.track.clone()).reward_mps < limit.reward_mps);
+    }
+}
+
+#[test]
+fn same_inputs_give_bit_identical_laps() {
+    let mut sim = Simulator::new(builtin("ridgeway"), &Car::spirit_300());
+    sim.config.trace = true;
+    let a = sim.lap(&mut SpeedHold::new(20.0));
+    let b = sim.lap(&mut SpeedHold::new(20.0));
+    assert_eq!(a, b);
+    assert_eq!(a.trace, b.trace);
+}
+
+fn straight(length: f64) -> Track {
+    let p = Piece { length, curvature: 0.0, z0: 0.0, z1: 0.0, banking0: 0.0, banking1: 0.0, width: 12.0, friction: 1.0 };
+    Track::from_pieces("straight", "test", &[p], vec![])
+}
+
+/// Drives the bare vehicle model straight ahead with fixed pedals for `seconds`.
+fn drive_straight(v0: f64, throttle: f64, brake: f64, seconds: f64) -> (cdbo::sim::vehicle::State, Vehicle) {
+    let track = straight(5000.0);
+    let car = Car::spirit_300();
+    let vehicle = Vehicle::new(&car);
+    let mut s = vehicle.at_rest(0.0, 0.0, 0.0);
+    s.vx = v0;
+    s.omega = [v0 / car.front_tyre.radius, v0 / car.rear_tyre.radius];
+    // Settle the gearbox into the gear for this speed before the clock starts.
+    for _ in 0..car.gears.len() {
+        vehicle.shift(&mut s);
+        s.gearbox.shifting = 0.0;
+    }
+    let c = Controls::new(0.0, throttle, brake);
+    let dt = 0.002;
+    for i in 0..(seconds / dt) as usize {
+        if i % 10 == 0 {
+            vehicle.shift(&mut s);
+        }
+        let k = track.index_at(s.x);
+        vehicle.step(&mut s, &c, track.sample(k), track.frame(k), dt);
+    }
+    (s, vehicle)
+}
+
+#[test]
+fn coasting_decelerates_by_drag_and_rolling_resistance() {
+    // Over 0.5 s from 40 m/s the mean deceleration is (0.645·Cx·A·v² + c_rr·m·g)/m_eff; the
+    // spinning wheels and engine add inertia, so the decrease is at most the point-mass one.
+    let (s, vehicle) = drive_straight(40.0, 0.0, 0.0, 0.5);
+    let car = &vehicle.car;
+    let point_mass = (car.drag(40.0) + 0.01 * car.mass * G) / car.mass * 0.5;
+    let lost = 40.0 - s.vx;
+    assert!(lost > 0.7 * point_mass && lost <= 1.02 * point_mass, "lost {lost} vs {point_mass}");
+    assert!(s.vy.abs() < 1e-9 && s.yaw.abs() < 1e-12);
+}
+
+#[test]
+fn braking_never_beats_the_friction_limit() {
+    // Full brakes from 30 m/s: the stopping distance is at least v²/(2·μ_peak·g) (ABS on).
+    let v0 = 30.0;
+    let (s, vehicle) = drive_straight(v0, 0.0, 1.0, 4.0);
+    let mu_peak = vehicle.car.front_tyre.mu * cdbo::sim::tyre::LOAD_FACTOR_MAX;
+    assert!(s.vx.abs() < 0.5, "still moving at {}", s.vx);
+    assert!(s.x >= v0 * v0 / (2.0 * mu_peak * G), "stopped in {} m", s.x);
+    // The Spirit's brakes are biased to the front (52 % of the pressure on much larger
+    // front pistons), so the rear tyres never reach their grip: about 0.85 g, not 1.3 g.
+    assert!(s.x < v0 * v0 / (2.0 * 0.7 * G), "braking too weak: {} m", s.x);
+}
+
+#[test]
+fn standing_start_acceleration_is_that_of_a_290_kw_car() {
+    // 0–100 km/h for a 1440 kg, 372 N·m car with traction control: 3.5–7 s.
+    let track = straight(2000.0);
+    let sim = Simulator::new(track, &Car::spirit_300());
+    let mut s = {
+        let mut sim = sim.clone();
+        sim.config.trace = true;
+        sim.lap(&mut ConstantPedal(1.0))
+    };
+    let t100 = s.trace.drain(..).find(|p| p.speed >= 100.0 / 3.6).map(|p| p.t).expect("reaches 100 km/h");
+    assert!((3.5..7.0).contains(&t100), "0-100 km/h in {t100} s");
+}
