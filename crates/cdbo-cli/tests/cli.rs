@@ -4,7 +4,11 @@ use std::path::PathBuf;
 use std::process::{Command, Output};
 
 fn cdbo(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_cdbo")).args(args).env("CDBO_DATA_PATH", shared()).output().expect("runs")
+    Command::new(env!("CARGO_BIN_EXE_cdbo"))
+        .args(args)
+        .env("CDBO_DATA_PATH", shared())
+        .output()
+        .expect("runs")
 }
 
 fn shared() -> PathBuf {
@@ -13,7 +17,11 @@ fn shared() -> PathBuf {
 
 fn json(args: &[&str]) -> serde_json::Value {
     let out = cdbo(args);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     serde_json::from_slice(&out.stdout).expect("JSON")
 }
 
@@ -54,7 +62,10 @@ fn a_demo_lap_reports_reward_and_limit() {
     let v = json(&["lap", "--demo", "15", "--json"]);
     assert_eq!(v["completed"], true);
     assert!(v["failure"].is_null());
-    let (reward, limit) = (v["reward_mps"].as_f64().unwrap(), v["limit_reward_mps"].as_f64().unwrap());
+    let (reward, limit) = (
+        v["reward_mps"].as_f64().unwrap(),
+        v["limit_reward_mps"].as_f64().unwrap(),
+    );
     assert!((14.0..15.5).contains(&reward) && limit > reward);
     let t = v["lap_time_s"].as_f64().unwrap();
     assert!((t * reward - 3595.9).abs() < 1.0, "L = R·T");
@@ -86,13 +97,35 @@ fn traces_and_plots_are_written() {
     let trace = scratch("lap.csv", "");
     let png = scratch("lap.png", "");
     let svg = scratch("map.svg", "");
-    let out = cdbo(&["lap", "--trace", trace.to_str().unwrap(), "--plot", png.to_str().unwrap()]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = cdbo(&[
+        "lap",
+        "--trace",
+        trace.to_str().unwrap(),
+        "--plot",
+        png.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let text = std::fs::read_to_string(&trace).unwrap();
     assert!(text.starts_with("t_s,distance_m,x,speed_mps") && text.lines().count() > 1000);
     assert_eq!(&std::fs::read(&png).unwrap()[1..4], b"PNG");
-    let out = cdbo(&["plot", "track", "ridgeway", "-o", svg.to_str().unwrap(), "--trace", trace.to_str().unwrap()]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = cdbo(&[
+        "plot",
+        "track",
+        "ridgeway",
+        "-o",
+        svg.to_str().unwrap(),
+        "--trace",
+        trace.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert!(std::fs::read_to_string(&svg).unwrap().contains("<svg"));
 }
 
@@ -114,23 +147,59 @@ const TRACK: &str = r#"<?xml version="1.0"?>
 fn a_hand_written_track_file_loads() {
     let p = scratch("oval.xml", TRACK);
     let v = json(&["track", "info", p.to_str().unwrap(), "--json"]);
-    assert!((v["length_m"].as_f64().unwrap() - (200.0 + 100.0 * std::f64::consts::PI)).abs() < 1e-6);
+    assert!(
+        (v["length_m"].as_f64().unwrap() - (200.0 + 100.0 * std::f64::consts::PI)).abs() < 1e-6
+    );
 }
 
 #[test]
 fn bad_track_files_give_one_clear_error() {
     let truncated = scratch("truncated.xml", &TRACK[..TRACK.len() / 2]);
-    fails_with(&["track", "info", truncated.to_str().unwrap()], &["truncated.xml"]);
-    let no_radius = scratch("noradius.xml", &TRACK.replacen(r#"<attnum name="radius" unit="m" val="50"/>"#, "", 1));
-    fails_with(&["track", "info", no_radius.to_str().unwrap()], &["noradius.xml", "Main Track/Track Segments/c1/radius", "missing"]);
-    let bad_unit = scratch("badunit.xml", &TRACK.replacen(r#"unit="deg""#, r#"unit="gradians""#, 1));
-    fails_with(&["track", "info", bad_unit.to_str().unwrap()], &["badunit.xml", "c1/arc", "gradians"]);
-    let nan = scratch("nan.csv", "# x_m,y_m,w_tr_right_m,w_tr_left_m\n0,0,5,5\n1,NaN,5,5\n");
-    fails_with(&["track", "info", nan.to_str().unwrap()], &["nan.csv:3", "NaN"]);
+    fails_with(
+        &["track", "info", truncated.to_str().unwrap()],
+        &["truncated.xml"],
+    );
+    let no_radius = scratch(
+        "noradius.xml",
+        &TRACK.replacen(r#"<attnum name="radius" unit="m" val="50"/>"#, "", 1),
+    );
+    fails_with(
+        &["track", "info", no_radius.to_str().unwrap()],
+        &[
+            "noradius.xml",
+            "Main Track/Track Segments/c1/radius",
+            "missing",
+        ],
+    );
+    let bad_unit = scratch(
+        "badunit.xml",
+        &TRACK.replacen(r#"unit="deg""#, r#"unit="gradians""#, 1),
+    );
+    fails_with(
+        &["track", "info", bad_unit.to_str().unwrap()],
+        &["badunit.xml", "c1/arc", "gradians"],
+    );
+    let nan = scratch(
+        "nan.csv",
+        "# x_m,y_m,w_tr_right_m,w_tr_left_m\n0,0,5,5\n1,NaN,5,5\n",
+    );
+    fails_with(
+        &["track", "info", nan.to_str().unwrap()],
+        &["nan.csv:3", "NaN"],
+    );
     let few = scratch("few.csv", "0,0,5,5\n10,0,5,5\n10,10,5,5\n");
-    fails_with(&["track", "info", few.to_str().unwrap()], &["few.csv", "at least 10 points"]);
-    fails_with(&["track", "info", "atlantis"], &["unknown track", "atlantis", "ridgeway"]);
-    fails_with(&["lap", "--car", "no-such-car"], &["unknown car", "no-such-car"]);
+    fails_with(
+        &["track", "info", few.to_str().unwrap()],
+        &["few.csv", "at least 10 points"],
+    );
+    fails_with(
+        &["track", "info", "atlantis"],
+        &["unknown track", "atlantis", "ridgeway"],
+    );
+    fails_with(
+        &["lap", "--car", "no-such-car"],
+        &["unknown car", "no-such-car"],
+    );
     fails_with(&["lap", "--throttle", "3"], &["--throttle"]);
     fails_with(&["lap", "--demo", "-5"], &["--demo"]);
 }

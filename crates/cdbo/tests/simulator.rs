@@ -17,13 +17,20 @@ fn demo(track: Track) -> cdbo::sim::LapResult {
 
 #[test]
 fn the_15_mps_demonstration_completes_every_required_track() {
-    let mut tracks: Vec<Track> = ["forza", "allondaz", "e-track-2", "aalborg"].iter().map(|n| shared_track(n)).collect();
+    let mut tracks: Vec<Track> = ["forza", "allondaz", "e-track-2", "aalborg"]
+        .iter()
+        .map(|n| shared_track(n))
+        .collect();
     tracks.extend(cdbo::track::builtin::names().map(builtin));
     for t in tracks {
         let name = t.name.clone();
         let r = demo(t);
         assert!(r.completed, "{name}: {:?}", r.failure);
-        assert!((13.5..15.5).contains(&r.reward_mps), "{name}: {} m/s", r.reward_mps);
+        assert!(
+            (13.5..15.5).contains(&r.reward_mps),
+            "{name}: {} m/s",
+            r.reward_mps
+        );
     }
 }
 
@@ -33,7 +40,10 @@ fn full_throttle_fails_on_forza_and_says_where() {
     let r = sim.lap(&mut ConstantPedal(1.0));
     let f = r.failure.expect("full throttle must not complete Forza");
     assert!(!r.completed && r.reward_mps == 0.0);
-    assert!(matches!(f.reason, FailureReason::OffTrack | FailureReason::Spun), "{f:?}");
+    assert!(
+        matches!(f.reason, FailureReason::OffTrack | FailureReason::Spun),
+        "{f:?}"
+    );
     assert!(f.x > 0.0 && f.x < 1.0 && f.distance_m > 100.0, "{f:?}");
 }
 
@@ -56,11 +66,23 @@ fn no_lap_beats_the_limit_and_the_limit_is_plausible() {
     for (name, lo, hi) in [("forza", 100.0, 150.0), ("allondaz", 150.0, 230.0)] {
         let t = shared_track(name);
         let limit = limit_lap(&t, &car);
-        assert!((lo..hi).contains(&limit.lap_time_s), "{name}: limit {} s", limit.lap_time_s);
+        assert!(
+            (lo..hi).contains(&limit.lap_time_s),
+            "{name}: limit {} s",
+            limit.lap_time_s
+        );
         let sim = Simulator::new(t, &car);
         for scale in [0.6, 0.7, 0.8, 0.9, 1.0, 1.1] {
-            let r = sim.lap(&mut LimitFollower { profile: limit.speed.clone(), scale });
-            assert!(r.reward_mps < limit.reward_mps, "{name}: a lap at {} m/s beat the limit {}", r.reward_mps, limit.reward_mps);
+            let r = sim.lap(&mut LimitFollower {
+                profile: limit.speed.clone(),
+                scale,
+            });
+            assert!(
+                r.reward_mps < limit.reward_mps,
+                "{name}: a lap at {} m/s beat the limit {}",
+                r.reward_mps,
+                limit.reward_mps
+            );
         }
         assert!(demo(sim.track.clone()).reward_mps < limit.reward_mps);
     }
@@ -77,12 +99,26 @@ fn same_inputs_give_bit_identical_laps() {
 }
 
 fn straight(length: f64) -> Track {
-    let p = Piece { length, curvature: 0.0, z0: 0.0, z1: 0.0, banking0: 0.0, banking1: 0.0, width: 12.0, friction: 1.0 };
+    let p = Piece {
+        length,
+        curvature: 0.0,
+        z0: 0.0,
+        z1: 0.0,
+        banking0: 0.0,
+        banking1: 0.0,
+        width: 12.0,
+        friction: 1.0,
+    };
     Track::from_pieces("straight", "test", &[p], vec![])
 }
 
 /// Drives the bare vehicle model straight ahead with fixed pedals for `seconds`.
-fn drive_straight(v0: f64, throttle: f64, brake: f64, seconds: f64) -> (cdbo::sim::vehicle::State, Vehicle) {
+fn drive_straight(
+    v0: f64,
+    throttle: f64,
+    brake: f64,
+    seconds: f64,
+) -> (cdbo::sim::vehicle::State, Vehicle) {
     let track = straight(5000.0);
     let car = Car::spirit_300();
     let vehicle = Vehicle::new(&car);
@@ -114,7 +150,10 @@ fn coasting_decelerates_by_drag_and_rolling_resistance() {
     let car = &vehicle.car;
     let point_mass = (car.drag(40.0) + 0.01 * car.mass * G) / car.mass * 0.5;
     let lost = 40.0 - s.vx;
-    assert!(lost > 0.7 * point_mass && lost <= 1.02 * point_mass, "lost {lost} vs {point_mass}");
+    assert!(
+        lost > 0.7 * point_mass && lost <= 1.02 * point_mass,
+        "lost {lost} vs {point_mass}"
+    );
     assert!(s.vy.abs() < 1e-9 && s.yaw.abs() < 1e-12);
 }
 
@@ -128,7 +167,11 @@ fn braking_never_beats_the_friction_limit() {
     assert!(s.x >= v0 * v0 / (2.0 * mu_peak * G), "stopped in {} m", s.x);
     // The Spirit's brakes are biased to the front (52 % of the pressure on much larger
     // front pistons), so the rear tyres never reach their grip: about 0.85 g, not 1.3 g.
-    assert!(s.x < v0 * v0 / (2.0 * 0.7 * G), "braking too weak: {} m", s.x);
+    assert!(
+        s.x < v0 * v0 / (2.0 * 0.7 * G),
+        "braking too weak: {} m",
+        s.x
+    );
 }
 
 #[test]
@@ -141,6 +184,11 @@ fn standing_start_acceleration_is_that_of_a_290_kw_car() {
         sim.config.trace = true;
         sim.lap(&mut ConstantPedal(1.0))
     };
-    let t100 = s.trace.drain(..).find(|p| p.speed >= 100.0 / 3.6).map(|p| p.t).expect("reaches 100 km/h");
+    let t100 = s
+        .trace
+        .drain(..)
+        .find(|p| p.speed >= 100.0 / 3.6)
+        .map(|p| p.t)
+        .expect("reaches 100 km/h");
     assert!((3.5..7.0).contains(&t100), "0-100 km/h in {t100} s");
 }

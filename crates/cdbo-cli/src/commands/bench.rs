@@ -45,7 +45,12 @@ pub fn run(cmd: &BenchCommand, data: &DataPath) -> CliResult {
     let sim = Simulator::new(track, &car);
     sim.lap(&mut SpeedHold::new(DEFAULT_TARGET_SPEED)); // warm-up
     let start = std::time::Instant::now();
-    let simulated_s: f64 = (0..args.laps).map(|_| sim.lap(&mut SpeedHold::new(DEFAULT_TARGET_SPEED)).simulated_s).sum();
+    let simulated_s: f64 = (0..args.laps)
+        .map(|_| {
+            sim.lap(&mut SpeedHold::new(DEFAULT_TARGET_SPEED))
+                .simulated_s
+        })
+        .sum();
     let wall_s = start.elapsed().as_secs_f64();
     let b = SimBench {
         track: sim.track.name.clone(),

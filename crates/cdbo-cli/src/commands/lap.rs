@@ -64,7 +64,9 @@ pub fn run(args: &LapArgs, data: &DataPath) -> CliResult {
         (speed, _, _) => {
             let speed = speed.unwrap_or(DEFAULT_TARGET_SPEED);
             if !(speed > 0.0 && speed.is_finite()) {
-                return Err(format!("--demo {speed}: the target speed must be positive (m/s)").into());
+                return Err(
+                    format!("--demo {speed}: the target speed must be positive (m/s)").into(),
+                );
             }
             Box::new(SpeedHold::new(speed))
         }
@@ -96,11 +98,24 @@ pub fn run(args: &LapArgs, data: &DataPath) -> CliResult {
     match (report.lap_time_s, report.failure) {
         (Some(t), _) => println!(
             "{} on {}: lap {:.2} s, reward {:.2} m/s ({:.1} % of the limit {:.2} s, {:.2} m/s)",
-            report.car, report.track, t, report.reward_mps, 100.0 * report.fraction_of_limit, report.limit_lap_time_s, report.limit_reward_mps
+            report.car,
+            report.track,
+            t,
+            report.reward_mps,
+            100.0 * report.fraction_of_limit,
+            report.limit_lap_time_s,
+            report.limit_reward_mps
         ),
         (None, Some(f)) => println!(
             "{} on {}: failed ({:?}) at x = {:.4} ({:.1} m, {:.2} s); reward 0 (limit {:.2} s, {:.2} m/s)",
-            report.car, report.track, f.reason, f.x, f.distance_m, f.time_s, report.limit_lap_time_s, report.limit_reward_mps
+            report.car,
+            report.track,
+            f.reason,
+            f.x,
+            f.distance_m,
+            f.time_s,
+            report.limit_lap_time_s,
+            report.limit_reward_mps
         ),
         (None, None) => unreachable!("a lap either completes or fails"),
     }
@@ -111,12 +126,27 @@ fn write_trace(path: &std::path::Path, trace: &[cdbo::sim::TracePoint]) -> CliRe
     use std::io::Write;
     let file = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut w = std::io::BufWriter::new(file);
-    writeln!(w, "t_s,distance_m,x,speed_mps,pedal,steer_rad,lateral_m,heading_error_rad,slip_angle_rad,gear,rpm,pos_x_m,pos_y_m")?;
+    writeln!(
+        w,
+        "t_s,distance_m,x,speed_mps,pedal,steer_rad,lateral_m,heading_error_rad,slip_angle_rad,gear,rpm,pos_x_m,pos_y_m"
+    )?;
     for p in trace {
         writeln!(
             w,
             "{:.3},{:.3},{:.6},{:.4},{:.4},{:.5},{:.4},{:.5},{:.5},{},{:.0},{:.3},{:.3}",
-            p.t, p.distance_m, p.x, p.speed, p.pedal, p.steer, p.lateral, p.heading_error, p.slip_angle, p.gear, p.rpm, p.pos_x, p.pos_y
+            p.t,
+            p.distance_m,
+            p.x,
+            p.speed,
+            p.pedal,
+            p.steer,
+            p.lateral,
+            p.heading_error,
+            p.slip_angle,
+            p.gear,
+            p.rpm,
+            p.pos_x,
+            p.pos_y
         )?;
     }
     w.flush()?;

@@ -21,6 +21,14 @@ pub fn run(args: &LimitArgs, data: &DataPath) -> CliResult {
     if args.json {
         return print_json(&limit);
     }
-    println!("{} on {} ({:.1} m): limit lap {:.2} s, {:.2} m/s ({:.1} km/h)", car.name, track.name, track.length, limit.lap_time_s, limit.reward_mps, limit.reward_mps * 3.6);
+    println!(
+        "{} on {} ({:.1} m): limit lap {:.2} s, {:.2} m/s ({:.1} km/h)",
+        car.name,
+        track.name,
+        track.length,
+        limit.lap_time_s,
+        limit.reward_mps,
+        limit.reward_mps * 3.6
+    );
     Ok(())
 }

@@ -32,13 +32,23 @@ pub enum PlotCommand {
 const SIZE: (u32, u32) = (1000, 800);
 
 pub fn run(cmd: &PlotCommand, data: &DataPath) -> CliResult {
-    let PlotCommand::Track { track, output, trace } = cmd;
+    let PlotCommand::Track {
+        track,
+        output,
+        trace,
+    } = cmd;
     let t = load_track(track, data)?;
     let speeds = match trace {
         Some(p) => Some(read_trace_speeds(p)?),
         None => None,
     };
-    draw(output, &TrackMap { track: &t, speeds: speeds.as_deref() })
+    draw(
+        output,
+        &TrackMap {
+            track: &t,
+            speeds: speeds.as_deref(),
+        },
+    )
 }
 
 /// Something drawn on a drawing area of any backend.
@@ -82,32 +92,65 @@ impl Figure for LapSpeed<'_> {
         let (track, lap, limit) = (self.track, self.lap, self.limit);
         let vmax = limit.speed.iter().copied().fold(10.0, f64::max) * 1.05;
         let mut chart = ChartBuilder::on(root)
-            .caption(format!("{}: speed along the lap", track.name), ("sans-serif", 24))
+            .caption(
+                format!("{}: speed along the lap", track.name),
+                ("sans-serif", 24),
+            )
             .margin(15)
             .x_label_area_size(45)
             .y_label_area_size(60)
             .build_cartesian_2d(0.0..track.length, 0.0..vmax)?;
-        chart.configure_mesh().x_desc("distance (m)").y_desc("speed (m/s)").draw()?;
+        chart
+            .configure_mesh()
+            .x_desc("distance (m)")
+            .y_desc("speed (m/s)")
+            .draw()?;
         let ds = track.ds;
         chart
-            .draw_series(LineSeries::new(limit.speed.iter().enumerate().map(|(i, v)| (i as f64 * ds, *v)), RED.stroke_width(2)))?
+            .draw_series(LineSeries::new(
+                limit
+                    .speed
+                    .iter()
+                    .enumerate()
+                    .map(|(i, v)| (i as f64 * ds, *v)),
+                RED.stroke_width(2),
+            ))?
             .label("limit (QSS)")
             .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED));
         chart
-            .draw_series(LineSeries::new(lap.trace.iter().map(|p| (p.distance_m, p.speed)), BLUE.stroke_width(2)))?
+            .draw_series(LineSeries::new(
+                lap.trace.iter().map(|p| (p.distance_m, p.speed)),
+                BLUE.stroke_width(2),
+            ))?
             .label("lap")
             .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLUE));
-        chart.configure_series_labels().border_style(BLACK).background_style(WHITE.mix(0.8)).draw()?;
+        chart
+            .configure_series_labels()
+            .border_style(BLACK)
+            .background_style(WHITE.mix(0.8))
+            .draw()?;
         Ok(())
     }
 }
 
-fn track_map<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, t: &Track, speeds: Option<&[(f64, f64)]>) -> CliResult
+fn track_map<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    t: &Track,
+    speeds: Option<&[(f64, f64)]>,
+) -> CliResult
 where
     DB::ErrorType: 'static,
 {
     let edge = |side: f64| -> Vec<(f64, f64)> {
-        t.samples.iter().map(|c| (c.x - side * 0.5 * c.width * c.heading.sin(), c.y + side * 0.5 * c.width * c.heading.cos())).collect()
+        t.samples
+            .iter()
+            .map(|c| {
+                (
+                    c.x - side * 0.5 * c.width * c.heading.sin(),
+                    c.y + side * 0.5 * c.width * c.heading.cos(),
+                )
+            })
+            .collect()
     };
     let (left, right) = (edge(1.0), edge(-1.0));
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
@@ -117,7 +160,11 @@ where
     // Equal scales on both axes.
     let (w, h) = (x1 - x0, y1 - y0);
     let aspect = (SIZE.0 - 100) as f64 / (SIZE.1 - 100) as f64;
-    let (w, h) = if w / h > aspect { (w, w / aspect) } else { (h * aspect, h) };
+    let (w, h) = if w / h > aspect {
+        (w, w / aspect)
+    } else {
+        (h * aspect, h)
+    };
     let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
     let title = match speeds {
         Some(_) => format!("{} — coloured by speed", t.name),
@@ -129,7 +176,12 @@ where
         .x_label_area_size(40)
         .y_label_area_size(60)
         .build_cartesian_2d(cx - 0.55 * w..cx + 0.55 * w, cy - 0.55 * h..cy + 0.55 * h)?;
-    chart.configure_mesh().disable_mesh().x_desc("x (m)").y_desc("y (m)").draw()?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc("x (m)")
+        .y_desc("y (m)")
+        .draw()?;
     let n = t.len();
     let value = |i: usize| -> f64 {
         match speeds {
@@ -138,13 +190,18 @@ where
         }
     };
     let vmax = (0..n).map(value).fold(1e-9, f64::max);
-    let centre_colour = |i: usize| plotters::style::colors::colormaps::ViridisRGB::get_color((value(i) / vmax).clamp(0.0, 1.0));
+    let centre_colour = |i: usize| {
+        plotters::style::colors::colormaps::ViridisRGB::get_color((value(i) / vmax).clamp(0.0, 1.0))
+    };
     chart.draw_series((0..n).map(|i| {
         let (a, b) = (&t.samples[i], &t.samples[(i + 1) % n]);
         PathElement::new([(a.x, a.y), (b.x, b.y)], centre_colour(i).stroke_width(4))
     }))?;
     for e in [&left, &right] {
-        chart.draw_series(std::iter::once(PathElement::new(e.iter().chain(e.first()).copied().collect::<Vec<_>>(), BLACK.stroke_width(1))))?;
+        chart.draw_series(std::iter::once(PathElement::new(
+            e.iter().chain(e.first()).copied().collect::<Vec<_>>(),
+            BLACK.stroke_width(1),
+        )))?;
     }
     let s0 = &t.samples[0];
     chart.draw_series(std::iter::once(Circle::new((s0.x, s0.y), 6, RED.filled())))?;
@@ -152,7 +209,11 @@ where
         Some(_) => format!("speed 0 .. {vmax:.1} m/s (dark → bright); red dot: start"),
         None => format!("|curvature| 0 .. {vmax:.3} 1/m (dark → bright); red dot: start"),
     };
-    root.draw(&Text::new(label, (80, (SIZE.1 - 30) as i32), ("sans-serif", 16)))?;
+    root.draw(&Text::new(
+        label,
+        (80, (SIZE.1 - 30) as i32),
+        ("sans-serif", 16),
+    ))?;
     Ok(())
 }
 
@@ -161,12 +222,23 @@ fn read_trace_speeds(path: &Path) -> Result<Vec<(f64, f64)>, Box<dyn std::error:
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
-    let col = |name: &str| header.iter().position(|h| *h == name).ok_or_else(|| format!("{}: no {name} column (expected a `cdbo lap --trace` file)", path.display()));
+    let col = |name: &str| {
+        header.iter().position(|h| *h == name).ok_or_else(|| {
+            format!(
+                "{}: no {name} column (expected a `cdbo lap --trace` file)",
+                path.display()
+            )
+        })
+    };
     let (d, v) = (col("distance_m")?, col("speed_mps")?);
     let mut rows = Vec::new();
     for (i, line) in lines.enumerate() {
         let f: Vec<&str> = line.split(',').collect();
-        let num = |k: usize| f.get(k).and_then(|s| s.parse::<f64>().ok()).ok_or_else(|| format!("{}:{}: bad row", path.display(), i + 2));
+        let num = |k: usize| {
+            f.get(k)
+                .and_then(|s| s.parse::<f64>().ok())
+                .ok_or_else(|| format!("{}:{}: bad row", path.display(), i + 2))
+        };
         rows.push((num(d)?, num(v)?));
     }
     if rows.is_empty() {
@@ -185,7 +257,11 @@ pub fn draw(path: &Path, figure: &impl Figure) -> CliResult {
     static FONT: Once = Once::new();
     FONT.call_once(|| {
         // The bundled font is valid, so registration cannot fail.
-        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular());
+        let _ = plotters::style::register_font(
+            "sans-serif",
+            FontStyle::Normal,
+            dejavu::sans::regular(),
+        );
     });
     match path.extension().and_then(|e| e.to_str()) {
         Some("svg") => {
@@ -198,9 +274,14 @@ pub fn draw(path: &Path, figure: &impl Figure) -> CliResult {
             let root = BitMapBackend::new(path, SIZE).into_drawing_area();
             root.fill(&WHITE)?;
             figure.render(&root)?;
-            root.present().map_err(|e| format!("{}: {e}", path.display()))?;
+            root.present()
+                .map_err(|e| format!("{}: {e}", path.display()))?;
         }
-        _ => return Err(format!("{}: the plot file must end in .png or .svg", path.display()).into()),
+        _ => {
+            return Err(
+                format!("{}: the plot file must end in .png or .svg", path.display()).into(),
+            );
+        }
     }
     Ok(())
 }

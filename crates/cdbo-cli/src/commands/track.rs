@@ -53,7 +53,13 @@ pub fn run(cmd: &TrackCommand, data: &DataPath) -> CliResult {
     println!("  length      {:>9.2} m", info.length_m);
     println!("  width       {:>9.2} m", info.width_m);
     println!("  min radius  {:>9.2} m", info.min_radius_m);
-    println!("  elevation   {:>9.2} .. {:.2} m", info.z_min_m, info.z_max_m);
-    println!("  closure     {:>9.3} m, {:.3}°", info.closure_gap_m, info.closure_heading_deg);
+    println!(
+        "  elevation   {:>9.2} .. {:.2} m",
+        info.z_min_m, info.z_max_m
+    );
+    println!(
+        "  closure     {:>9.3} m, {:.3}°",
+        info.closure_gap_m, info.closure_heading_deg
+    );
     Ok(())
 }

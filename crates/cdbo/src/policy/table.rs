@@ -16,14 +16,20 @@ impl PolicyTable {
     /// A table from points; x must increase strictly and a lie in [−1, 1].
     pub fn new(points: Vec<(f64, f64)>) -> Result<PolicyTable> {
         if points.is_empty() {
-            return Err(Error::Domain("a policy table needs at least one point".into()));
+            return Err(Error::Domain(
+                "a policy table needs at least one point".into(),
+            ));
         }
         for (i, &(x, a)) in points.iter().enumerate() {
             if !x.is_finite() || !a.is_finite() || !(-1.0..=1.0).contains(&a) {
-                return Err(Error::Domain(format!("policy point {i}: (x {x}, a {a}) must be finite with a in [-1, 1]")));
+                return Err(Error::Domain(format!(
+                    "policy point {i}: (x {x}, a {a}) must be finite with a in [-1, 1]"
+                )));
             }
             if i > 0 && x <= points[i - 1].0 {
-                return Err(Error::Domain(format!("policy point {i}: x {x} does not increase")));
+                return Err(Error::Domain(format!(
+                    "policy point {i}: x {x} does not increase"
+                )));
             }
         }
         Ok(PolicyTable { points })
@@ -31,20 +37,34 @@ impl PolicyTable {
 
     /// Reads `x,a` rows (a header line and `#` comments are skipped).
     pub fn read_csv(path: &Path) -> Result<PolicyTable> {
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: path.to_owned(), source })?;
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            path: path.to_owned(),
+            source,
+        })?;
         let file = path.display().to_string();
         let mut points = Vec::new();
         for (i, line) in text.lines().enumerate() {
             let line = line.trim();
-            if line.is_empty() || line.starts_with('#') || (i == 0 && line.chars().next().is_some_and(char::is_alphabetic)) {
+            if line.is_empty()
+                || line.starts_with('#')
+                || (i == 0 && line.chars().next().is_some_and(char::is_alphabetic))
+            {
                 continue;
             }
-            let err = |m: String| Error::Invalid { file: file.clone(), line: Some(i as u32 + 1), element: "row".into(), message: m };
+            let err = |m: String| Error::Invalid {
+                file: file.clone(),
+                line: Some(i as u32 + 1),
+                element: "row".into(),
+                message: m,
+            };
             let cols: Vec<&str> = line.split(',').map(str::trim).collect();
             if cols.len() != 2 {
                 return Err(err(format!("expected 2 columns x,a, found {}", cols.len())));
             }
-            let num = |s: &str| s.parse::<f64>().map_err(|_| err(format!("{s:?} is not a number")));
+            let num = |s: &str| {
+                s.parse::<f64>()
+                    .map_err(|_| err(format!("{s:?} is not a number")))
+            };
             points.push((num(cols[0])?, num(cols[1])?));
         }
         PolicyTable::new(points).map_err(|e| Error::invalid(file, "rows", e.to_string()))

@@ -210,7 +210,14 @@ impl Simulator {
                     })
                     .clamp(-1.0, 1.0);
                 let a = if a.is_nan() { 0.0 } else { a };
-                let steer = steering.update(track, car.wheelbase, car.steer_lock, &state, &proj, driver_dt);
+                let steer = steering.update(
+                    track,
+                    car.wheelbase,
+                    car.steer_lock,
+                    &state,
+                    &proj,
+                    driver_dt,
+                );
                 controls = Controls::new(steer, a.max(0.0), (-a).max(0.0));
                 self.vehicle.shift(&mut state);
                 if cfg.trace {

@@ -48,7 +48,12 @@ impl Controls {
     /// Commands for a road-wheel steering angle (rad, positive left), a throttle and a brake
     /// pedal in [0, 1].
     pub fn new(steer: f64, throttle: f64, brake: f64) -> Controls {
-        Controls { steer, throttle, brake, steer_sin_cos: steer.sin_cos() }
+        Controls {
+            steer,
+            throttle,
+            brake,
+            steer_sin_cos: steer.sin_cos(),
+        }
     }
 
     /// Steering angle (rad).

@@ -8,7 +8,9 @@ use cdbo::track::Track;
 
 /// `../shared` beside the repository root.
 pub fn shared(rel: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared").join(rel)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared")
+        .join(rel)
 }
 
 /// A track from ../shared, found by name.
@@ -19,5 +21,7 @@ pub fn shared_track(name: &str) -> Track {
 
 /// A built-in track.
 pub fn builtin(name: &str) -> Track {
-    cdbo::track::builtin::load(name).expect("built-in").expect("loads")
+    cdbo::track::builtin::load(name)
+        .expect("built-in")
+        .expect("loads")
 }
