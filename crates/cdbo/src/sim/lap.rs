@@ -129,7 +129,8 @@ impl Default for LapConfig {
     }
 }
 
-const SPIN_SLIP_ANGLE: f64 = std::f64::consts::FRAC_PI_3;
+/// 1 / tan(60°): a body slip angle above 60° means vₓ < |v_y| / tan 60°.
+const INV_TAN_SPIN_SLIP_ANGLE: f64 = 0.577_350_269_189_625_8;
 const SPIN_MIN_SPEED: f64 = 3.0;
 const BACKWARDS_DISTANCE: f64 = 10.0;
 const STALL_SPEED: f64 = 0.5;
@@ -275,7 +276,7 @@ impl Simulator {
                 Some(super::FailureReason::OffTrack)
             } else if facing_away(&state, track.frame(proj.index))
                 || (state.speed() > SPIN_MIN_SPEED
-                    && state.vx < state.vy.abs() / SPIN_SLIP_ANGLE.tan())
+                    && state.vx < state.vy.abs() * INV_TAN_SPIN_SLIP_ANGLE)
             {
                 Some(super::FailureReason::Spun)
             } else if distance < farthest - BACKWARDS_DISTANCE {

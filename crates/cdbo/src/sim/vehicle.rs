@@ -16,7 +16,7 @@
 //!   m(v̇_y + vₓ r) = F_xf sin δ + F_yf cos δ + F_yr − m g sin β,
 //!   I_z ṙ = a(F_xf sin δ + F_yf cos δ) − b F_yr, with β the banking.
 //! - Drag F = 0.645·Cx·A·v², downforce Dᵢ = 0.645·Clᵢ·A·v², rolling resistance
-//!   F = c_rr·(F_zf + F_zr).
+//!   F = c_rr·(F_zf + F_zr)·sgn vₓ.
 //! - Brakes: T = p·share·A_piston·μ_pad·r_disc per wheel, with ABS easing the pressure while an
 //!   axle's slip exceeds half the tyre's peak slip; traction control eases the throttle
 //!   likewise (the Spirit 300 has both; TORCS robots implement them in the driver).
@@ -171,8 +171,10 @@ impl Vehicle {
         }
     }
 
-    /// The automatic gearbox's decision, taken at the driver's rate.
+    /// The automatic gearbox's decision, taken at the driver's rate; also re-synchronises the
+    /// incrementally rotated (sin ψ, cos ψ) with ψ.
     pub fn shift(&self, s: &mut State) {
+        s.yaw_sin_cos = s.yaw.sin_cos();
         let w = self.driven_omega(s);
         s.gearbox.update(&self.car, &self.shift_map, w);
     }
@@ -268,7 +270,8 @@ impl Vehicle {
         }
 
         // Body forces and moments.
-        let roll = self.rolling * (fz[0] + fz[1]) * (s.vx / 0.5).tanh();
+        // Rolling resistance opposes motion; sgn vₓ is smoothed over ±0.5 m/s for standing starts.
+        let roll = self.rolling * (fz[0] + fz[1]) * (s.vx / 0.5).clamp(-1.0, 1.0);
         let drag = car.drag(v) * if v > 1e-9 { s.vx / v } else { 0.0 };
         let force_x = fx[0] * cos_d - fy[0] * sin_d + fx[1] - drag - roll - m * G * frame.sin_pitch;
         // cos(ψ − θ) of the car's yaw against the road's heading.
@@ -282,7 +285,22 @@ impl Vehicle {
         s.vy += dt * (force_y / m - s.vx * s.yaw_rate);
         s.yaw_rate += dt * moment / self.yaw_inertia;
         s.yaw += dt * s.yaw_rate;
-        s.yaw_sin_cos = s.yaw.sin_cos();
+        // Keep the yaw in (−π, π]: cheap trigonometry, and no drift of precision over laps.
+        if s.yaw > std::f64::consts::PI {
+            s.yaw -= std::f64::consts::TAU;
+        } else if s.yaw <= -std::f64::consts::PI {
+            s.yaw += std::f64::consts::TAU;
+        }
+        // Rotate (sin ψ, cos ψ) by the step's dψ (|dψ| < 0.01 rad, so the series to dψ⁵ is
+        // exact in double precision); the driver step re-synchronises it with sin_cos(ψ).
+        let d = dt * s.yaw_rate;
+        let d2 = d * d;
+        let (sd, cd) = (
+            d * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0)),
+            1.0 - d2 / 2.0 * (1.0 - d2 / 12.0),
+        );
+        let (sy0, cy0) = s.yaw_sin_cos;
+        s.yaw_sin_cos = (sy0 * cd + cy0 * sd, cy0 * cd - sy0 * sd);
         let (sin_y, cos_y) = s.yaw_sin_cos;
         s.x += dt * (s.vx * cos_y - s.vy * sin_y);
         s.y += dt * (s.vx * sin_y + s.vy * cos_y);

@@ -148,19 +148,41 @@ impl Track {
     /// The sample at index `i`, wrapping around the lap.
     #[inline]
     pub fn sample(&self, i: usize) -> &Sample {
-        &self.samples[i % self.samples.len()]
+        let n = self.samples.len();
+        &self.samples[if i < n { i } else { i % n }]
     }
 
     /// The pre-computed trigonometry of sample `i` (wrapping around the lap).
     #[inline]
     pub fn frame(&self, i: usize) -> &Frame {
-        &self.frames[i % self.frames.len()]
+        let n = self.frames.len();
+        &self.frames[if i < n { i } else { i % n }]
+    }
+
+    /// An arc length wrapped into [0, length): a subtraction for the common near-lap values.
+    #[inline]
+    pub fn wrap(&self, s: f64) -> f64 {
+        if s < 0.0 {
+            if s >= -self.length {
+                s + self.length
+            } else {
+                s.rem_euclid(self.length)
+            }
+        } else if s >= self.length {
+            if s < 2.0 * self.length {
+                s - self.length
+            } else {
+                s.rem_euclid(self.length)
+            }
+        } else {
+            s
+        }
     }
 
     /// The index of the sample at or before arc length `s` (wrapped into the lap).
     #[inline]
     pub fn index_at(&self, s: f64) -> usize {
-        let s = s.rem_euclid(self.length);
+        let s = self.wrap(s);
         ((s / self.ds) as usize).min(self.samples.len() - 1)
     }
 
@@ -187,7 +209,7 @@ impl Track {
                 // lateral = l − κa²/2, station offset = a(1 + κl).
                 let l = -dx * sin + dy * cos;
                 let lateral = l - 0.5 * c.curvature * along * along;
-                let s = (c.s + along * (1.0 + c.curvature * l)).rem_euclid(self.length);
+                let s = self.wrap(c.s + along * (1.0 + c.curvature * l));
                 return Projection {
                     index: i,
                     s,
