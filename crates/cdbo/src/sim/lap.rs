@@ -186,6 +186,8 @@ impl Simulator {
         let limit = self.time_limit();
         let driver_dt = cfg.dt * cfg.driver_every as f64;
         let mut step = 0usize;
+        let mut until_driver = 0usize;
+        let half_length = 0.5 * track.length;
         let fail = |reason, distance: f64, t: f64| LapResult {
             completed: false,
             lap_time_s: None,
@@ -200,8 +202,9 @@ impl Simulator {
             trace: Vec::new(),
         };
         loop {
-            let t = step as f64 * cfg.dt;
-            if step % cfg.driver_every == 0 {
+            if until_driver == 0 {
+                until_driver = cfg.driver_every;
+                let t = step as f64 * cfg.dt;
                 let x = (distance / track.length).clamp(0.0, 1.0);
                 let a = pedal
                     .pedal(&Observation {
@@ -247,13 +250,14 @@ impl Simulator {
                 cfg.dt,
             );
             step += 1;
+            until_driver -= 1;
             let t = step as f64 * cfg.dt;
             let prev_s = proj.s;
             proj = track.project(state.x, state.y, proj.index);
             let mut ds = proj.s - prev_s;
-            if ds > track.length / 2.0 {
+            if ds > half_length {
                 ds -= track.length;
-            } else if ds < -track.length / 2.0 {
+            } else if ds < -half_length {
                 ds += track.length;
             }
             let before = distance;
@@ -275,8 +279,8 @@ impl Simulator {
             let failure = if proj.lateral.abs() > half_width {
                 Some(super::FailureReason::OffTrack)
             } else if facing_away(&state, track.frame(proj.index))
-                || (state.speed() > SPIN_MIN_SPEED
-                    && state.vx < state.vy.abs() * INV_TAN_SPIN_SLIP_ANGLE)
+                || (state.vx < state.vy.abs() * INV_TAN_SPIN_SLIP_ANGLE
+                    && state.speed() > SPIN_MIN_SPEED)
             {
                 Some(super::FailureReason::Spun)
             } else if distance < farthest - BACKWARDS_DISTANCE {
@@ -284,7 +288,7 @@ impl Simulator {
             } else if t > limit {
                 Some(super::FailureReason::TimeLimit)
             } else {
-                slow_for = if state.speed() < STALL_SPEED {
+                slow_for = if state.vx.abs() < STALL_SPEED && state.speed() < STALL_SPEED {
                     slow_for + cfg.dt
                 } else {
                     0.0

@@ -3,6 +3,7 @@
 
 pub mod lap;
 pub mod powertrain;
+pub mod table;
 pub mod tyre;
 pub mod vehicle;
 

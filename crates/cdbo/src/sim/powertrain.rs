@@ -54,6 +54,60 @@ impl ShiftMap {
     }
 }
 
+/// The full-throttle torque curve with O(1) look-up: the speed range is cut into buckets,
+/// each knowing the first curve segment it overlaps; values equal [`Car::engine_torque`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct EngineMap {
+    curve: Vec<(f64, f64)>,
+    rev_limiter: f64,
+    buckets_per_rad_s: f64,
+    /// For each bucket, the number of curve points at or below its lower edge.
+    first: Vec<usize>,
+}
+
+impl EngineMap {
+    /// Buckets of the speed range up to the rev limiter.
+    const BUCKETS: usize = 512;
+
+    /// The map of a car's curve.
+    pub fn new(car: &Car) -> EngineMap {
+        let width = car.rev_limiter / Self::BUCKETS as f64;
+        let first = (0..=Self::BUCKETS)
+            .map(|b| {
+                car.torque_curve
+                    .partition_point(|&(w, _)| w <= b as f64 * width)
+            })
+            .collect();
+        EngineMap {
+            curve: car.torque_curve.clone(),
+            rev_limiter: car.rev_limiter,
+            buckets_per_rad_s: 1.0 / width,
+            first,
+        }
+    }
+
+    /// Full-throttle torque at engine speed ω (N·m), 0 at and above the rev limiter.
+    #[inline]
+    pub fn torque(&self, omega: f64) -> f64 {
+        if !(omega >= 0.0 && omega < self.rev_limiter) {
+            return if omega < 0.0 { self.curve[0].1 } else { 0.0 };
+        }
+        let c = &self.curve;
+        let mut i = self.first[(omega * self.buckets_per_rad_s) as usize];
+        while i < c.len() && c[i].0 <= omega {
+            i += 1;
+        }
+        match i {
+            0 => c[0].1,
+            i if i == c.len() => c[i - 1].1,
+            i => {
+                let ((w0, t0), (w1, t1)) = (c[i - 1], c[i]);
+                t0 + (t1 - t0) * (omega - w0) / (w1 - w0)
+            }
+        }
+    }
+}
+
 impl Gearbox {
     /// Standing in first gear.
     pub fn new() -> Gearbox {
@@ -89,13 +143,19 @@ impl Gearbox {
 
     /// Drive torque at the driven wheels (N·m) for a throttle in [0, 1], and the engine speed.
     #[inline]
-    pub fn wheel_torque(&self, car: &Car, throttle: f64, wheel_omega: f64) -> (f64, f64) {
+    pub fn wheel_torque(
+        &self,
+        car: &Car,
+        engine_map: &EngineMap,
+        throttle: f64,
+        wheel_omega: f64,
+    ) -> (f64, f64) {
         let ratio = self.ratio(car);
         let engine = (wheel_omega * ratio).max(car.tickover);
         if self.shifting > 0.0 {
             return (0.0, engine);
         }
-        (throttle * car.engine_torque(engine) * ratio, engine)
+        (throttle * engine_map.torque(engine) * ratio, engine)
     }
 }
 
@@ -128,6 +188,16 @@ mod tests {
                 "gear {i} shifts at {} rpm",
                 w * 30.0 / std::f64::consts::PI
             );
+        }
+    }
+
+    #[test]
+    fn the_engine_map_equals_the_curve() {
+        let car = Car::spirit_300();
+        let map = EngineMap::new(&car);
+        for i in 0..20_000 {
+            let w = i as f64 * 0.05 - 1.0;
+            assert_eq!(map.torque(w), car.engine_torque(w), "at {w} rad/s");
         }
     }
 

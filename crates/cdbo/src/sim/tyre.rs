@@ -10,6 +10,7 @@
 //! Longitudinal and lateral forces share this one budget along the slip vector:
 //! Fₓ = F·sₓ/s, F_y = F·s_y/s (the friction ellipse of combined slip).
 
+use super::table::HermiteTable;
 use crate::car::Tyre;
 
 /// λ_min of the load sensitivity (TORCS default).
@@ -32,16 +33,15 @@ pub struct TyreModel {
     pub operating_load: f64,
     /// k of the load sensitivity.
     load_k: f64,
+    /// 1 / F_op.
+    inv_operating_load: f64,
     /// Slip magnitude at which the force peaks.
     pub peak_slip: f64,
-    /// (f, f′) at s = k·[`TABLE_STEP`], k = 0..=[`TABLE_LEN`].
-    table: Vec<(f64, f64)>,
+    /// f and f′ of the shape, tabulated on s ∈ [0, 2].
+    shape_table: HermiteTable,
+    /// λ and dλ/dz of the load sensitivity, tabulated on z = F_z/F_op ∈ [0, 8].
+    load_table: HermiteTable,
 }
-
-/// Slip spacing of the shape table.
-pub const TABLE_STEP: f64 = 1.0 / 2048.0;
-/// Intervals of the shape table: it covers s ∈ [0, 2]; beyond, the formula is evaluated.
-pub const TABLE_LEN: usize = 4096;
 
 impl TyreModel {
     /// The model of a car's tyre.
@@ -56,21 +56,29 @@ impl TyreModel {
             e: t.elasticity,
             operating_load: t.operating_load,
             load_k,
+            inv_operating_load: 1.0 / t.operating_load,
             peak_slip: 0.0,
-            table: Vec::new(),
+            shape_table: HermiteTable::new(1.0, 0, |_| (0.0, 0.0)),
+            load_table: HermiteTable::new(1.0, 0, |_| (0.0, 0.0)),
         };
         m.peak_slip = m.find_peak_slip();
-        m.table = (0..=TABLE_LEN)
-            .map(|k| m.shape_exact(k as f64 * TABLE_STEP))
-            .collect();
+        // Steps 1/2048 and 1/256 keep the interpolation error below 1e-11.
+        m.shape_table = HermiteTable::new(1.0 / 2048.0, 4096, |s| m.shape_exact(s));
+        m.load_table = HermiteTable::new(1.0 / 256.0, 2048, |z| {
+            let e = (LOAD_FACTOR_MAX - LOAD_FACTOR_MIN) * (load_k * z).exp();
+            (LOAD_FACTOR_MIN + e, load_k * e)
+        });
         m
     }
 
-    /// Load sensitivity λ(F_z).
+    /// Load sensitivity λ(F_z) (tabulated; the formula beyond 8 × the operating load).
     #[inline]
     pub fn load_factor(&self, fz: f64) -> f64 {
-        LOAD_FACTOR_MIN
-            + (LOAD_FACTOR_MAX - LOAD_FACTOR_MIN) * (self.load_k * fz / self.operating_load).exp()
+        let z = fz * self.inv_operating_load;
+        match self.load_table.eval(z) {
+            Some((l, _)) => l,
+            None => LOAD_FACTOR_MIN + (LOAD_FACTOR_MAX - LOAD_FACTOR_MIN) * (self.load_k * z).exp(),
+        }
     }
 
     /// Largest force the tyre can give under load `fz` on a surface of friction `surface` (N).
@@ -79,28 +87,13 @@ impl TyreModel {
         fz * self.mu * surface * self.load_factor(fz)
     }
 
-    /// The shape f(s) and f′(s) for s ≥ 0, by cubic Hermite interpolation of the exact values
-    /// and slopes tabulated every 1/2048 (error below 1e-11), the formula past s = 2.
+    /// The shape f(s) and f′(s) for s ≥ 0: the tabulated values up to s = 2 (error below
+    /// 1e-11), the formula beyond.
     #[inline]
     pub fn shape(&self, s: f64) -> (f64, f64) {
-        let x = s * (1.0 / TABLE_STEP);
-        if !(x < TABLE_LEN as f64) {
-            return self.shape_exact(s);
-        }
-        let k = x as usize;
-        let t = x - k as f64;
-        let ((f0, d0), (f1, d1)) = (self.table[k], self.table[k + 1]);
-        let (m0, m1) = (d0 * TABLE_STEP, d1 * TABLE_STEP);
-        let (t2, t3) = (t * t, t * t * t);
-        let f = (2.0 * t3 - 3.0 * t2 + 1.0) * f0
-            + (t3 - 2.0 * t2 + t) * m0
-            + (3.0 * t2 - 2.0 * t3) * f1
-            + (t3 - t2) * m1;
-        let df = ((6.0 * t2 - 6.0 * t) * (f0 - f1)
-            + (3.0 * t2 - 4.0 * t + 1.0) * m0
-            + (3.0 * t2 - 2.0 * t) * m1)
-            * (1.0 / TABLE_STEP);
-        (f, df)
+        self.shape_table
+            .eval(s)
+            .unwrap_or_else(|| self.shape_exact(s))
     }
 
     /// The Magic-Formula shape f(s) = sin(C·atan(B·s·(1 − E) + E·atan(B·s))) and its
@@ -132,8 +125,10 @@ impl TyreModel {
         }
         let s = s2.sqrt();
         let (f, df) = self.shape(s);
-        let (fs, dfs2) = (f / s, df / s2);
-        let fs3 = fs / s2;
+        let inv_s = 1.0 / s;
+        let inv_s2 = inv_s * inv_s;
+        let (fs, dfs2) = (f * inv_s, df * inv_s2);
+        let fs3 = fs * inv_s2;
         Forces {
             fx: fmax * fs * sx,
             fy: fmax * fs * sy,
@@ -225,6 +220,12 @@ mod tests {
     #[test]
     fn load_sensitivity_is_one_at_the_operating_load() {
         let m = TyreModel::new(&Car::spirit_300().rear_tyre);
+        for i in 0..10_000 {
+            let fz = i as f64 * 3.7;
+            let exact = LOAD_FACTOR_MIN
+                + (LOAD_FACTOR_MAX - LOAD_FACTOR_MIN) * (m.load_k * fz / m.operating_load).exp();
+            assert!((m.load_factor(fz) - exact).abs() < 1e-11);
+        }
         assert!((m.load_factor(m.operating_load) - 1.0).abs() < 1e-12);
         assert!((m.load_factor(0.0) - LOAD_FACTOR_MAX).abs() < 1e-12);
         assert!(m.load_factor(2.0 * m.operating_load) < 1.0);

@@ -21,7 +21,7 @@
 //!   axle's slip exceeds half the tyre's peak slip; traction control eases the throttle
 //!   likewise (the Spirit 300 has both; TORCS robots implement them in the driver).
 
-use super::powertrain::{Gearbox, ShiftMap};
+use super::powertrain::{EngineMap, Gearbox, ShiftMap};
 use super::tyre::TyreModel;
 use crate::car::{Car, Drive};
 use crate::track::{Frame, Sample};
@@ -123,10 +123,21 @@ pub struct Vehicle {
     max_brake: [f64; 2],
     driven: [f64; 2],
     shift_map: ShiftMap,
+    engine_map: EngineMap,
     a: f64,
     b: f64,
-    yaw_inertia: f64,
+    inv_yaw_inertia: f64,
     rolling: f64,
+    /// m·g·b/L and m·g·a/L: the axles' static loads on level ground (N).
+    static_load: [f64; 2],
+    /// m·h/L: load moved from front to rear per m/s² of acceleration (kg).
+    transfer_per_accel: f64,
+    /// Slip at which ABS and traction control start easing, per axle.
+    aid_threshold: [f64; 2],
+    /// 0.645·Cx·A (kg/m).
+    drag_per_v2: f64,
+    /// 0.645·Clᵢ·A per axle (kg/m).
+    downforce_per_v2: [f64; 2],
 }
 
 impl Vehicle {
@@ -137,19 +148,30 @@ impl Vehicle {
             Drive::Front => [1.0, 0.0],
             Drive::All => [0.5, 0.5],
         };
+        let (a, b, l) = (car.cg_to_front(), car.cg_to_rear(), car.wheelbase);
+        let tyres = [
+            TyreModel::new(&car.front_tyre),
+            TyreModel::new(&car.rear_tyre),
+        ];
         Vehicle {
-            tyres: [
-                TyreModel::new(&car.front_tyre),
-                TyreModel::new(&car.rear_tyre),
+            aid_threshold: [
+                tyres[0].peak_slip * AID_SLIP_RATIO,
+                tyres[1].peak_slip * AID_SLIP_RATIO,
             ],
+            static_load: [car.mass * G * b / l, car.mass * G * a / l],
+            transfer_per_accel: car.mass * car.cg_height / l,
+            drag_per_v2: car.drag(1.0),
+            downforce_per_v2: car.downforce(1.0),
+            tyres,
             radius: [car.front_tyre.radius, car.rear_tyre.radius],
             wheel_inertia: [2.0 * car.front_tyre.inertia, 2.0 * car.rear_tyre.inertia],
             max_brake: [2.0 * car.brake_torque(true), 2.0 * car.brake_torque(false)],
             driven,
             shift_map: ShiftMap::new(car),
+            engine_map: EngineMap::new(car),
             a: car.cg_to_front(),
             b: car.cg_to_rear(),
-            yaw_inertia: car.yaw_inertia(),
+            inv_yaw_inertia: 1.0 / car.yaw_inertia(),
             rolling: 0.5 * (car.front_tyre.rolling_resistance + car.rear_tyre.rolling_resistance),
             car: car.clone(),
         }
@@ -187,14 +209,13 @@ impl Vehicle {
     pub fn step(&self, s: &mut State, c: &Controls, road: &Sample, frame: &Frame, dt: f64) {
         let car = &self.car;
         let m = car.mass;
-        let l = self.a + self.b;
-        let v = s.speed();
-        let down = car.downforce(v);
-        let weight = m * G * frame.cos_pitch * frame.cos_banking;
-        let transfer = m * s.ax * car.cg_height / l;
+        let v2 = s.vx * s.vx + s.vy * s.vy;
+        let down = [self.downforce_per_v2[0] * v2, self.downforce_per_v2[1] * v2];
+        let normal = frame.cos_pitch * frame.cos_banking;
+        let transfer = self.transfer_per_accel * s.ax;
         let fz = [
-            (weight * self.b / l - transfer + down[0]).max(0.0),
-            (weight * self.a / l + transfer + down[1]).max(0.0),
+            (self.static_load[0] * normal - transfer + down[0]).max(0.0),
+            (self.static_load[1] * normal + transfer + down[1]).max(0.0),
         ];
 
         // Wheel-frame velocities of the front (steered) and rear axles.
@@ -210,15 +231,17 @@ impl Vehicle {
         // slip, with the wheel spinning faster than the road, passes the aid threshold.
         let mut throttle = c.throttle();
         let k = if self.driven[1] > 0.0 { 1 } else { 0 };
-        let denom = vt[k].abs().max(SLIP_SPEED_FLOOR);
-        let spin = (s.omega[k] * self.radius[k] - vt[k]) / denom;
-        let combined = (spin * spin + (vl[k] / denom).powi(2)).sqrt();
-        let threshold = self.tyres[k].peak_slip * AID_SLIP_RATIO;
-        if spin > 0.0 && combined > threshold {
-            throttle *= (1.0 - (combined - threshold) / threshold).clamp(0.0, 1.0);
+        let inv_denom = 1.0 / vt[k].abs().max(SLIP_SPEED_FLOOR);
+        let spin = (s.omega[k] * self.radius[k] - vt[k]) * inv_denom;
+        let lateral = vl[k] * inv_denom;
+        let combined2 = spin * spin + lateral * lateral;
+        let threshold = self.aid_threshold[k];
+        if spin > 0.0 && combined2 > threshold * threshold {
+            throttle *= (2.0 - combined2.sqrt() / threshold).clamp(0.0, 1.0);
         }
         let (drive_torque, engine_speed) =
-            s.gearbox.wheel_torque(car, throttle, self.driven_omega(s));
+            s.gearbox
+                .wheel_torque(car, &self.engine_map, throttle, self.driven_omega(s));
         s.engine_speed = engine_speed;
         let engine_inertia = if s.gearbox.shifting > 0.0 {
             0.0
@@ -232,20 +255,19 @@ impl Vehicle {
         for k in 0..2 {
             let tyre = &self.tyres[k];
             let r = self.radius[k];
-            let denom = vt[k].abs().max(SLIP_SPEED_FLOOR);
+            let inv_denom = 1.0 / vt[k].abs().max(SLIP_SPEED_FLOOR);
             let fmax = tyre.max_force(fz[k], road.friction);
+            let sx = (s.omega[k] * r - vt[k]) * inv_denom;
+            let sy = -vl[k] * inv_denom;
             // ABS: ease the pressure while the wheel slides backwards past the threshold.
-            let lock = (vt[k] - s.omega[k] * r) / denom;
             let mut brake = c.brake() * self.max_brake[k];
-            let threshold = tyre.peak_slip * AID_SLIP_RATIO;
-            if lock > threshold {
-                brake *= (1.0 - (lock - threshold) / threshold).clamp(0.0, 1.0);
+            let threshold = self.aid_threshold[k];
+            if -sx > threshold {
+                brake *= (2.0 + sx / threshold).clamp(0.0, 1.0);
             }
-            let sx = (s.omega[k] * r - vt[k]) / denom;
-            let sy = -vl[k] / denom;
             let f = tyre.forces(sx, sy, fmax);
             // Implicit step of I·dω/dt = T − T_b·sgn ω − R·Fₓ(ω), with Fₓ linear in ω.
-            let dfx_domega = f.dfx_dsx * r / denom;
+            let dfx_domega = f.dfx_dsx * r * inv_denom;
             let inertia = self.wheel_inertia[k] + self.driven[k] * engine_inertia;
             let torque = self.driven[k] * drive_torque - r * f.fx;
             let free = torque - brake * s.omega[k].signum() * f64::from(s.omega[k] != 0.0);
@@ -256,7 +278,7 @@ impl Vehicle {
             {
                 new_omega = 0.0;
             }
-            let dsx = (new_omega - s.omega[k]) * r / denom;
+            let dsx = (new_omega - s.omega[k]) * r * inv_denom;
             s.omega[k] = new_omega;
             // Forces at the new spin, to first order, kept inside the grip budget.
             let (mut x, mut y) = (f.fx + f.dfx_dsx * dsx, f.fy + f.dfy_dsx * dsx);
@@ -272,7 +294,8 @@ impl Vehicle {
         // Body forces and moments.
         // Rolling resistance opposes motion; sgn vₓ is smoothed over ±0.5 m/s for standing starts.
         let roll = self.rolling * (fz[0] + fz[1]) * (s.vx / 0.5).clamp(-1.0, 1.0);
-        let drag = car.drag(v) * if v > 1e-9 { s.vx / v } else { 0.0 };
+        // Drag 0.645·Cx·A·v² along the velocity: its x component is 0.645·Cx·A·v·vₓ.
+        let drag = self.drag_per_v2 * v2.sqrt() * s.vx;
         let force_x = fx[0] * cos_d - fy[0] * sin_d + fx[1] - drag - roll - m * G * frame.sin_pitch;
         // cos(ψ − θ) of the car's yaw against the road's heading.
         let (sy, cy) = s.yaw_sin_cos;
@@ -280,10 +303,11 @@ impl Vehicle {
         let force_y = fx[0] * sin_d + fy[0] * cos_d + fy[1] - m * G * frame.sin_banking * along;
         let moment = self.a * (fx[0] * sin_d + fy[0] * cos_d) - self.b * fy[1];
 
-        let ax = force_x / m;
+        let inv_m = 1.0 / m;
+        let ax = force_x * inv_m;
         s.vx += dt * (ax + s.vy * s.yaw_rate);
-        s.vy += dt * (force_y / m - s.vx * s.yaw_rate);
-        s.yaw_rate += dt * moment / self.yaw_inertia;
+        s.vy += dt * (force_y * inv_m - s.vx * s.yaw_rate);
+        s.yaw_rate += dt * moment * self.inv_yaw_inertia;
         s.yaw += dt * s.yaw_rate;
         // Keep the yaw in (−π, π]: cheap trigonometry, and no drift of precision over laps.
         if s.yaw > std::f64::consts::PI {
