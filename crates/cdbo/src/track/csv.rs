@@ -11,7 +11,7 @@
 use std::path::Path;
 
 use super::spline::PeriodicSpline;
-use super::{Closure, Sample, TARGET_DS, Track};
+use super::{Closure, MAX_LENGTH_M, Sample, TARGET_DS, Track};
 use crate::error::{Error, Result};
 
 /// Width of the moving average applied to the curvature (m).
@@ -88,6 +88,19 @@ pub fn parse(text: &str, name: &str, file: &str) -> Result<Track> {
                 "a closed track needs at least 10 points, found {}",
                 rows.len()
             ),
+        ));
+    }
+    let perimeter: f64 = (0..rows.len())
+        .map(|i| {
+            let (p, q) = (rows[i], rows[(i + 1) % rows.len()]);
+            (p[0] - q[0]).hypot(p[1] - q[1])
+        })
+        .sum();
+    if perimeter > MAX_LENGTH_M {
+        return Err(Error::invalid(
+            file,
+            "rows",
+            format!("the track is {perimeter:.0} m long, more than {MAX_LENGTH_M} m"),
         ));
     }
     Ok(build(&rows, name, file))

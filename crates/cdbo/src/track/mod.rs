@@ -193,7 +193,7 @@ impl Track {
     #[inline]
     pub fn project(&self, x: f64, y: f64, hint: usize) -> Projection {
         let n = self.samples.len();
-        let mut i = hint % n;
+        let mut i = if hint < n { hint } else { hint % n };
         let half = 0.5 * self.ds;
         for _ in 0..n {
             let c = &self.samples[i];
@@ -313,6 +313,9 @@ impl Track {
         Track::new(name, source, length, closure, samples, warnings)
     }
 }
+
+/// Longest track accepted (m): longer files are refused rather than sampled.
+pub const MAX_LENGTH_M: f64 = 100_000.0;
 
 /// Target spacing of the samples (m).
 pub const TARGET_DS: f64 = 1.0;

@@ -14,7 +14,7 @@
 
 use std::path::Path;
 
-use super::{Piece, Track};
+use super::{MAX_LENGTH_M, Piece, Track};
 use crate::error::Result;
 use crate::params::{Params, Section};
 
@@ -59,6 +59,14 @@ pub fn from_params(params: &Params, source: &str) -> Result<Track> {
             &mut state,
             &mut pieces,
         )?;
+    }
+    let length: f64 = pieces.iter().map(|p| p.length).sum();
+    if length > MAX_LENGTH_M {
+        return Err(params.error(
+            &segments.path,
+            Some(segments.line),
+            format!("the track is {length:.0} m long, more than {MAX_LENGTH_M} m"),
+        ));
     }
     let name = params
         .section("Header")
