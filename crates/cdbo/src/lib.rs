@@ -13,6 +13,7 @@ pub mod car;
 pub mod data_path;
 pub mod drive;
 pub mod error;
+pub mod gp;
 pub mod limit;
 pub mod params;
 pub mod policy;

@@ -1,0 +1,490 @@
+//! Gaussian-process regression of the reward over policy weights (paper eq. 3–7).
+//!
+//! With K = k(W, W) + (σ_n² + jitter)·I = LLᵀ and α = K⁻¹(z − m):
+//! μ(w*) = m + k(w*, W)·α and σ²(w*) = k(w*, w*) − vᵀv with v = L⁻¹k(W, w*).
+//! Observations are added in O(n²) by extending L with one row (no refactorisation); the
+//! jitter is the smallest of 0, 1e-10, 1e-9, … that keeps L finite, raised only when needed
+//! and reported by [`GaussianProcess::jitter`].
+
+pub mod kernel;
+pub mod likelihood;
+
+use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
+use faer::{Mat, MatMut, Par, Side};
+use serde::{Deserialize, Serialize};
+
+pub use kernel::{Kernel, scaled_sq_dist};
+
+use crate::error::{Error, Result};
+
+/// The prior mean.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Mean {
+    /// m = 0 (the paper).
+    Zero,
+    /// m = the average of the observed values.
+    Constant,
+}
+
+/// Hyperparameters: kernel shape, length-scales, signal and noise variance.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Hyper {
+    /// Kernel shape.
+    pub kernel: Kernel,
+    /// Length-scales: one (isotropic) or one per dimension (ARD).
+    pub lengthscales: Vec<f64>,
+    /// Signal variance σ_f².
+    pub signal_var: f64,
+    /// Observation noise variance σ_n² (the paper: 0, the simulator is deterministic).
+    pub noise_var: f64,
+    /// Prior mean.
+    pub mean: Mean,
+}
+
+impl Hyper {
+    /// 1/l_d² for each length-scale.
+    pub fn inv_l2(&self) -> Vec<f64> {
+        self.lengthscales.iter().map(|l| 1.0 / (l * l)).collect()
+    }
+}
+
+/// Jitter levels tried in turn when the factor would not be positive definite.
+const JITTERS: [f64; 8] = [0.0, 1e-10, 1e-9, 1e-8, 1e-7, 1e-6, 1e-5, 1e-4];
+
+/// A GP with its Cholesky factor kept up to date.
+#[derive(Debug, Clone)]
+pub struct GaussianProcess {
+    dim: usize,
+    hyper: Hyper,
+    inv_l2: Vec<f64>,
+    /// Inputs, row-major n × dim.
+    x: Vec<f64>,
+    y: Vec<f64>,
+    mean: f64,
+    /// Lower Cholesky factor of K.
+    chol: Mat<f64>,
+    alpha: Vec<f64>,
+    jitter: f64,
+}
+
+impl GaussianProcess {
+    /// An empty GP over `dim`-dimensional inputs.
+    pub fn new(dim: usize, hyper: Hyper) -> Result<GaussianProcess> {
+        check_hyper(dim, &hyper)?;
+        Ok(GaussianProcess {
+            dim,
+            inv_l2: hyper.inv_l2(),
+            hyper,
+            x: Vec::new(),
+            y: Vec::new(),
+            mean: 0.0,
+            chol: Mat::zeros(0, 0),
+            alpha: Vec::new(),
+            jitter: 0.0,
+        })
+    }
+
+    /// Input dimension.
+    pub fn dim(&self) -> usize {
+        self.dim
+    }
+
+    /// Number of observations.
+    pub fn len(&self) -> usize {
+        self.y.len()
+    }
+
+    /// Whether there are no observations.
+    pub fn is_empty(&self) -> bool {
+        self.y.is_empty()
+    }
+
+    /// The hyperparameters.
+    pub fn hyper(&self) -> &Hyper {
+        &self.hyper
+    }
+
+    /// 1/l_d² of the current length-scales.
+    pub fn inv_l2(&self) -> &[f64] {
+        &self.inv_l2
+    }
+
+    /// The jitter added to the diagonal (0 unless needed for a finite factor).
+    pub fn jitter(&self) -> f64 {
+        self.jitter
+    }
+
+    /// The prior mean in use.
+    pub fn mean(&self) -> f64 {
+        self.mean
+    }
+
+    /// The i-th input.
+    pub fn input(&self, i: usize) -> &[f64] {
+        &self.x[i * self.dim..(i + 1) * self.dim]
+    }
+
+    /// All inputs, row-major.
+    pub fn inputs(&self) -> &[f64] {
+        &self.x
+    }
+
+    /// The observed values.
+    pub fn values(&self) -> &[f64] {
+        &self.y
+    }
+
+    /// α = K⁻¹(z − m).
+    pub fn alpha(&self) -> &[f64] {
+        &self.alpha
+    }
+
+    /// The lower Cholesky factor L of K.
+    pub fn cholesky(&self) -> faer::MatRef<'_, f64> {
+        self.chol.as_ref()
+    }
+
+    /// k(a, b) = σ_f²·κ(r²).
+    #[inline]
+    pub fn k(&self, a: &[f64], b: &[f64]) -> f64 {
+        self.hyper.signal_var * self.hyper.kernel.of_r2(scaled_sq_dist(a, b, &self.inv_l2))
+    }
+
+    /// Adds one observation in O(n²): L gains the row [lᵀ, d] with Ll = k(W, w) and
+    /// d = √(k(w, w) + σ_n² + jitter − lᵀl).
+    pub fn add(&mut self, w: &[f64], z: f64) -> Result<()> {
+        self.check_point(w)?;
+        if !z.is_finite() {
+            return Err(Error::Domain(format!(
+                "observation value {z} is not finite"
+            )));
+        }
+        let n = self.len();
+        let mut l = Mat::from_fn(n, 1, |i, _| self.k(self.input(i), w));
+        if n > 0 {
+            solve_lower_triangular_in_place(self.chol.as_ref(), l.as_mut(), Par::Seq);
+        }
+        let ll: f64 = (0..n).map(|i| l[(i, 0)] * l[(i, 0)]).sum();
+        let d2 = self.hyper.signal_var + self.hyper.noise_var + self.jitter - ll;
+        self.x.extend_from_slice(w);
+        self.y.push(z);
+        if d2 > 1e-12 * self.hyper.signal_var && d2.is_finite() {
+            let mut chol = Mat::zeros(n + 1, n + 1);
+            chol.as_mut()
+                .submatrix_mut(0, 0, n, n)
+                .copy_from(self.chol.as_ref());
+            for j in 0..n {
+                chol[(n, j)] = l[(j, 0)];
+            }
+            chol[(n, n)] = d2.sqrt();
+            self.chol = chol;
+            self.update_alpha();
+            Ok(())
+        } else {
+            // The new point nearly duplicates an old one: refactor with more jitter.
+            self.refactor().or_else(|e| {
+                self.x.truncate(n * self.dim);
+                self.y.pop();
+                self.refactor()?;
+                Err(e)
+            })
+        }
+    }
+
+    /// Replaces the hyperparameters and refactors (O(n³)).
+    pub fn set_hyper(&mut self, hyper: Hyper) -> Result<()> {
+        check_hyper(self.dim, &hyper)?;
+        self.inv_l2 = hyper.inv_l2();
+        self.hyper = hyper;
+        self.jitter = 0.0;
+        self.refactor()
+    }
+
+    /// The covariance matrix of the observations, without noise or jitter.
+    pub fn gram(&self) -> Mat<f64> {
+        let n = self.len();
+        let mut k = Mat::zeros(n, n);
+        for i in 0..n {
+            for j in 0..=i {
+                let v = self.k(self.input(i), self.input(j));
+                k[(i, j)] = v;
+                k[(j, i)] = v;
+            }
+        }
+        k
+    }
+
+    /// Factors K from scratch, raising the jitter until it succeeds.
+    fn refactor(&mut self) -> Result<()> {
+        let n = self.len();
+        let gram = self.gram();
+        let start = JITTERS
+            .iter()
+            .position(|&j| j >= self.jitter)
+            .unwrap_or(JITTERS.len() - 1);
+        for &jitter in &JITTERS[start..] {
+            let add = self.hyper.noise_var + jitter * self.hyper.signal_var;
+            let k = Mat::from_fn(n, n, |i, j| gram[(i, j)] + if i == j { add } else { 0.0 });
+            if let Ok(llt) = k.llt(Side::Lower) {
+                let l = llt.L().to_owned();
+                if (0..n).all(|i| l[(i, i)].is_finite() && l[(i, i)] > 0.0) {
+                    self.chol = l;
+                    self.jitter = jitter * self.hyper.signal_var;
+                    self.update_alpha();
+                    return Ok(());
+                }
+            }
+        }
+        Err(Error::Domain(format!(
+            "the GP covariance of {n} points is not positive definite even with jitter 1e-4·σ_f²"
+        )))
+    }
+
+    fn update_alpha(&mut self) {
+        let n = self.len();
+        self.mean = match self.hyper.mean {
+            Mean::Zero => 0.0,
+            Mean::Constant => self.y.iter().sum::<f64>() / n.max(1) as f64,
+        };
+        let mut a = Mat::from_fn(n, 1, |i, _| self.y[i] - self.mean);
+        solve_lower_triangular_in_place(self.chol.as_ref(), a.as_mut(), Par::Seq);
+        faer::linalg::triangular_solve::solve_upper_triangular_in_place(
+            self.chol.as_ref().transpose(),
+            a.as_mut(),
+            Par::Seq,
+        );
+        self.alpha = (0..n).map(|i| a[(i, 0)]).collect();
+    }
+
+    /// Posterior mean and variance at one point.
+    pub fn predict(&self, w: &[f64]) -> (f64, f64) {
+        let mut kv = Mat::from_fn(self.len(), 1, |i, _| self.k(self.input(i), w));
+        self.predict_from_k(kv.as_mut())[0]
+    }
+
+    /// Posterior mean and variance at many points (row-major, `dim` columns each).
+    pub fn predict_batch(&self, points: &[f64]) -> Vec<(f64, f64)> {
+        let b = points.len() / self.dim;
+        let mut kv = Mat::from_fn(self.len(), b, |i, j| {
+            self.k(self.input(i), &points[j * self.dim..(j + 1) * self.dim])
+        });
+        self.predict_from_k(kv.as_mut())
+    }
+
+    /// Posterior mean and variance from the cross-covariance columns k(W, w*) (overwritten).
+    pub fn predict_from_k(&self, mut kv: MatMut<'_, f64>) -> Vec<(f64, f64)> {
+        let (n, b) = (kv.nrows(), kv.ncols());
+        let means: Vec<f64> = (0..b)
+            .map(|j| self.mean + (0..n).map(|i| kv[(i, j)] * self.alpha[i]).sum::<f64>())
+            .collect();
+        if n > 0 {
+            solve_lower_triangular_in_place(self.chol.as_ref(), kv.as_mut(), Par::Seq);
+        }
+        (0..b)
+            .map(|j| {
+                let vv: f64 = (0..n).map(|i| kv[(i, j)] * kv[(i, j)]).sum();
+                (means[j], (self.hyper.signal_var - vv).max(0.0))
+            })
+            .collect()
+    }
+
+    fn check_point(&self, w: &[f64]) -> Result<()> {
+        if w.len() != self.dim {
+            return Err(Error::Domain(format!(
+                "expected {} weights, got {}",
+                self.dim,
+                w.len()
+            )));
+        }
+        if let Some(i) = w.iter().position(|v| !v.is_finite()) {
+            return Err(Error::Domain(format!("weight {i} is {}", w[i])));
+        }
+        Ok(())
+    }
+}
+
+fn check_hyper(dim: usize, h: &Hyper) -> Result<()> {
+    if dim == 0 {
+        return Err(Error::Domain(
+            "a GP needs at least one input dimension".into(),
+        ));
+    }
+    if h.lengthscales.len() != 1 && h.lengthscales.len() != dim {
+        return Err(Error::Domain(format!(
+            "{} length-scales for {dim} dimensions (give 1 or {dim})",
+            h.lengthscales.len()
+        )));
+    }
+    if h.lengthscales.iter().any(|l| !(l.is_finite() && *l > 0.0))
+        || !(h.signal_var.is_finite() && h.signal_var > 0.0)
+        || !(h.noise_var.is_finite() && h.noise_var >= 0.0)
+    {
+        return Err(Error::Domain(format!(
+            "hyperparameters must be positive and finite: {h:?}"
+        )));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+
+    fn random_gp(
+        n: usize,
+        dim: usize,
+        kernel: Kernel,
+        ard: bool,
+        seed: u64,
+    ) -> (GaussianProcess, rand_chacha::ChaCha8Rng) {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let lengthscales = if ard {
+            (0..dim).map(|_| rng.random_range(0.5..2.0)).collect()
+        } else {
+            vec![1.3]
+        };
+        let hyper = Hyper {
+            kernel,
+            lengthscales,
+            signal_var: 2.0,
+            noise_var: 0.01,
+            mean: Mean::Constant,
+        };
+        let mut gp = GaussianProcess::new(dim, hyper).unwrap();
+        for _ in 0..n {
+            let w: Vec<f64> = (0..dim).map(|_| rng.random_range(-2.0..2.0)).collect();
+            let z = w.iter().map(|v| v.sin()).sum::<f64>() + 5.0;
+            gp.add(&w, z).unwrap();
+        }
+        (gp, rng)
+    }
+
+    /// Naive O(n³) reference: explicit inverse of K by Gauss–Jordan elimination.
+    fn naive_predict(gp: &GaussianProcess, w: &[f64]) -> (f64, f64) {
+        let n = gp.len();
+        let mut k = gp.gram();
+        for i in 0..n {
+            k[(i, i)] += gp.hyper().noise_var + gp.jitter();
+        }
+        let mut inv = Mat::<f64>::identity(n, n);
+        for c in 0..n {
+            let p = (c..n)
+                .max_by(|&a, &b| k[(a, c)].abs().total_cmp(&k[(b, c)].abs()))
+                .unwrap();
+            for j in 0..n {
+                let (t, u) = (k[(c, j)], inv[(c, j)]);
+                k[(c, j)] = k[(p, j)];
+                k[(p, j)] = t;
+                inv[(c, j)] = inv[(p, j)];
+                inv[(p, j)] = u;
+            }
+            let d = k[(c, c)];
+            for j in 0..n {
+                k[(c, j)] /= d;
+                inv[(c, j)] /= d;
+            }
+            for r in 0..n {
+                if r != c {
+                    let f = k[(r, c)];
+                    for j in 0..n {
+                        k[(r, j)] -= f * k[(c, j)];
+                        inv[(r, j)] -= f * inv[(c, j)];
+                    }
+                }
+            }
+        }
+        let ks: Vec<f64> = (0..n).map(|i| gp.k(gp.input(i), w)).collect();
+        let m = gp.mean();
+        let mu = m
+            + (0..n)
+                .map(|i| {
+                    (0..n)
+                        .map(|j| ks[i] * inv[(i, j)] * (gp.values()[j] - m))
+                        .sum::<f64>()
+                })
+                .sum::<f64>();
+        let var = gp.hyper().signal_var
+            - (0..n)
+                .map(|i| (0..n).map(|j| ks[i] * inv[(i, j)] * ks[j]).sum::<f64>())
+                .sum::<f64>();
+        (mu, var)
+    }
+
+    #[test]
+    fn predictions_equal_the_naive_reference() {
+        for (kernel, ard) in [
+            (Kernel::Exponential, true),
+            (Kernel::Matern52, false),
+            (Kernel::SquaredExponential, true),
+        ] {
+            let (gp, mut rng) = random_gp(40, 5, kernel, ard, 7);
+            for _ in 0..10 {
+                let w: Vec<f64> = (0..5).map(|_| rng.random_range(-2.0..2.0)).collect();
+                let (mu, var) = gp.predict(&w);
+                let (rm, rv) = naive_predict(&gp, &w);
+                assert!(
+                    (mu - rm).abs() <= 1e-9 * rm.abs().max(1.0),
+                    "{kernel:?} mean {mu} vs {rm}"
+                );
+                assert!(
+                    (var - rv).abs() <= 1e-9 * gp.hyper().signal_var,
+                    "{kernel:?} var {var} vs {rv}"
+                );
+            }
+            let batch: Vec<f64> = (0..15).map(|i| i as f64 * 0.1 - 0.7).collect();
+            let b = gp.predict_batch(&batch);
+            for j in 0..3 {
+                let one = gp.predict(&batch[j * 5..(j + 1) * 5]);
+                assert!((b[j].0 - one.0).abs() < 1e-12 && (b[j].1 - one.1).abs() < 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn the_grown_factor_equals_a_fresh_one() {
+        let (mut gp, _) = random_gp(60, 4, Kernel::Exponential, true, 3);
+        let grown = gp.cholesky().to_owned();
+        gp.set_hyper(gp.hyper().clone()).unwrap();
+        let fresh = gp.cholesky();
+        for i in 0..60 {
+            for j in 0..=i {
+                assert!((grown[(i, j)] - fresh[(i, j)]).abs() < 1e-10, "L[{i},{j}]");
+            }
+        }
+    }
+
+    #[test]
+    fn noiseless_duplicates_get_jitter_and_interpolation_holds() {
+        let hyper = Hyper {
+            kernel: Kernel::Exponential,
+            lengthscales: vec![1.0],
+            signal_var: 1.0,
+            noise_var: 0.0,
+            mean: Mean::Zero,
+        };
+        let mut gp = GaussianProcess::new(2, hyper).unwrap();
+        gp.add(&[0.0, 0.0], 1.0).unwrap();
+        gp.add(&[1.0, 0.5], 2.0).unwrap();
+        let (mu, var) = gp.predict(&[1.0, 0.5]);
+        assert!(
+            (mu - 2.0).abs() < 1e-9 && var < 1e-9,
+            "noise-free interpolation: {mu} {var}"
+        );
+        assert_eq!(gp.jitter(), 0.0);
+        gp.add(&[1.0, 0.5], 2.0).unwrap();
+        assert!(gp.jitter() > 0.0 && gp.jitter() <= 1e-4);
+    }
+
+    #[test]
+    fn bad_input_is_refused_and_changes_nothing() {
+        let (mut gp, _) = random_gp(5, 3, Kernel::Matern32, false, 1);
+        let before = gp.alpha().to_vec();
+        assert!(gp.add(&[0.0, 1.0], 1.0).is_err());
+        assert!(gp.add(&[0.0, 1.0, f64::NAN], 1.0).is_err());
+        assert!(gp.add(&[0.0, 1.0, 2.0], f64::INFINITY).is_err());
+        assert_eq!(gp.len(), 5);
+        assert_eq!(gp.alpha(), &before[..]);
+    }
+}

@@ -1,0 +1,227 @@
+//! The paper's policy (eq. 2–7): π_w(x) = clamp(wᵀφ(x), −1, 1), with φᵢ(x) = k(x, x̂ᵢ) a
+//! Matérn-3/2 kernel, k(x, x′) = (1 + √3|x − x′|/l)·exp(−√3|x − x′|/l), at M regularly spaced
+//! inducing points x̂ᵢ = i/(M − 1) on [0, 1].
+//!
+//! The initial weights fit a demonstration's (xⱼ, aⱼ) by ridge regression (eq. 8–9):
+//! w₀ = [ΦᵀΦ + λI]⁻¹Φᵀa, Φⱼᵢ = φᵢ(xⱼ).
+
+use faer::linalg::solvers::Solve;
+use faer::{Mat, Side};
+use serde::{Deserialize, Serialize};
+
+use crate::drive::{Observation, Pedal};
+use crate::error::{Error, Result};
+
+/// Default ridge factor λ.
+pub const DEFAULT_RIDGE: f64 = 1e-3;
+
+/// A policy in the RKHS of the Matérn-3/2 kernel.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RkhsPolicy {
+    /// Kernel length-scale l on the lap fraction x.
+    pub lengthscale: f64,
+    /// Weights w, one per inducing point.
+    pub weights: Vec<f64>,
+}
+
+/// The paper's default length-scale: the spacing of the inducing points, 1/(M − 1).
+pub fn default_lengthscale(kernels: usize) -> f64 {
+    1.0 / (kernels.max(2) - 1) as f64
+}
+
+impl RkhsPolicy {
+    /// A policy with given weights (M = weights.len() ≥ 2) and length-scale.
+    pub fn new(weights: Vec<f64>, lengthscale: f64) -> Result<RkhsPolicy> {
+        check_shape(weights.len(), lengthscale)?;
+        if let Some(i) = weights.iter().position(|w| !w.is_finite()) {
+            return Err(Error::Domain(format!(
+                "policy weight {i} is {}",
+                weights[i]
+            )));
+        }
+        Ok(RkhsPolicy {
+            lengthscale,
+            weights,
+        })
+    }
+
+    /// Fits w₀ to a demonstration by ridge regression (paper eq. 9).
+    pub fn fit(
+        demo: &[(f64, f64)],
+        kernels: usize,
+        lengthscale: f64,
+        ridge: f64,
+    ) -> Result<RkhsPolicy> {
+        check_shape(kernels, lengthscale)?;
+        if demo.is_empty() {
+            return Err(Error::Domain(
+                "the demonstration is empty: record at least one (x, a) pair".into(),
+            ));
+        }
+        if let Some((x, a)) = demo.iter().find(|(x, a)| !x.is_finite() || !a.is_finite()) {
+            return Err(Error::Domain(format!(
+                "demonstration pair (x {x}, a {a}) is not finite"
+            )));
+        }
+        if !(ridge.is_finite() && ridge > 0.0) {
+            return Err(Error::Domain(format!(
+                "the ridge factor must be positive, got {ridge}"
+            )));
+        }
+        let mut phi = vec![0.0; kernels];
+        let mut gram = Mat::<f64>::zeros(kernels, kernels);
+        let mut rhs = Mat::<f64>::zeros(kernels, 1);
+        for &(x, a) in demo {
+            features_into(x, lengthscale, &mut phi);
+            for i in 0..kernels {
+                rhs[(i, 0)] += phi[i] * a;
+                for j in 0..=i {
+                    gram[(i, j)] += phi[i] * phi[j];
+                }
+            }
+        }
+        for i in 0..kernels {
+            gram[(i, i)] += ridge;
+            for j in 0..i {
+                gram[(j, i)] = gram[(i, j)];
+            }
+        }
+        let llt = gram
+            .llt(Side::Lower)
+            .map_err(|e| Error::Domain(format!("ridge system is singular: {e:?}")))?;
+        let w = llt.solve(&rhs);
+        RkhsPolicy::new((0..kernels).map(|i| w[(i, 0)]).collect(), lengthscale)
+    }
+
+    /// Number of kernels M.
+    pub fn kernels(&self) -> usize {
+        self.weights.len()
+    }
+
+    /// wᵀφ(x), before clamping.
+    pub fn raw(&self, x: f64) -> f64 {
+        let m = self.weights.len();
+        let h = 1.0 / (m - 1) as f64;
+        // Only kernels within ~12 length-scales matter (φ < 1e-7 beyond).
+        let reach = (12.0 * self.lengthscale / h).ceil() as isize + 1;
+        let centre = (x / h).round() as isize;
+        let lo = (centre - reach).max(0) as usize;
+        let hi = ((centre + reach).max(0) as usize).min(m - 1);
+        (lo..=hi)
+            .map(|i| self.weights[i] * matern32((x - i as f64 * h).abs() / self.lengthscale))
+            .sum()
+    }
+
+    /// π(x) = clamp(wᵀφ(x), −1, 1).
+    pub fn action(&self, x: f64) -> f64 {
+        self.raw(x).clamp(-1.0, 1.0)
+    }
+
+    /// The (x, a) table at `points` evenly spaced x in [0, 1].
+    pub fn table(&self, points: usize) -> Vec<(f64, f64)> {
+        let n = points.max(2);
+        (0..n)
+            .map(|i| i as f64 / (n - 1) as f64)
+            .map(|x| (x, self.action(x)))
+            .collect()
+    }
+}
+
+impl Pedal for RkhsPolicy {
+    fn pedal(&mut self, obs: &Observation) -> f64 {
+        self.action(obs.x)
+    }
+}
+
+/// The Matérn-3/2 shape (1 + √3 u)·e^(−√3 u) of u = |x − x′|/l.
+fn matern32(u: f64) -> f64 {
+    let a = 1.732_050_807_568_877_2 * u;
+    (1.0 + a) * (-a).exp()
+}
+
+/// φ(x) into `out` (length M).
+pub fn features_into(x: f64, lengthscale: f64, out: &mut [f64]) {
+    let m = out.len();
+    for (i, o) in out.iter_mut().enumerate() {
+        *o = matern32((x - i as f64 / (m - 1) as f64).abs() / lengthscale);
+    }
+}
+
+fn check_shape(kernels: usize, lengthscale: f64) -> Result<()> {
+    if kernels < 2 {
+        return Err(Error::Domain(format!(
+            "a policy needs at least 2 kernels, got {kernels}"
+        )));
+    }
+    if !(lengthscale.is_finite() && lengthscale > 0.0) {
+        return Err(Error::Domain(format!(
+            "the policy length-scale must be positive, got {lengthscale}"
+        )));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn features_peak_at_their_inducing_points() {
+        let mut phi = vec![0.0; 11];
+        features_into(0.3, 0.1, &mut phi);
+        assert!((phi[3] - 1.0).abs() < 1e-15);
+        assert!(phi[2] < 1.0 && (phi[2] - phi[4]).abs() < 1e-12);
+    }
+
+    #[test]
+    fn ridge_fit_solves_the_normal_equations() {
+        let demo: Vec<(f64, f64)> = (0..500)
+            .map(|i| i as f64 / 499.0)
+            .map(|x| (x, (6.0 * x).sin() * 0.8))
+            .collect();
+        let (m, l, lambda) = (12, default_lengthscale(12), 1e-3);
+        let p = RkhsPolicy::fit(&demo, m, l, lambda).unwrap();
+        // Gradient of ‖a − Φw‖² + λ‖w‖² vanishes: Φᵀ(Φw − a) + λw = 0.
+        let mut grad = vec![0.0; m];
+        let mut phi = vec![0.0; m];
+        for &(x, a) in &demo {
+            features_into(x, l, &mut phi);
+            let r: f64 = phi.iter().zip(&p.weights).map(|(f, w)| f * w).sum::<f64>() - a;
+            for i in 0..m {
+                grad[i] += phi[i] * r;
+            }
+        }
+        for i in 0..m {
+            assert!(
+                (grad[i] + lambda * p.weights[i]).abs() < 1e-8,
+                "{i}: {}",
+                grad[i] + lambda * p.weights[i]
+            );
+        }
+        // And it fits: a smooth demonstration is reproduced closely.
+        for &(x, a) in demo.iter().step_by(37) {
+            assert!(
+                (p.action(x) - a).abs() < 0.05,
+                "x {x}: {} vs {a}",
+                p.action(x)
+            );
+        }
+        // The truncated sum equals the full one.
+        let mut full = |x: f64| {
+            features_into(x, l, &mut phi);
+            phi.iter().zip(&p.weights).map(|(f, w)| f * w).sum::<f64>()
+        };
+        for x in [0.0, 0.123, 0.5, 0.999, 1.0] {
+            assert!((p.raw(x) - full(x)).abs() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn bad_input_is_refused() {
+        assert!(RkhsPolicy::fit(&[], 10, 0.1, 1e-3).is_err());
+        assert!(RkhsPolicy::fit(&[(0.5, 0.1)], 1, 0.1, 1e-3).is_err());
+        assert!(RkhsPolicy::fit(&[(f64::NAN, 0.1)], 10, 0.1, 1e-3).is_err());
+        assert!(RkhsPolicy::fit(&[(0.5, 0.1)], 10, -1.0, 1e-3).is_err());
+        assert!(RkhsPolicy::new(vec![0.0, f64::INFINITY], 0.5).is_err());
+    }
+}
