@@ -9,12 +9,15 @@
 //! - [`drive`]: the environment's controllers (steering, demonstrator).
 //! - [`limit`]: the quasi-steady-state minimum lap time.
 
+pub mod acquisition;
+pub mod benchmarks;
 pub mod car;
 pub mod data_path;
 pub mod drive;
 pub mod error;
 pub mod gp;
 pub mod limit;
+pub mod optimizers;
 pub mod params;
 pub mod policy;
 pub mod sim;

@@ -1,0 +1,333 @@
+//! Coordinate Descent Bayesian Optimisation (paper Alg. 2).
+//!
+//! 1. Drive w₀, then S laps with w ~ N(w₀, σ₀²I) clamped to the search box.
+//! 2. Then, each lap: fit the GP's hyperparameters by maximum likelihood when due, choose
+//!    w = argmax h by stochastic coordinate ascent from the best weights so far
+//!    ([`super::coordinate_ascent`]), drive it, add (w, R) to the GP.
+//!
+//! The length-scales' upper bound adapts as in REMBO (Wang et al. 2016), applied by the paper
+//! to every BO method: when the chosen point's posterior standard deviation falls below
+//! [`LOW_UNCERTAINTY`]·σ_f, the upper bound is halved (never below twice the lower bound), so
+//! that the next fit must explain the data with shorter length-scales and the acquisition
+//! finds uncertainty again.
+
+use rand_distr::{Distribution, Normal};
+use serde::{Deserialize, Serialize};
+
+use super::coordinate_ascent::{AxisSearch, GpAcquisition, maximise};
+use super::{Optimizer, SearchBox, check_tell, rng_for};
+use crate::acquisition::Acquisition;
+use crate::acquisition::ucb::DEFAULT_BETA;
+use crate::error::{Error, Result};
+use crate::gp::likelihood::{Bounds, fit};
+use crate::gp::{GaussianProcess, Hyper, Kernel, Mean};
+
+/// σ(w_next) below this fraction of σ_f shrinks the length-scale upper bound.
+pub const LOW_UNCERTAINTY: f64 = 0.05;
+
+/// Settings of a CDBO run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CdboConfig {
+    /// Seed of every random choice.
+    pub seed: u64,
+    /// Acquisition (UCB with β = 1 by default).
+    pub acquisition: Acquisition,
+    /// Initial random laps S (the paper: 10).
+    pub initial_samples: usize,
+    /// Standard deviation σ₀ of the initial samples around w₀.
+    pub initial_sigma: f64,
+    /// Half-width of the search box around w₀.
+    pub box_radius: f64,
+    /// Kernel of the reward GP (the paper: exponential, ARD).
+    pub kernel: Kernel,
+    /// One length-scale per weight (ARD) or one for all.
+    pub ard: bool,
+    /// Prior mean (the paper: zero).
+    pub mean: Mean,
+    /// Observation noise variance (the paper: 0).
+    pub noise_var: f64,
+    /// Re-fit the hyperparameters every this many observations (0: never after the first).
+    pub refit_every: usize,
+    /// Adam iterations per fit.
+    pub fit_iterations: usize,
+    /// Coordinate-ascent settings.
+    pub search: AxisSearch,
+}
+
+impl Default for CdboConfig {
+    fn default() -> Self {
+        CdboConfig {
+            seed: 0,
+            acquisition: Acquisition::Ucb { beta: DEFAULT_BETA },
+            initial_samples: 10,
+            initial_sigma: 0.1,
+            box_radius: super::DEFAULT_BOX_RADIUS,
+            kernel: Kernel::Exponential,
+            ard: true,
+            mean: Mean::Zero,
+            noise_var: 0.0,
+            refit_every: 10,
+            fit_iterations: 30,
+            search: AxisSearch::default(),
+        }
+    }
+}
+
+/// Everything needed to resume a run: settings, w₀ and what was told.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CdboState {
+    /// Settings.
+    pub config: CdboConfig,
+    /// The demonstration's weights.
+    pub w0: Vec<f64>,
+    /// Told (weights, reward), in order.
+    pub observations: Vec<(Vec<f64>, f64)>,
+    /// Current hyperparameters.
+    pub hyper: Hyper,
+    /// Current upper bound of the length-scales.
+    pub lengthscale_max: f64,
+    /// The length-scale upper bound in force when each told point was suggested, so that a
+    /// resumed run replays the same hyperparameter fits bit for bit.
+    pub bounds_used: Vec<f64>,
+}
+
+/// The CDBO optimiser.
+#[derive(Debug, Clone)]
+pub struct Cdbo {
+    state: CdboState,
+    bounds: SearchBox,
+    gp: GaussianProcess,
+    best: Option<(Vec<f64>, f64)>,
+    /// The pending suggestion and the length-scale bound it was made under.
+    pending: Option<(Vec<f64>, f64)>,
+    last_fit_at: usize,
+    /// Acquisition evaluations of the last suggestion.
+    pub last_af_evaluations: usize,
+    /// Seconds spent fitting hyperparameters, in total.
+    pub fit_seconds: f64,
+}
+
+/// The hyperparameters a run starts from: length-scales half the box width, σ_f² = 1.
+fn initial_hyper(config: &CdboConfig, dim: usize) -> Hyper {
+    Hyper {
+        kernel: config.kernel,
+        lengthscales: vec![config.box_radius; if config.ard { dim } else { 1 }],
+        signal_var: 1.0,
+        noise_var: config.noise_var,
+        mean: config.mean,
+    }
+}
+
+/// Smallest length-scale searched, relative to the box width.
+const LENGTHSCALE_MIN_FRACTION: f64 = 0.01;
+/// Largest length-scale searched at the start, relative to the box width.
+const LENGTHSCALE_MAX_FRACTION: f64 = 10.0;
+
+impl Cdbo {
+    /// A new run from the demonstration's weights.
+    pub fn new(w0: Vec<f64>, config: CdboConfig) -> Result<Cdbo> {
+        if w0.is_empty() {
+            return Err(Error::Domain("CDBO needs at least one weight".into()));
+        }
+        if let Some(i) = w0.iter().position(|w| !w.is_finite()) {
+            return Err(Error::Domain(format!("initial weight {i} is {}", w0[i])));
+        }
+        if !(config.initial_sigma.is_finite() && config.initial_sigma >= 0.0) {
+            return Err(Error::Domain(format!(
+                "σ₀ must be non-negative, got {}",
+                config.initial_sigma
+            )));
+        }
+        let hyper = initial_hyper(&config, w0.len());
+        let lengthscale_max = LENGTHSCALE_MAX_FRACTION * 2.0 * config.box_radius;
+        let state = CdboState {
+            w0,
+            observations: Vec::new(),
+            hyper,
+            lengthscale_max,
+            bounds_used: Vec::new(),
+            config,
+        };
+        Cdbo::resume(state)
+    }
+
+    /// Rebuilds a run from its state by replaying its observations and hyperparameter fits,
+    /// so that it continues exactly as the uninterrupted run would.
+    pub fn resume(saved: CdboState) -> Result<Cdbo> {
+        if saved.bounds_used.len() != saved.observations.len() {
+            return Err(Error::Domain(format!(
+                "corrupt CDBO state: {} observations but {} recorded bounds",
+                saved.observations.len(),
+                saved.bounds_used.len()
+            )));
+        }
+        let dim = saved.w0.len();
+        let mut state = CdboState {
+            observations: Vec::new(),
+            bounds_used: Vec::new(),
+            hyper: initial_hyper(&saved.config, dim),
+            ..saved.clone()
+        };
+        state.lengthscale_max = LENGTHSCALE_MAX_FRACTION * 2.0 * saved.config.box_radius;
+        let bounds = SearchBox::around(&state.w0, state.config.box_radius)?;
+        let gp = GaussianProcess::new(dim, state.hyper.clone())?;
+        let mut run = Cdbo {
+            state,
+            bounds,
+            gp,
+            best: None,
+            pending: None,
+            last_fit_at: 0,
+            last_af_evaluations: 0,
+            fit_seconds: 0.0,
+        };
+        for ((w, r), bound) in saved.observations.iter().zip(&saved.bounds_used) {
+            run.state.lengthscale_max = *bound;
+            if run.gp.len() > run.state.config.initial_samples {
+                run.maybe_refit()?;
+            }
+            run.pending = Some((w.clone(), *bound));
+            run.tell(w, *r)?;
+        }
+        run.state.lengthscale_max = saved.lengthscale_max;
+        Ok(run)
+    }
+
+    /// The state to save.
+    pub fn state(&self) -> &CdboState {
+        &self.state
+    }
+
+    /// The search box.
+    pub fn search_box(&self) -> &SearchBox {
+        &self.bounds
+    }
+
+    /// The reward GP.
+    pub fn gp(&self) -> &GaussianProcess {
+        &self.gp
+    }
+
+    fn hyper_bounds(&self) -> Bounds {
+        let width = 2.0 * self.state.config.box_radius;
+        let ys = self.gp.values();
+        let n = ys.len().max(1) as f64;
+        let mean_sq = ys.iter().map(|y| y * y).sum::<f64>() / n;
+        let scale = mean_sq.max(1e-6);
+        Bounds {
+            lengthscale: (LENGTHSCALE_MIN_FRACTION * width, self.state.lengthscale_max),
+            signal_var: (1e-3 * scale, 1e2 * scale),
+            noise_var: None,
+        }
+    }
+
+    /// Re-fits the hyperparameters when due (the first BO step, then every `refit_every`).
+    fn maybe_refit(&mut self) -> Result<()> {
+        let n = self.gp.len();
+        let every = self.state.config.refit_every;
+        let first = n == self.state.config.initial_samples + 1;
+        if n < 2 || !(first || (every > 0 && n >= self.last_fit_at + every)) {
+            return Ok(());
+        }
+        self.fit_hyperparameters()
+    }
+
+    /// Fits the GP's hyperparameters by maximum likelihood within the current bounds now.
+    pub fn fit_hyperparameters(&mut self) -> Result<()> {
+        let start = std::time::Instant::now();
+        let bounds = self.hyper_bounds();
+        fit(&mut self.gp, &bounds, self.state.config.fit_iterations)?;
+        self.state.hyper = self.gp.hyper().clone();
+        self.last_fit_at = self.gp.len();
+        self.fit_seconds += start.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    /// The next point and the length-scale bound in force when it was chosen.
+    fn suggest(&mut self) -> Result<(Vec<f64>, f64)> {
+        let bound = self.state.lengthscale_max;
+        let w = self.choose()?;
+        Ok((w, bound))
+    }
+
+    fn choose(&mut self) -> Result<Vec<f64>> {
+        let n = self.state.observations.len();
+        let mut rng = rng_for(self.state.config.seed, n as u64);
+        if n == 0 {
+            return Ok(self.state.w0.clone());
+        }
+        if n <= self.state.config.initial_samples {
+            let normal = Normal::new(0.0, self.state.config.initial_sigma)
+                .map_err(|e| Error::Domain(e.to_string()))?;
+            let mut w: Vec<f64> = self
+                .state
+                .w0
+                .iter()
+                .map(|w| w + normal.sample(&mut rng))
+                .collect();
+            self.bounds.clamp(&mut w);
+            return Ok(w);
+        }
+        self.maybe_refit()?;
+        let start = self.best.as_ref().map_or(&self.state.w0, |b| &b.0).clone();
+        let mut objective = GpAcquisition::new(&self.gp, self.state.config.acquisition, &start);
+        let ascent = maximise(
+            &mut objective,
+            &self.bounds,
+            &start,
+            &self.state.config.search,
+            &mut rng,
+        );
+        self.last_af_evaluations = ascent.evaluations;
+        // Wang & de Freitas: too little uncertainty at the chosen point shrinks the bound.
+        if ascent.var.sqrt() < LOW_UNCERTAINTY * self.gp.hyper().signal_var.sqrt() {
+            let floor = 2.0 * LENGTHSCALE_MIN_FRACTION * 2.0 * self.state.config.box_radius;
+            self.state.lengthscale_max = (0.5 * self.state.lengthscale_max).max(floor);
+        }
+        Ok(ascent.point)
+    }
+}
+
+impl Optimizer for Cdbo {
+    fn name(&self) -> &'static str {
+        "cdbo"
+    }
+
+    fn dim(&self) -> usize {
+        self.state.w0.len()
+    }
+
+    fn ask(&mut self) -> Result<Vec<f64>> {
+        if let Some((w, _)) = &self.pending {
+            return Ok(w.clone());
+        }
+        let (w, bound) = self.suggest()?;
+        self.pending = Some((w.clone(), bound));
+        Ok(w)
+    }
+
+    fn tell(&mut self, weights: &[f64], reward: f64) -> Result<()> {
+        check_tell(self.dim(), weights, reward)?;
+        self.gp.add(weights, reward)?;
+        self.state.observations.push((weights.to_vec(), reward));
+        let bound = self
+            .pending
+            .take()
+            .map_or(self.state.lengthscale_max, |(_, b)| b);
+        self.state.bounds_used.push(bound);
+        self.state.hyper = self.gp.hyper().clone();
+        if self.best.as_ref().is_none_or(|b| reward > b.1) {
+            self.best = Some((weights.to_vec(), reward));
+        }
+        self.pending = None;
+        Ok(())
+    }
+
+    fn best(&self) -> Option<(&[f64], f64)> {
+        self.best.as_ref().map(|(w, r)| (w.as_slice(), *r))
+    }
+
+    fn evaluations(&self) -> usize {
+        self.state.observations.len()
+    }
+}
