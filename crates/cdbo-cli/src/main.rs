@@ -31,6 +31,9 @@ enum Command {
     /// Plot tracks.
     #[command(subcommand)]
     Plot(commands::plot::PlotCommand),
+    /// Fit and print RKHS policies.
+    #[command(subcommand)]
+    Policy(commands::policy::PolicyCommand),
     /// Measure speed.
     #[command(subcommand)]
     Bench(commands::bench::BenchCommand),
@@ -44,6 +47,7 @@ fn main() -> ExitCode {
         Command::Limit(args) => commands::limit::run(&args, &data),
         Command::Track(cmd) => commands::track::run(&cmd, &data),
         Command::Plot(cmd) => commands::plot::run(&cmd, &data),
+        Command::Policy(cmd) => commands::policy::run(&cmd),
         Command::Bench(cmd) => commands::bench::run(&cmd, &data),
     };
     match result {

@@ -12,6 +12,41 @@ use cdbo::sim::Simulator;
 pub enum BenchCommand {
     /// Laps of the 15 m/s demonstrator on one thread: simulated time over wall time.
     Sim(SimArgs),
+    /// Time of one CDBO suggestion on a GP with N observations in D dimensions.
+    Suggest(SuggestArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct SuggestArgs {
+    /// Observations in the GP.
+    #[arg(long, default_value_t = 300)]
+    observations: usize,
+    /// Dimensions (policy weights).
+    #[arg(long, default_value_t = 100)]
+    dims: usize,
+    /// Suggestions timed.
+    #[arg(long, default_value_t = 20)]
+    repeats: usize,
+    /// Values scanned per axis (default: the library's).
+    #[arg(long)]
+    scan: Option<usize>,
+    /// COBYLA evaluations per axis (default: the library's).
+    #[arg(long)]
+    polish: Option<usize>,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Debug, Serialize)]
+struct SuggestBench {
+    observations: usize,
+    dims: usize,
+    repeats: usize,
+    median_ms: f64,
+    p90_ms: f64,
+    af_evals_per_suggest: f64,
+    refit_ms: f64,
 }
 
 #[derive(Debug, Args)]
@@ -37,7 +72,75 @@ struct SimBench {
 }
 
 pub fn run(cmd: &BenchCommand, data: &DataPath) -> CliResult {
-    let BenchCommand::Sim(args) = cmd;
+    match cmd {
+        BenchCommand::Sim(args) => sim(args, data),
+        BenchCommand::Suggest(args) => suggest(args),
+    }
+}
+
+/// A GP of `observations` points around w₀ = 0 with a smooth synthetic reward, hyperparameters
+/// fitted once (timed), then `repeats` suggestions from clones of the same state.
+fn suggest(args: &SuggestArgs) -> CliResult {
+    use cdbo::optimizers::Optimizer;
+    use cdbo::optimizers::cdbo::{Cdbo, CdboConfig};
+    if args.observations < 2 || args.dims == 0 || args.repeats == 0 {
+        return Err("--observations must be at least 2, --dims and --repeats at least 1".into());
+    }
+    let mut config = CdboConfig {
+        initial_samples: 0,
+        refit_every: 0,
+        ..CdboConfig::default()
+    };
+    config.search.scan = args.scan.unwrap_or(config.search.scan);
+    config.search.polish = args.polish.unwrap_or(config.search.polish);
+    let mut opt = Cdbo::new(vec![0.0; args.dims], config)?;
+    let mut rng = cdbo::optimizers::rng_for(7, 0);
+    let normal = rand_distr::Normal::new(0.0, 0.3)?;
+    for _ in 0..args.observations {
+        let w: Vec<f64> = (0..args.dims)
+            .map(|_| rand_distr::Distribution::sample(&normal, &mut rng))
+            .collect();
+        let reward = 30.0
+            - w.iter()
+                .enumerate()
+                .map(|(i, v)| (v - 0.1 * (i % 5) as f64).powi(2))
+                .sum::<f64>();
+        opt.tell(&w, reward)?;
+    }
+    let start = std::time::Instant::now();
+    opt.fit_hyperparameters()?;
+    let refit_ms = start.elapsed().as_secs_f64() * 1e3;
+    let mut times = Vec::with_capacity(args.repeats);
+    let mut evals = 0usize;
+    for _ in 0..args.repeats {
+        let mut c = opt.clone();
+        let t = std::time::Instant::now();
+        c.ask()?;
+        times.push(t.elapsed().as_secs_f64() * 1e3);
+        evals += c.last_af_evaluations;
+    }
+    times.sort_by(f64::total_cmp);
+    let pick = |q: f64| times[((times.len() - 1) as f64 * q).round() as usize];
+    let b = SuggestBench {
+        observations: args.observations,
+        dims: args.dims,
+        repeats: args.repeats,
+        median_ms: pick(0.5),
+        p90_ms: pick(0.9),
+        af_evals_per_suggest: evals as f64 / args.repeats as f64,
+        refit_ms,
+    };
+    if args.json {
+        return print_json(&b);
+    }
+    println!(
+        "CDBO suggestion, {} observations in {} dimensions: median {:.2} ms, p90 {:.2} ms, {:.0} acquisition evaluations; hyperparameter fit {:.0} ms",
+        b.observations, b.dims, b.median_ms, b.p90_ms, b.af_evals_per_suggest, b.refit_ms
+    );
+    Ok(())
+}
+
+fn sim(args: &SimArgs, data: &DataPath) -> CliResult {
     if args.laps == 0 {
         return Err("--laps must be at least 1".into());
     }

@@ -4,6 +4,7 @@ pub mod bench;
 pub mod lap;
 pub mod limit;
 pub mod plot;
+pub mod policy;
 pub mod track;
 
 use clap::Args;

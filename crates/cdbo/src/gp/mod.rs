@@ -10,6 +10,7 @@ pub mod kernel;
 pub mod likelihood;
 
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
+use faer::reborrow::ReborrowMut;
 use faer::{Mat, MatMut, Par, Side};
 use serde::{Deserialize, Serialize};
 
@@ -272,9 +273,38 @@ impl GaussianProcess {
         self.predict_from_k(kv.as_mut())
     }
 
+    /// Posterior mean and variance of one point from its cross-covariance k(W, w*)
+    /// (overwritten by L⁻¹k): column-oriented forward substitution, xⱼ = kⱼ/Lⱼⱼ then
+    /// k[j+1..] −= xⱼ·L[j+1.., j], whose inner loop is a contiguous axpy that vectorises.
+    pub fn predict_one_from_k(&self, k: &mut [f64]) -> (f64, f64) {
+        let mean = self.mean + k.iter().zip(&self.alpha).map(|(a, b)| a * b).sum::<f64>();
+        let n = k.len();
+        let mut vv = 0.0;
+        for j in 0..n {
+            let col = self
+                .chol
+                .col(j)
+                .try_as_col_major()
+                .map(|c| c.as_slice())
+                .unwrap_or_default();
+            let x = k[j] / col[j];
+            k[j] = x;
+            vv += x * x;
+            for (ki, lij) in k[j + 1..].iter_mut().zip(&col[j + 1..]) {
+                *ki -= x * lij;
+            }
+        }
+        (mean, (self.hyper.signal_var - vv).max(0.0))
+    }
+
     /// Posterior mean and variance from the cross-covariance columns k(W, w*) (overwritten).
     pub fn predict_from_k(&self, mut kv: MatMut<'_, f64>) -> Vec<(f64, f64)> {
         let (n, b) = (kv.nrows(), kv.ncols());
+        if b == 1
+            && let Some(col) = kv.rb_mut().col_mut(0).try_as_col_major_mut()
+        {
+            return vec![self.predict_one_from_k(col.as_slice_mut())];
+        }
         let means: Vec<f64> = (0..b)
             .map(|j| self.mean + (0..n).map(|i| kv[(i, j)] * self.alpha[i]).sum::<f64>())
             .collect();

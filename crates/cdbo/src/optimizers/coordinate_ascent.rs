@@ -4,10 +4,10 @@
 //! others fixed, inside the search box. Along axis i only one term of each squared distance to
 //! the n observations changes, r²ⱼ(v) = r²ⱼ − sᵢ(wᵢ − Xⱼᵢ)² + sᵢ(v − Xⱼᵢ)² (sᵢ = 1/lᵢ²), so a
 //! candidate costs O(n) kernel values plus one triangular solve. Each axis gets a coarse scan of
-//! `scan` evenly spaced values (one batched solve), then a COBYLA polish from the best of them
-//! (the paper's per-axis optimiser), stopping at the evaluation budget.
+//! `scan` evenly spaced values (one batched solve), then, where the scan beat the current value,
+//! a COBYLA polish from the best of them (the paper's per-axis optimiser), stopping at the
+//! evaluation budget.
 
-use faer::Mat;
 use rand::seq::SliceRandom;
 
 use super::SearchBox;
@@ -32,7 +32,7 @@ impl Default for AxisSearch {
         AxisSearch {
             sweeps: 1,
             scan: 12,
-            polish: 12,
+            polish: 8,
             budget: 50_000,
         }
     }
@@ -96,16 +96,18 @@ impl AxisObjective for GpAcquisition<'_> {
         let n = gp.len();
         let h = gp.hyper();
         let (current, scale) = (point[axis], self.scale(axis));
-        let mut kv = Mat::<f64>::zeros(n, values.len());
-        for j in 0..n {
-            let xj = gp.input(j)[axis];
-            let base = self.r2[j] - scale * (current - xj) * (current - xj);
-            for (c, v) in values.iter().enumerate() {
-                let r2 = (base + scale * (v - xj) * (v - xj)).max(0.0);
-                kv[(j, c)] = h.signal_var * h.kernel.of_r2(r2);
+        // Column-major n × B buffer of r², turned into kernel values in one vectorised pass.
+        let mut buf = vec![0.0; n * values.len()];
+        for (c, v) in values.iter().enumerate() {
+            let col = &mut buf[c * n..(c + 1) * n];
+            for (j, out) in col.iter_mut().enumerate() {
+                let xj = gp.input(j)[axis];
+                *out = self.r2[j] + scale * ((v - xj) * (v - xj) - (current - xj) * (current - xj));
             }
         }
-        gp.predict_from_k(kv.as_mut())
+        h.kernel.apply_in_place(&mut buf, h.signal_var);
+        let kv = faer::MatMut::from_column_major_slice_mut(&mut buf, n, values.len());
+        gp.predict_from_k(kv)
             .into_iter()
             .map(|(m, v)| (self.acq.value(m, v, self.best), v))
             .collect()
@@ -261,13 +263,8 @@ mod tests {
             },
             &mut rng,
         );
-        for d in 0..dim {
-            assert!(
-                (a.point[d] - target[d]).abs() < 1e-4,
-                "axis {d}: {} vs {}",
-                a.point[d],
-                target[d]
-            );
+        for (d, (got, want)) in a.point.iter().zip(&target).enumerate() {
+            assert!((got - want).abs() < 1e-4, "axis {d}: {got} vs {want}");
         }
         assert!(a.value > -1e-6 && a.evaluations <= 50_000);
         // A target outside the box ends on the box.

@@ -187,16 +187,12 @@ mod tests {
         for &(x, a) in &demo {
             features_into(x, l, &mut phi);
             let r: f64 = phi.iter().zip(&p.weights).map(|(f, w)| f * w).sum::<f64>() - a;
-            for i in 0..m {
-                grad[i] += phi[i] * r;
+            for (g, f) in grad.iter_mut().zip(&phi) {
+                *g += f * r;
             }
         }
-        for i in 0..m {
-            assert!(
-                (grad[i] + lambda * p.weights[i]).abs() < 1e-8,
-                "{i}: {}",
-                grad[i] + lambda * p.weights[i]
-            );
+        for (i, (g, w)) in grad.iter().zip(&p.weights).enumerate() {
+            assert!((g + lambda * w).abs() < 1e-8, "{i}: {}", g + lambda * w);
         }
         // And it fits: a smooth demonstration is reproduced closely.
         for &(x, a) in demo.iter().step_by(37) {

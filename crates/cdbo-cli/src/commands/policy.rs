@@ -1,0 +1,136 @@
+//! `cdbo policy fit` and `cdbo policy table`: the paper's RKHS policies as files.
+
+use std::path::{Path, PathBuf};
+
+use clap::Subcommand;
+
+use super::CliResult;
+use cdbo::policy::RkhsPolicy;
+use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
+
+#[derive(Debug, Subcommand)]
+pub enum PolicyCommand {
+    /// Fit w₀ to a demonstration's (x, a) pairs by ridge regression (paper eq. 9).
+    Fit {
+        /// CSV rows `x,a` (a header line is skipped), e.g. from `cdbo lap --trace` columns.
+        #[arg(long, value_name = "FILE.csv")]
+        demo: PathBuf,
+        /// Number of kernels M.
+        #[arg(long)]
+        kernels: usize,
+        /// Kernel length-scale (default 1/(M − 1)).
+        #[arg(long)]
+        lengthscale: Option<f64>,
+        /// Ridge factor λ.
+        #[arg(long, default_value_t = DEFAULT_RIDGE)]
+        ridge: f64,
+        /// Output weights (JSON).
+        #[arg(short, long, value_name = "FILE.json")]
+        output: PathBuf,
+    },
+    /// Print a policy's (x, a) table as CSV.
+    Table {
+        /// Weights written by `cdbo policy fit` (JSON).
+        weights: PathBuf,
+        /// Points in the table.
+        #[arg(long, default_value_t = 101)]
+        points: usize,
+    },
+}
+
+pub fn run(cmd: &PolicyCommand) -> CliResult {
+    match cmd {
+        PolicyCommand::Fit {
+            demo,
+            kernels,
+            lengthscale,
+            ridge,
+            output,
+        } => {
+            let pairs = read_demo(demo)?;
+            let l = lengthscale.unwrap_or_else(|| default_lengthscale(*kernels));
+            let policy = RkhsPolicy::fit(&pairs, *kernels, l, *ridge)
+                .map_err(|e| format!("{}: {e}", demo.display()))?;
+            std::fs::write(output, serde_json::to_string_pretty(&policy)?)
+                .map_err(|e| format!("{}: {e}", output.display()))?;
+            let rms = (pairs
+                .iter()
+                .map(|(x, a)| (policy.action(*x) - a).powi(2))
+                .sum::<f64>()
+                / pairs.len() as f64)
+                .sqrt();
+            eprintln!(
+                "fitted {kernels} kernels (l = {l:.4}) to {} pairs, rms error {rms:.4}: {}",
+                pairs.len(),
+                output.display()
+            );
+            Ok(())
+        }
+        PolicyCommand::Table { weights, points } => {
+            let policy = read_policy(weights)?;
+            println!("x,a");
+            for (x, a) in policy.table(*points) {
+                println!("{x:.6},{a:.6}");
+            }
+            Ok(())
+        }
+    }
+}
+
+/// Reads policy weights written by `cdbo policy fit`.
+pub fn read_policy(path: &Path) -> Result<RkhsPolicy, Box<dyn std::error::Error>> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let p: RkhsPolicy = serde_json::from_str(&text)
+        .map_err(|e| format!("{}: not policy weights: {e}", path.display()))?;
+    Ok(
+        RkhsPolicy::new(p.weights, p.lengthscale)
+            .map_err(|e| format!("{}: {e}", path.display()))?,
+    )
+}
+
+/// Reads `x,a` pairs; with more columns, uses the `x` and `pedal` (or `a`) columns by name.
+fn read_demo(path: &Path) -> Result<Vec<(f64, f64)>, Box<dyn std::error::Error>> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty() && !l.starts_with('#'))
+        .peekable();
+    let (mut xc, mut ac) = (0, 1);
+    if let Some((_, first)) = lines.peek()
+        && first.chars().next().is_some_and(char::is_alphabetic)
+    {
+        let header: Vec<&str> = first.split(',').map(str::trim).collect();
+        xc = header
+            .iter()
+            .position(|h| *h == "x")
+            .ok_or_else(|| format!("{}: no x column in the header", path.display()))?;
+        ac = header
+            .iter()
+            .position(|h| *h == "a" || *h == "pedal")
+            .ok_or_else(|| format!("{}: no a (or pedal) column in the header", path.display()))?;
+        lines.next();
+    }
+    let mut pairs = Vec::new();
+    for (i, line) in lines {
+        let cols: Vec<&str> = line.split(',').map(str::trim).collect();
+        let get = |c: usize| -> Result<f64, String> {
+            cols.get(c)
+                .and_then(|s| s.parse::<f64>().ok())
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| {
+                    format!(
+                        "{}:{}: column {} is not a finite number",
+                        path.display(),
+                        i + 1,
+                        c + 1
+                    )
+                })
+        };
+        pairs.push((get(xc)?, get(ac)?));
+    }
+    if pairs.is_empty() {
+        return Err(format!("{}: the demonstration is empty", path.display()).into());
+    }
+    Ok(pairs)
+}
