@@ -21,6 +21,8 @@ struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
+    /// Learn a fast policy for a track: demonstration, then CDBO for N laps (the main job).
+    Race(commands::race::RaceArgs),
     /// Drive one lap and report its time, reward and the physical limit.
     Lap(commands::lap::LapArgs),
     /// The quasi-steady-state minimum lap time of a car on a track.
@@ -43,6 +45,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let data = cdbo::data_path::DataPath::new(&cli.data_dirs);
     let result = match cli.command {
+        Command::Race(args) => commands::race::run(&args, &data),
         Command::Lap(args) => commands::lap::run(&args, &data),
         Command::Limit(args) => commands::limit::run(&args, &data),
         Command::Track(cmd) => commands::track::run(&cmd, &data),

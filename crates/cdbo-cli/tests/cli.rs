@@ -203,3 +203,165 @@ fn bad_track_files_give_one_clear_error() {
     fails_with(&["lap", "--throttle", "3"], &["--throttle"]);
     fails_with(&["lap", "--demo", "-5"], &["--demo"]);
 }
+
+#[test]
+fn a_short_race_writes_its_results() {
+    let out = std::env::temp_dir().join(format!("cdbo-cli-race-{}", std::process::id()));
+    let v = json(&[
+        "race",
+        "--laps",
+        "15",
+        "--kernels",
+        "10",
+        "--seed",
+        "3",
+        "--json",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    for key in [
+        "method",
+        "track",
+        "kernels",
+        "laps",
+        "seed",
+        "demo_reward_mps",
+        "best_reward_mps",
+        "best_lap_time_s",
+        "limit_reward_mps",
+        "wall_s",
+        "optimizer_s",
+        "simulator_s",
+    ] {
+        assert!(v.get(key).is_some(), "{key}");
+    }
+    let (best, demo, limit) = (
+        v["best_reward_mps"].as_f64().unwrap(),
+        v["demo_reward_mps"].as_f64().unwrap(),
+        v["limit_reward_mps"].as_f64().unwrap(),
+    );
+    assert!(
+        best >= demo * 0.99 && best < limit,
+        "best {best}, demo {demo}, limit {limit}"
+    );
+    let laps = std::fs::read_to_string(out.join("laps.csv")).unwrap();
+    assert_eq!(laps.lines().count(), 16);
+    assert!(
+        laps.starts_with(
+            "lap,reward_mps,best_mps,lap_time_s,failure,x_fail,optimizer_s,simulator_s"
+        )
+    );
+    let policy: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("best_policy.json")).unwrap())
+            .unwrap();
+    assert_eq!(policy["weights"].as_array().unwrap().len(), 10);
+    assert!(
+        std::fs::read_to_string(out.join("best_policy.csv"))
+            .unwrap()
+            .lines()
+            .count()
+            > 100
+    );
+    // Same seed, same race.
+    let again = json(&[
+        "race",
+        "--laps",
+        "15",
+        "--kernels",
+        "10",
+        "--seed",
+        "3",
+        "--json",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(again["best_reward_mps"], v["best_reward_mps"]);
+}
+
+#[test]
+fn policies_fit_to_a_trace_and_print_tables() {
+    let trace = scratch("demo-trace.csv", "");
+    let out = cdbo(&["lap", "--trace", trace.to_str().unwrap()]);
+    assert!(out.status.success());
+    let weights = scratch("w0.json", "");
+    let out = cdbo(&[
+        "policy",
+        "fit",
+        "--demo",
+        trace.to_str().unwrap(),
+        "--kernels",
+        "20",
+        "-o",
+        weights.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = cdbo(&[
+        "policy",
+        "table",
+        weights.to_str().unwrap(),
+        "--points",
+        "11",
+    ]);
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(table.lines().count(), 12);
+    // The fitted table drives the car round like the demonstration did.
+    let csv = scratch("table.csv", &table);
+    let v = json(&["lap", "--policy", csv.to_str().unwrap(), "--json"]);
+    assert!(v["completed"].as_bool().unwrap() || v["failure"]["x"].as_f64().unwrap() > 0.0);
+    fails_with(
+        &[
+            "policy",
+            "fit",
+            "--demo",
+            trace.to_str().unwrap(),
+            "--kernels",
+            "1",
+            "-o",
+            weights.to_str().unwrap(),
+        ],
+        &["at least 2 kernels"],
+    );
+    let empty = scratch("empty.csv", "x,a\n");
+    fails_with(
+        &[
+            "policy",
+            "fit",
+            "--demo",
+            empty.to_str().unwrap(),
+            "--kernels",
+            "5",
+            "-o",
+            weights.to_str().unwrap(),
+        ],
+        &["empty"],
+    );
+}
+
+#[test]
+fn bench_suggest_reports_its_keys() {
+    let v = json(&[
+        "bench",
+        "suggest",
+        "--observations",
+        "30",
+        "--dims",
+        "8",
+        "--repeats",
+        "3",
+        "--json",
+    ]);
+    for key in [
+        "median_ms",
+        "p90_ms",
+        "observations",
+        "dims",
+        "af_evals_per_suggest",
+        "refit_ms",
+    ] {
+        assert!(v[key].as_f64().is_some(), "{key}");
+    }
+}

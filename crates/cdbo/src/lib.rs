@@ -8,6 +8,10 @@
 //! - [`sim`]: the vehicle model and the lap evaluator.
 //! - [`drive`]: the environment's controllers (steering, demonstrator).
 //! - [`limit`]: the quasi-steady-state minimum lap time.
+//! - [`policy`]: policies π(x), the paper's RKHS policy and (x, a) tables.
+//! - [`gp`], [`acquisition`], [`optimizers`]: the Gaussian process, UCB / EI and the ask/tell
+//!   optimisers, CDBO first.
+//! - [`experiment`]: learning to race a track end to end.
 
 pub mod acquisition;
 pub mod benchmarks;
@@ -15,6 +19,7 @@ pub mod car;
 pub mod data_path;
 pub mod drive;
 pub mod error;
+pub mod experiment;
 pub mod gp;
 pub mod limit;
 pub mod optimizers;

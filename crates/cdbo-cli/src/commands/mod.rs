@@ -5,6 +5,7 @@ pub mod lap;
 pub mod limit;
 pub mod plot;
 pub mod policy;
+pub mod race;
 pub mod track;
 
 use clap::Args;

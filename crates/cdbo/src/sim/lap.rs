@@ -22,7 +22,7 @@ use crate::drive::{Observation, Pedal};
 use crate::track::{Frame, Track};
 
 /// Why a lap failed.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum FailureReason {
     /// The car left the road.

@@ -1,0 +1,226 @@
+//! `cdbo race`: the main job — learn a fast pedal policy for a track in a few hundred laps.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use serde::Serialize;
+
+use super::{CliResult, Setup, print_json};
+use cdbo::data_path::DataPath;
+use cdbo::experiment::race::{RaceConfig, RaceOutcome, race};
+use cdbo::policy::RkhsPolicy;
+
+#[derive(Debug, Args)]
+pub struct RaceArgs {
+    #[command(flatten)]
+    setup: Setup,
+    /// Policy kernels M (the paper: 10 to 100).
+    #[arg(long, default_value_t = 30)]
+    kernels: usize,
+    /// Optimiser.
+    #[arg(long, default_value = "cdbo")]
+    method: String,
+    /// Laps (the paper: 300).
+    #[arg(long, default_value_t = 300)]
+    laps: usize,
+    /// Seed of every random choice.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// UCB exploration weight β (the paper: 0.5 to 2).
+    #[arg(long, default_value_t = cdbo::acquisition::ucb::DEFAULT_BETA)]
+    beta: f64,
+    /// Speed of the demonstrator (m/s).
+    #[arg(long, default_value_t = 15.0)]
+    demo_speed: f64,
+    /// Output folder (default: runs/race-TRACK-METHOD-mM-sSEED).
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
+    /// Print the summary as JSON (no progress bar).
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Debug, Serialize)]
+struct Summary {
+    method: String,
+    track: String,
+    kernels: usize,
+    laps: usize,
+    seed: u64,
+    demo_reward_mps: f64,
+    best_reward_mps: f64,
+    best_lap_time_s: Option<f64>,
+    limit_reward_mps: f64,
+    limit_lap_time_s: f64,
+    best_fraction_of_limit: f64,
+    failed_laps: usize,
+    wall_s: f64,
+    optimizer_s: f64,
+    simulator_s: f64,
+    out: String,
+}
+
+pub fn run(args: &RaceArgs, data: &DataPath) -> CliResult {
+    if !(args.beta.is_finite() && args.beta >= 0.0) {
+        return Err(format!("--beta {}: must be a non-negative number", args.beta).into());
+    }
+    let (track, car) = args.setup.load(data)?;
+    let track_name = track.name.clone();
+    let out = args.out.clone().unwrap_or_else(|| {
+        PathBuf::from("runs").join(format!(
+            "race-{}-{}-m{}-s{}",
+            slug(&track_name),
+            args.method,
+            args.kernels,
+            args.seed
+        ))
+    });
+    std::fs::create_dir_all(&out).map_err(|e| format!("{}: {e}", out.display()))?;
+    let config = RaceConfig {
+        method: args.method.clone(),
+        kernels: args.kernels,
+        laps: args.laps,
+        seed: args.seed,
+        beta: args.beta,
+        demo_speed: args.demo_speed,
+    };
+    let bar = if args.json {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new(args.laps as u64)
+    };
+    bar.set_style(
+        ProgressStyle::with_template("{prefix} [{bar:30}] lap {pos}/{len} {msg} ({elapsed})")?
+            .progress_chars("=> "),
+    );
+    bar.set_prefix(format!("{} on {}", args.method, track_name));
+    let limit_reward = cdbo::limit::limit_lap(&track, &car).reward_mps;
+    let start = std::time::Instant::now();
+    let outcome = race(track.clone(), &car, &config, |r| {
+        bar.set_position(r.lap as u64);
+        bar.set_message(format!(
+            "best {:.2} m/s ({:.0}% of the limit)",
+            r.best_mps,
+            100.0 * r.best_mps / limit_reward
+        ));
+    })?;
+    bar.finish_and_clear();
+    let wall_s = start.elapsed().as_secs_f64();
+    write_outputs(&out, &outcome)?;
+    let best_lap = outcome
+        .laps
+        .iter()
+        .filter(|l| l.reward_mps == outcome.best_reward_mps)
+        .find_map(|l| l.lap_time_s);
+    let summary = Summary {
+        method: args.method.clone(),
+        track: track_name,
+        kernels: args.kernels,
+        laps: args.laps,
+        seed: args.seed,
+        demo_reward_mps: outcome.demo.reward_mps,
+        best_reward_mps: outcome.best_reward_mps,
+        best_lap_time_s: best_lap,
+        limit_reward_mps: outcome.limit.reward_mps,
+        limit_lap_time_s: outcome.limit.lap_time_s,
+        best_fraction_of_limit: outcome.best_reward_mps / outcome.limit.reward_mps,
+        failed_laps: outcome.laps.iter().filter(|l| l.failure.is_some()).count(),
+        wall_s,
+        optimizer_s: outcome.laps.iter().map(|l| l.optimizer_s).sum(),
+        simulator_s: outcome.laps.iter().map(|l| l.simulator_s).sum(),
+        out: out.display().to_string(),
+    };
+    std::fs::write(
+        out.join("summary.json"),
+        serde_json::to_string_pretty(&summary)?,
+    )?;
+    if args.json {
+        return print_json(&summary);
+    }
+    println!(
+        "{} on {}, {} kernels, {} laps: best lap {} at {:.2} m/s, {:.1} % of the limit ({:.2} m/s), {:.2}x the demonstration ({:.2} m/s); {} laps failed",
+        summary.method,
+        summary.track,
+        summary.kernels,
+        summary.laps,
+        summary
+            .best_lap_time_s
+            .map_or("-".into(), |t| format!("{t:.2} s")),
+        summary.best_reward_mps,
+        100.0 * summary.best_fraction_of_limit,
+        summary.limit_reward_mps,
+        summary.best_reward_mps / summary.demo_reward_mps,
+        summary.demo_reward_mps,
+        summary.failed_laps
+    );
+    println!(
+        "{:.1} s wall: optimiser {:.1} s, simulator {:.1} s. Results in {}",
+        summary.wall_s,
+        summary.optimizer_s,
+        summary.simulator_s,
+        out.display()
+    );
+    Ok(())
+}
+
+fn slug(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() {
+                c.to_ascii_lowercase()
+            } else {
+                '-'
+            }
+        })
+        .collect()
+}
+
+fn write_outputs(out: &Path, o: &RaceOutcome) -> CliResult {
+    let mut laps = std::io::BufWriter::new(std::fs::File::create(out.join("laps.csv"))?);
+    writeln!(
+        laps,
+        "lap,reward_mps,best_mps,lap_time_s,failure,x_fail,optimizer_s,simulator_s"
+    )?;
+    for l in &o.laps {
+        let failure = l
+            .failure
+            .map(|f| {
+                serde_json::to_value(f)
+                    .ok()
+                    .and_then(|v| v.as_str().map(str::to_owned))
+                    .unwrap_or_default()
+            })
+            .unwrap_or_default();
+        writeln!(
+            laps,
+            "{},{:.6},{:.6},{},{},{},{:.6},{:.6}",
+            l.lap,
+            l.reward_mps,
+            l.best_mps,
+            l.lap_time_s.map_or(String::new(), |t| format!("{t:.4}")),
+            failure,
+            l.x_fail.map_or(String::new(), |x| format!("{x:.5}")),
+            l.optimizer_s,
+            l.simulator_s
+        )?;
+    }
+    laps.flush()?;
+    write_policy(out, "best_policy", &o.best)?;
+    write_policy(out, "initial_policy", &o.initial)?;
+    Ok(())
+}
+
+fn write_policy(out: &Path, name: &str, p: &RkhsPolicy) -> CliResult {
+    std::fs::write(
+        out.join(format!("{name}.json")),
+        serde_json::to_string_pretty(p)?,
+    )?;
+    let mut csv = String::from("x,a\n");
+    for (x, a) in p.table(1001) {
+        csv += &format!("{x:.6},{a:.6}\n");
+    }
+    std::fs::write(out.join(format!("{name}.csv")), csv)?;
+    Ok(())
+}

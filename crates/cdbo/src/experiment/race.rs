@@ -1,0 +1,170 @@
+//! Learning to race one track (paper Sec. V): drive the demonstration, fit w₀, then optimise
+//! the policy weights for a number of laps, one lap per evaluation.
+
+use serde::{Deserialize, Serialize};
+
+use crate::car::Car;
+use crate::drive::demo::SpeedHold;
+use crate::error::{Error, Result};
+use crate::limit::{Limit, limit_lap};
+use crate::optimizers::Optimizer;
+use crate::optimizers::cdbo::{Cdbo, CdboConfig};
+use crate::policy::RkhsPolicy;
+use crate::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
+use crate::sim::{FailureReason, LapResult, Simulator};
+use crate::track::Track;
+
+/// Settings of a race.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RaceConfig {
+    /// Optimiser name (`cdbo`).
+    pub method: String,
+    /// Policy kernels M.
+    pub kernels: usize,
+    /// Laps (evaluations), the demonstration's fitted policy included.
+    pub laps: usize,
+    /// Seed of every random choice.
+    pub seed: u64,
+    /// UCB β.
+    pub beta: f64,
+    /// Demonstration speed (m/s).
+    pub demo_speed: f64,
+}
+
+impl Default for RaceConfig {
+    fn default() -> Self {
+        RaceConfig {
+            method: "cdbo".into(),
+            kernels: 30,
+            laps: 300,
+            seed: 0,
+            beta: crate::acquisition::ucb::DEFAULT_BETA,
+            demo_speed: 15.0,
+        }
+    }
+}
+
+/// One lap of the optimisation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LapRecord {
+    /// 1-based lap number.
+    pub lap: usize,
+    /// Reward L/T (0 on failure).
+    pub reward_mps: f64,
+    /// Best reward so far.
+    pub best_mps: f64,
+    /// Lap time, if completed.
+    pub lap_time_s: Option<f64>,
+    /// Failure reason, if any.
+    pub failure: Option<FailureReason>,
+    /// Lap fraction where it failed.
+    pub x_fail: Option<f64>,
+    /// Seconds the optimiser spent choosing this lap's weights.
+    pub optimizer_s: f64,
+    /// Seconds the simulator spent on this lap.
+    pub simulator_s: f64,
+}
+
+/// What a race produced.
+#[derive(Debug, Clone)]
+pub struct RaceOutcome {
+    /// The demonstration lap.
+    pub demo: LapResult,
+    /// The demonstration's (x, a) pairs.
+    pub demo_pairs: Vec<(f64, f64)>,
+    /// The fitted initial policy.
+    pub initial: RkhsPolicy,
+    /// The best policy found.
+    pub best: RkhsPolicy,
+    /// Its reward.
+    pub best_reward_mps: f64,
+    /// Every optimisation lap.
+    pub laps: Vec<LapRecord>,
+    /// The limit lap.
+    pub limit: Limit,
+}
+
+/// Drives the demonstration and records its (x, a) pairs at every driver step.
+pub fn demonstrate(sim: &Simulator, speed: f64) -> (LapResult, Vec<(f64, f64)>) {
+    let mut s = sim.clone();
+    s.config.trace = true;
+    let lap = s.lap(&mut SpeedHold::new(speed));
+    let pairs = lap.trace.iter().map(|p| (p.x, p.pedal)).collect();
+    (lap, pairs)
+}
+
+/// Runs a race; `progress` is called after every lap.
+pub fn race(
+    track: Track,
+    car: &Car,
+    config: &RaceConfig,
+    mut progress: impl FnMut(&LapRecord),
+) -> Result<RaceOutcome> {
+    if config.laps == 0 {
+        return Err(Error::Domain("a race needs at least one lap".into()));
+    }
+    let limit = limit_lap(&track, car);
+    let sim = Simulator::new(track, car);
+    let (demo, demo_pairs) = demonstrate(&sim, config.demo_speed);
+    if !demo.completed {
+        return Err(Error::Domain(format!(
+            "the {} m/s demonstration does not complete {} ({:?}): choose a slower --demo-speed",
+            config.demo_speed, sim.track.name, demo.failure
+        )));
+    }
+    let lengthscale = default_lengthscale(config.kernels);
+    let initial = RkhsPolicy::fit(&demo_pairs, config.kernels, lengthscale, DEFAULT_RIDGE)?;
+    let mut optimizer: Box<dyn Optimizer> = match config.method.as_str() {
+        "cdbo" => {
+            let mut c = CdboConfig {
+                seed: config.seed,
+                ..CdboConfig::default()
+            };
+            c.acquisition = crate::acquisition::Acquisition::Ucb { beta: config.beta };
+            Box::new(Cdbo::new(initial.weights.clone(), c)?)
+        }
+        other => {
+            return Err(Error::Domain(format!(
+                "unknown method {other:?} (available: cdbo)"
+            )));
+        }
+    };
+    let mut laps = Vec::with_capacity(config.laps);
+    let mut best = (initial.clone(), 0.0);
+    for lap in 1..=config.laps {
+        let t0 = std::time::Instant::now();
+        let weights = optimizer.ask()?;
+        let optimizer_s = t0.elapsed().as_secs_f64();
+        let mut policy = RkhsPolicy::new(weights.clone(), lengthscale)?;
+        let t1 = std::time::Instant::now();
+        let result = sim.lap(&mut policy);
+        let simulator_s = t1.elapsed().as_secs_f64();
+        let t2 = std::time::Instant::now();
+        optimizer.tell(&weights, result.reward_mps)?;
+        let optimizer_s = optimizer_s + t2.elapsed().as_secs_f64();
+        if result.reward_mps > best.1 {
+            best = (policy, result.reward_mps);
+        }
+        let record = LapRecord {
+            lap,
+            reward_mps: result.reward_mps,
+            best_mps: best.1,
+            lap_time_s: result.lap_time_s,
+            failure: result.failure.map(|f| f.reason),
+            x_fail: result.failure.map(|f| f.x),
+            optimizer_s,
+            simulator_s,
+        };
+        progress(&record);
+        laps.push(record);
+    }
+    Ok(RaceOutcome {
+        demo,
+        demo_pairs,
+        initial,
+        best: best.0,
+        best_reward_mps: best.1,
+        laps,
+        limit,
+    })
+}
