@@ -34,7 +34,9 @@ pub struct CdboConfig {
     pub acquisition: Acquisition,
     /// Initial random laps S (the paper: 10).
     pub initial_samples: usize,
-    /// Standard deviation σ₀ of the initial samples around w₀.
+    /// Standard deviation σ₀ of the initial samples around w₀. The paper gives no value; 0.03
+    /// keeps most initial laps alive on Forza (with 0.1 all ten stall: the demonstration's
+    /// policy cruises at a ≈ 0.01, so larger perturbations brake the car to a stop).
     pub initial_sigma: f64,
     /// Half-width of the search box around w₀.
     pub box_radius: f64,
@@ -63,13 +65,13 @@ impl Default for CdboConfig {
             seed: 0,
             acquisition: Acquisition::Ucb { beta: DEFAULT_BETA },
             initial_samples: 10,
-            initial_sigma: 0.1,
+            initial_sigma: 0.03,
             box_radius: super::DEFAULT_BOX_RADIUS,
             kernel: Kernel::Exponential,
             ard: true,
             mean: Mean::Constant,
             noise_var: 0.0,
-            refit_every: 10,
+            refit_every: 5,
             fit_iterations: 30,
             search: AxisSearch::default(),
         }
