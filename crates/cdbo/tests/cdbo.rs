@@ -118,3 +118,127 @@ fn bad_tells_are_refused_and_change_nothing() {
     assert!(Cdbo::new(vec![], CdboConfig::default()).is_err());
     assert!(Cdbo::new(vec![f64::NAN], CdboConfig::default()).is_err());
 }
+
+mod cmaes {
+    use cdbo::optimizers::Optimizer;
+    use cdbo::optimizers::cmaes::{Cmaes, CmaesConfig};
+
+    fn sphere(x: &[f64]) -> f64 {
+        x.iter().map(|v| v * v).sum()
+    }
+
+    fn ellipsoid(x: &[f64]) -> f64 {
+        let n = x.len() as f64;
+        x.iter()
+            .enumerate()
+            .map(|(i, v)| 1e6f64.powf(i as f64 / (n - 1.0)) * v * v)
+            .sum()
+    }
+
+    fn rosen(x: &[f64]) -> f64 {
+        -cdbo::benchmarks::rosenbrock(x)
+    }
+
+    /// Evaluations until f ≤ 1e-8 (minimising f; the optimiser maximises −f).
+    fn evals_to_target(
+        f: fn(&[f64]) -> f64,
+        n: usize,
+        x0: f64,
+        sigma0: f64,
+        seed: u64,
+        cap: usize,
+    ) -> Option<usize> {
+        let mut es = Cmaes::new(
+            vec![x0; n],
+            CmaesConfig {
+                seed,
+                sigma0,
+                ..CmaesConfig::default()
+            },
+        )
+        .unwrap();
+        for k in 1..=cap {
+            let x = es.ask().unwrap();
+            let v = f(&x);
+            es.tell(&x, -v).unwrap();
+            if v <= 1e-8 {
+                return Some(k);
+            }
+        }
+        None
+    }
+
+    fn median_evals(
+        f: fn(&[f64]) -> f64,
+        n: usize,
+        x0: f64,
+        sigma0: f64,
+        seeds: u64,
+        cap: usize,
+    ) -> usize {
+        let mut v: Vec<usize> = (1..=seeds)
+            .map(|s| evals_to_target(f, n, x0, sigma0, s, cap).unwrap_or(usize::MAX))
+            .collect();
+        v.sort();
+        v[v.len() / 2]
+    }
+
+    /// Reference: pycma 4.5.0 with CMA_active, x0 = 1 (Rosenbrock 0), σ0 = 1 (0.5), f ≤ 1e-8,
+    /// median of seeds 1–5: sphere-10 1350, sphere-50 5955, ellipsoid-10 4000, ellipsoid-50
+    /// 74565, Rosenbrock-10 4850 evaluations.
+    #[test]
+    fn evaluation_counts_are_within_20_percent_of_pycma() {
+        for (name, f, n, x0, s0, reference) in [
+            (
+                "sphere-10",
+                sphere as fn(&[f64]) -> f64,
+                10,
+                1.0,
+                1.0,
+                1350.0,
+            ),
+            ("sphere-50", sphere, 50, 1.0, 1.0, 5955.0),
+            ("ellipsoid-10", ellipsoid, 10, 1.0, 1.0, 4000.0),
+            ("rosenbrock-10", rosen, 10, 0.0, 0.5, 4850.0),
+        ] {
+            let m = median_evals(f, n, x0, s0, 5, 100_000) as f64;
+            eprintln!("{name}: median {m} evaluations (pycma {reference})");
+            assert!(
+                m <= 1.2 * reference,
+                "{name}: {m} evaluations vs pycma's {reference}"
+            );
+        }
+    }
+
+    #[test]
+    fn ellipsoid_50_is_within_20_percent_of_pycma() {
+        let m = median_evals(ellipsoid, 50, 1.0, 1.0, 3, 200_000) as f64;
+        eprintln!("ellipsoid-50: median {m} evaluations (pycma 74565)");
+        assert!(m <= 1.2 * 74565.0);
+    }
+
+    #[test]
+    fn resume_mid_generation_continues_identically() {
+        let f = |x: &[f64]| -sphere(x);
+        let mut a = Cmaes::new(
+            vec![0.7; 6],
+            CmaesConfig {
+                seed: 5,
+                ..CmaesConfig::default()
+            },
+        )
+        .unwrap();
+        for _ in 0..23 {
+            let x = a.ask().unwrap();
+            a.tell(&x, f(&x)).unwrap();
+        }
+        let saved = serde_json::to_string(a.state()).unwrap();
+        let mut b = Cmaes::resume(serde_json::from_str(&saved).unwrap()).unwrap();
+        for _ in 0..30 {
+            let (xa, xb) = (a.ask().unwrap(), b.ask().unwrap());
+            assert_eq!(xa, xb);
+            a.tell(&xa, f(&xa)).unwrap();
+            b.tell(&xb, f(&xb)).unwrap();
+        }
+    }
+}

@@ -7,8 +7,6 @@ use crate::car::Car;
 use crate::drive::demo::SpeedHold;
 use crate::error::{Error, Result};
 use crate::limit::{Limit, limit_lap};
-use crate::optimizers::Optimizer;
-use crate::optimizers::cdbo::{Cdbo, CdboConfig};
 use crate::policy::RkhsPolicy;
 use crate::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 use crate::sim::{FailureReason, LapResult, Simulator};
@@ -114,21 +112,12 @@ pub fn race(
     }
     let lengthscale = default_lengthscale(config.kernels);
     let initial = RkhsPolicy::fit(&demo_pairs, config.kernels, lengthscale, DEFAULT_RIDGE)?;
-    let mut optimizer: Box<dyn Optimizer> = match config.method.as_str() {
-        "cdbo" => {
-            let mut c = CdboConfig {
-                seed: config.seed,
-                ..CdboConfig::default()
-            };
-            c.acquisition = crate::acquisition::Acquisition::Ucb { beta: config.beta };
-            Box::new(Cdbo::new(initial.weights.clone(), c)?)
-        }
-        other => {
-            return Err(Error::Domain(format!(
-                "unknown method {other:?} (available: cdbo)"
-            )));
-        }
-    };
+    let mut optimizer = crate::optimizers::by_name(
+        &config.method,
+        initial.weights.clone(),
+        config.seed,
+        config.beta,
+    )?;
     let mut laps = Vec::with_capacity(config.laps);
     let mut best = (initial.clone(), 0.0);
     for lap in 1..=config.laps {

@@ -5,7 +5,9 @@
 //! choice from its seed, and treats a failed lap (reward 0) as an ordinary observation.
 
 pub mod cdbo;
+pub mod cmaes;
 pub mod coordinate_ascent;
+pub mod random;
 
 use serde::{Deserialize, Serialize};
 
@@ -31,6 +33,46 @@ pub trait Optimizer {
 
     /// Number of rewards told.
     fn evaluations(&self) -> usize;
+}
+
+/// The methods [`by_name`] knows.
+pub const METHODS: &[&str] = &["cdbo", "cmaes", "random"];
+
+/// An optimiser by its command-line name, from w₀, a seed and the UCB β (used by the BO
+/// methods).
+pub fn by_name(name: &str, w0: Vec<f64>, seed: u64, beta: f64) -> Result<Box<dyn Optimizer>> {
+    Ok(match name {
+        "cdbo" => {
+            let config = cdbo::CdboConfig {
+                seed,
+                acquisition: crate::acquisition::Acquisition::Ucb { beta },
+                ..cdbo::CdboConfig::default()
+            };
+            Box::new(cdbo::Cdbo::new(w0, config)?)
+        }
+        "cmaes" => {
+            let config = cmaes::CmaesConfig {
+                seed,
+                sigma0: 0.1,
+                box_radius: Some(DEFAULT_BOX_RADIUS),
+                ..cmaes::CmaesConfig::default()
+            };
+            Box::new(cmaes::Cmaes::new(w0, config)?)
+        }
+        "random" => Box::new(random::RandomSearch::new(
+            w0,
+            random::RandomConfig {
+                seed,
+                ..random::RandomConfig::default()
+            },
+        )?),
+        other => {
+            return Err(Error::Domain(format!(
+                "unknown method {other:?} (available: {})",
+                METHODS.join(", ")
+            )));
+        }
+    })
 }
 
 /// The box the weights are searched in: [w₀ − r, w₀ + r] in every coordinate.

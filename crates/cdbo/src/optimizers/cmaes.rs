@@ -1,0 +1,459 @@
+//! Active CMA-ES (Hansen 2016, "The CMA Evolution Strategy: A Tutorial", with the negative
+//! weights of active CMA, Jastrebski & Arnold 2006; libcmaes's default aCMA-ES, the paper's
+//! baseline). Minimises f = −reward, one individual per lap.
+//!
+//! With λ = 4 + ⌊3 ln n⌋, μ = ⌊λ/2⌋, w′ᵢ = ln((λ+1)/2) − ln i and the tutorial's constants:
+//! - sample yₖ = B·D·zₖ, xₖ = m + σyₖ (clamped into the box; the clamped step is used),
+//! - m ← m + σ·Σᵢ≤μ wᵢ yᵢ:λ,
+//! - p_σ ← (1 − c_σ)p_σ + √(c_σ(2 − c_σ)μ_eff)·C^(−1/2)⟨y⟩, σ ← σ·exp(c_σ/d_σ·(‖p_σ‖/E‖N(0,I)‖ − 1)),
+//! - p_c ← (1 − c_c)p_c + h_σ√(c_c(2 − c_c)μ_eff)⟨y⟩,
+//! - C ← (1 + c₁δ(h_σ) − c₁ − c_μΣwⱼ)C + c₁p_cp_cᵀ + c_μΣᵢ wᵢ° yᵢ:λ yᵢ:λᵀ, with
+//!   wᵢ° = wᵢ·n/‖C^(−1/2)yᵢ:λ‖² for the negative weights.
+//!
+//! IPOP restarts (Auger & Hansen 2005): when the search has collapsed (σ·max√λ(C) below
+//! 1e-12 of σ₀, a condition number of C above 1e14, or a non-finite state), it restarts from
+//! the best point with σ₀ and twice the population.
+
+use faer::{Mat, Side};
+use rand_distr::{Distribution, StandardNormal};
+use serde::{Deserialize, Serialize};
+
+use super::{Optimizer, SearchBox, check_tell, rng_for};
+use crate::error::{Error, Result};
+
+/// Settings of a CMA-ES run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CmaesConfig {
+    /// Seed of every random choice.
+    pub seed: u64,
+    /// Initial step size σ₀.
+    pub sigma0: f64,
+    /// Population size λ (0: 4 + ⌊3 ln n⌋).
+    pub population: usize,
+    /// Half-width of the search box around the start (`None`: no box).
+    pub box_radius: Option<f64>,
+}
+
+impl Default for CmaesConfig {
+    fn default() -> Self {
+        CmaesConfig {
+            seed: 0,
+            sigma0: 0.3,
+            population: 0,
+            box_radius: None,
+        }
+    }
+}
+
+/// The strategy parameters derived from n and λ.
+#[derive(Debug, Clone, PartialEq)]
+struct Params {
+    lambda: usize,
+    mu: usize,
+    weights: Vec<f64>,
+    mu_eff: f64,
+    cc: f64,
+    cs: f64,
+    c1: f64,
+    cmu: f64,
+    damps: f64,
+    chi_n: f64,
+}
+
+impl Params {
+    fn new(n: usize, lambda: usize) -> Params {
+        let nf = n as f64;
+        let mu = lambda / 2;
+        let raw: Vec<f64> = (1..=lambda)
+            .map(|i| ((lambda as f64 + 1.0) / 2.0).ln() - (i as f64).ln())
+            .collect();
+        let pos_sum: f64 = raw[..mu].iter().sum();
+        let pos_sq: f64 = raw[..mu].iter().map(|w| w * w).sum();
+        let mu_eff = pos_sum * pos_sum / pos_sq;
+        let neg_sum: f64 = raw[mu..].iter().map(|w| w.abs()).sum();
+        let neg_sq: f64 = raw[mu..].iter().map(|w| w * w).sum();
+        let mu_eff_neg = if neg_sq > 0.0 {
+            neg_sum * neg_sum / neg_sq
+        } else {
+            0.0
+        };
+        let cc = (4.0 + mu_eff / nf) / (nf + 4.0 + 2.0 * mu_eff / nf);
+        let cs = (mu_eff + 2.0) / (nf + mu_eff + 5.0);
+        let c1 = 2.0 / ((nf + 1.3).powi(2) + mu_eff);
+        let cmu =
+            (1.0 - c1).min(2.0 * (mu_eff - 2.0 + 1.0 / mu_eff) / ((nf + 2.0).powi(2) + mu_eff));
+        let damps = 1.0 + 2.0 * (((mu_eff - 1.0) / (nf + 1.0)).sqrt() - 1.0).max(0.0) + cs;
+        let alpha_mu = 1.0 + c1 / cmu;
+        let alpha_eff = 1.0 + 2.0 * mu_eff_neg / (mu_eff + 2.0);
+        let alpha_posdef = (1.0 - c1 - cmu) / (nf * cmu);
+        let neg_scale = alpha_mu.min(alpha_eff).min(alpha_posdef);
+        let weights = raw
+            .iter()
+            .enumerate()
+            .map(|(i, w)| {
+                if i < mu {
+                    w / pos_sum
+                } else if neg_sum > 0.0 {
+                    neg_scale * w / neg_sum
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        let chi_n = nf.sqrt() * (1.0 - 1.0 / (4.0 * nf) + 1.0 / (21.0 * nf * nf));
+        Params {
+            lambda,
+            mu,
+            weights,
+            mu_eff,
+            cc,
+            cs,
+            c1,
+            cmu,
+            damps,
+            chi_n,
+        }
+    }
+}
+
+/// Everything needed to resume a run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CmaesState {
+    /// Settings.
+    pub config: CmaesConfig,
+    /// The start point.
+    pub start: Vec<f64>,
+    /// Mean m.
+    pub mean: Vec<f64>,
+    /// Step size σ.
+    pub sigma: f64,
+    /// Covariance C, row-major n × n.
+    pub cov: Vec<f64>,
+    /// Evolution paths.
+    pub ps: Vec<f64>,
+    /// Evolution path of C.
+    pub pc: Vec<f64>,
+    /// Generations completed.
+    pub generation: u64,
+    /// The current generation's steps yₖ (sampled, then clamped).
+    pub population: Vec<Vec<f64>>,
+    /// Fitness (−reward) told for the current generation, in order.
+    pub fitness: Vec<f64>,
+    /// Rewards told in total.
+    pub evaluations: usize,
+    /// The best (weights, reward) told.
+    pub best: Option<(Vec<f64>, f64)>,
+    /// IPOP restarts so far (the population is λ·2^restarts).
+    pub restarts: u32,
+}
+
+/// Active CMA-ES.
+#[derive(Debug, Clone)]
+pub struct Cmaes {
+    state: CmaesState,
+    params: Params,
+    bounds: SearchBox,
+    /// Eigenvectors B (columns) and square roots of the eigenvalues D of C.
+    b: Mat<f64>,
+    d: Vec<f64>,
+}
+
+impl Cmaes {
+    /// A run from `start` with step size σ₀.
+    pub fn new(start: Vec<f64>, config: CmaesConfig) -> Result<Cmaes> {
+        let n = start.len();
+        if n == 0 || start.iter().any(|v| !v.is_finite()) {
+            return Err(Error::Domain(
+                "CMA-ES needs a finite start point of at least one weight".into(),
+            ));
+        }
+        if !(config.sigma0.is_finite() && config.sigma0 > 0.0) {
+            return Err(Error::Domain(format!(
+                "σ₀ must be positive, got {}",
+                config.sigma0
+            )));
+        }
+        let mut cov = vec![0.0; n * n];
+        for i in 0..n {
+            cov[i * n + i] = 1.0;
+        }
+        let state = CmaesState {
+            mean: start.clone(),
+            sigma: config.sigma0,
+            cov,
+            ps: vec![0.0; n],
+            pc: vec![0.0; n],
+            generation: 0,
+            population: Vec::new(),
+            fitness: Vec::new(),
+            evaluations: 0,
+            best: None,
+            restarts: 0,
+            start,
+            config,
+        };
+        Cmaes::resume(state)
+    }
+
+    /// Rebuilds a run from its state.
+    pub fn resume(state: CmaesState) -> Result<Cmaes> {
+        let n = state.start.len();
+        if state.cov.len() != n * n || state.mean.len() != n {
+            return Err(Error::Domain(
+                "corrupt CMA-ES state: sizes do not match the dimension".into(),
+            ));
+        }
+        let base = if state.config.population > 0 {
+            state.config.population
+        } else {
+            4 + (3.0 * (n as f64).ln()).floor() as usize
+        };
+        let lambda = base << state.restarts.min(16);
+        let bounds = match state.config.box_radius {
+            Some(r) => SearchBox::around(&state.start, r)?,
+            None => SearchBox {
+                lower: vec![f64::NEG_INFINITY; n],
+                upper: vec![f64::INFINITY; n],
+            },
+        };
+        let mut run = Cmaes {
+            params: Params::new(n, lambda.max(2)),
+            bounds,
+            b: Mat::identity(n, n),
+            d: vec![1.0; n],
+            state,
+        };
+        run.decompose()?;
+        if run.state.population.is_empty() {
+            run.sample();
+        }
+        Ok(run)
+    }
+
+    /// The state to save.
+    pub fn state(&self) -> &CmaesState {
+        &self.state
+    }
+
+    /// Current step size σ.
+    pub fn sigma(&self) -> f64 {
+        self.state.sigma
+    }
+
+    fn decompose(&mut self) -> Result<()> {
+        let n = self.state.mean.len();
+        let c = Mat::from_fn(n, n, |i, j| self.state.cov[i * n + j]);
+        let evd = c.self_adjoint_eigen(Side::Lower).map_err(|e| {
+            Error::Domain(format!(
+                "CMA-ES covariance eigendecomposition failed: {e:?}"
+            ))
+        })?;
+        self.b = evd.U().to_owned();
+        let s = evd.S().column_vector();
+        self.d = (0..n).map(|i| s[i].max(1e-300).sqrt()).collect();
+        Ok(())
+    }
+
+    /// B·(D ∘ z).
+    fn transform(&self, z: &[f64]) -> Vec<f64> {
+        let n = z.len();
+        (0..n)
+            .map(|i| (0..n).map(|k| self.b[(i, k)] * self.d[k] * z[k]).sum())
+            .collect()
+    }
+
+    /// C^(−1/2)·y = B·(D⁻¹ ∘ Bᵀy).
+    fn inv_sqrt(&self, y: &[f64]) -> Vec<f64> {
+        let n = y.len();
+        let bty: Vec<f64> = (0..n)
+            .map(|k| (0..n).map(|i| self.b[(i, k)] * y[i]).sum::<f64>() / self.d[k])
+            .collect();
+        (0..n)
+            .map(|i| (0..n).map(|k| self.b[(i, k)] * bty[k]).sum())
+            .collect()
+    }
+
+    fn sample(&mut self) {
+        let n = self.state.mean.len();
+        let mut rng = rng_for(self.state.config.seed, self.state.generation);
+        let sigma = self.state.sigma;
+        self.state.population = (0..self.params.lambda)
+            .map(|_| {
+                let z: Vec<f64> = (0..n).map(|_| StandardNormal.sample(&mut rng)).collect();
+                let y = self.transform(&z);
+                let mut x: Vec<f64> = self
+                    .state
+                    .mean
+                    .iter()
+                    .zip(&y)
+                    .map(|(m, yi)| m + sigma * yi)
+                    .collect();
+                self.bounds.clamp(&mut x);
+                x.iter()
+                    .zip(&self.state.mean)
+                    .map(|(xi, m)| (xi - m) / sigma)
+                    .collect()
+            })
+            .collect();
+        self.state.fitness.clear();
+    }
+
+    fn point(&self, k: usize) -> Vec<f64> {
+        self.state
+            .mean
+            .iter()
+            .zip(&self.state.population[k])
+            .map(|(m, y)| m + self.state.sigma * y)
+            .collect()
+    }
+
+    /// The generation's update, once all λ individuals are told.
+    fn update(&mut self) -> Result<()> {
+        let n = self.state.mean.len();
+        let nf = n as f64;
+        let p = self.params.clone();
+        let mut order: Vec<usize> = (0..p.lambda).collect();
+        order.sort_by(|&a, &b| self.state.fitness[a].total_cmp(&self.state.fitness[b]));
+        let ys: Vec<Vec<f64>> = order
+            .iter()
+            .map(|&k| self.state.population[k].clone())
+            .collect();
+        let mut yw = vec![0.0; n];
+        for (w, y) in p.weights[..p.mu].iter().zip(&ys) {
+            for (acc, yi) in yw.iter_mut().zip(y) {
+                *acc += w * yi;
+            }
+        }
+        let s = &mut self.state;
+        for (m, y) in s.mean.iter_mut().zip(&yw) {
+            *m += s.sigma * y;
+        }
+        let cinv_yw = self.inv_sqrt(&yw);
+        let s = &mut self.state;
+        let a = (p.cs * (2.0 - p.cs) * p.mu_eff).sqrt();
+        for (ps, c) in s.ps.iter_mut().zip(&cinv_yw) {
+            *ps = (1.0 - p.cs) * *ps + a * c;
+        }
+        let ps_norm = s.ps.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let g = (s.generation + 1) as i32;
+        let hsig =
+            ps_norm / (1.0 - (1.0 - p.cs).powi(2 * g)).sqrt() < (1.4 + 2.0 / (nf + 1.0)) * p.chi_n;
+        let hs = if hsig { 1.0 } else { 0.0 };
+        let b = (p.cc * (2.0 - p.cc) * p.mu_eff).sqrt();
+        for (pc, y) in s.pc.iter_mut().zip(&yw) {
+            *pc = (1.0 - p.cc) * *pc + hs * b * y;
+        }
+        // Weights with the negative ones rescaled by n/‖C^(−1/2)y‖².
+        let wo: Vec<f64> = p
+            .weights
+            .iter()
+            .zip(&ys)
+            .map(|(w, y)| {
+                if *w >= 0.0 {
+                    *w
+                } else {
+                    let c = self.inv_sqrt(y);
+                    w * nf / c.iter().map(|v| v * v).sum::<f64>().max(1e-300)
+                }
+            })
+            .collect();
+        let s = &mut self.state;
+        let sum_w: f64 = p.weights.iter().sum();
+        let delta = (1.0 - hs) * p.cc * (2.0 - p.cc);
+        let decay = 1.0 + p.c1 * delta - p.c1 - p.cmu * sum_w;
+        for i in 0..n {
+            for j in 0..n {
+                let rank_mu: f64 = wo.iter().zip(&ys).map(|(w, y)| w * y[i] * y[j]).sum();
+                s.cov[i * n + j] =
+                    decay * s.cov[i * n + j] + p.c1 * s.pc[i] * s.pc[j] + p.cmu * rank_mu;
+            }
+        }
+        s.sigma *= ((p.cs / p.damps) * (ps_norm / p.chi_n - 1.0))
+            .min(1.0)
+            .exp();
+        s.generation += 1;
+        let decomposed = self.decompose();
+        let (dmin, dmax) = self.d.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), d| {
+            (lo.min(*d), hi.max(*d))
+        });
+        let collapsed = decomposed.is_err()
+            || !self.state.sigma.is_finite()
+            || self.state.sigma * dmax < 1e-12 * self.state.config.sigma0
+            || dmax * dmax > 1e14 * dmin * dmin;
+        if collapsed {
+            self.restart()?;
+        }
+        self.sample();
+        Ok(())
+    }
+
+    /// IPOP restart from the best point with σ₀ and a doubled population.
+    fn restart(&mut self) -> Result<()> {
+        let n = self.state.mean.len();
+        let s = &mut self.state;
+        s.restarts += 1;
+        s.mean = s
+            .best
+            .as_ref()
+            .map_or_else(|| s.start.clone(), |b| b.0.clone());
+        s.sigma = s.config.sigma0;
+        s.cov = (0..n * n)
+            .map(|k| if k % (n + 1) == 0 { 1.0 } else { 0.0 })
+            .collect();
+        s.ps = vec![0.0; n];
+        s.pc = vec![0.0; n];
+        let base = if s.config.population > 0 {
+            s.config.population
+        } else {
+            4 + (3.0 * (n as f64).ln()).floor() as usize
+        };
+        self.params = Params::new(n, base << s.restarts.min(16));
+        self.decompose()
+    }
+}
+
+impl Optimizer for Cmaes {
+    fn name(&self) -> &'static str {
+        "cmaes"
+    }
+
+    fn dim(&self) -> usize {
+        self.state.mean.len()
+    }
+
+    fn ask(&mut self) -> Result<Vec<f64>> {
+        Ok(self.point(self.state.fitness.len()))
+    }
+
+    /// Told weights other than the asked ones are injected: their step (w − m)/σ replaces the
+    /// pending individual's.
+    fn tell(&mut self, weights: &[f64], reward: f64) -> Result<()> {
+        check_tell(self.dim(), weights, reward)?;
+        let k = self.state.fitness.len();
+        let mut w = weights.to_vec();
+        self.bounds.clamp(&mut w);
+        let y: Vec<f64> = w
+            .iter()
+            .zip(&self.state.mean)
+            .map(|(wi, m)| (wi - m) / self.state.sigma)
+            .collect();
+        self.state.population[k] = y;
+        self.state.fitness.push(-reward);
+        self.state.evaluations += 1;
+        if self.state.best.as_ref().is_none_or(|b| reward > b.1) {
+            self.state.best = Some((weights.to_vec(), reward));
+        }
+        if self.state.fitness.len() == self.params.lambda {
+            self.update()?;
+        }
+        Ok(())
+    }
+
+    fn best(&self) -> Option<(&[f64], f64)> {
+        self.state.best.as_ref().map(|(w, r)| (w.as_slice(), *r))
+    }
+
+    fn evaluations(&self) -> usize {
+        self.state.evaluations
+    }
+}

@@ -1,0 +1,113 @@
+//! Gaussian random search around the best point so far: w ~ N(w*, σ²I), clamped to the box.
+//! The floor every model-based method must beat.
+
+use rand_distr::{Distribution, Normal};
+use serde::{Deserialize, Serialize};
+
+use super::{Optimizer, SearchBox, check_tell, rng_for};
+use crate::error::{Error, Result};
+
+/// Settings of a random search.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RandomConfig {
+    /// Seed of every random choice.
+    pub seed: u64,
+    /// Standard deviation σ of the perturbations.
+    pub sigma: f64,
+    /// Half-width of the search box around the start.
+    pub box_radius: f64,
+}
+
+impl Default for RandomConfig {
+    fn default() -> Self {
+        RandomConfig {
+            seed: 0,
+            sigma: 0.1,
+            box_radius: super::DEFAULT_BOX_RADIUS,
+        }
+    }
+}
+
+/// Random search; its state is its settings, its start and what was told.
+#[derive(Debug, Clone)]
+pub struct RandomSearch {
+    config: RandomConfig,
+    start: Vec<f64>,
+    bounds: SearchBox,
+    evaluations: usize,
+    best: Option<(Vec<f64>, f64)>,
+    pending: Option<Vec<f64>>,
+}
+
+impl RandomSearch {
+    /// A search from `start` (asked first, unperturbed).
+    pub fn new(start: Vec<f64>, config: RandomConfig) -> Result<RandomSearch> {
+        if start.is_empty() || start.iter().any(|v| !v.is_finite()) {
+            return Err(Error::Domain(
+                "random search needs a finite start point of at least one weight".into(),
+            ));
+        }
+        if !(config.sigma.is_finite() && config.sigma > 0.0) {
+            return Err(Error::Domain(format!(
+                "σ must be positive, got {}",
+                config.sigma
+            )));
+        }
+        let bounds = SearchBox::around(&start, config.box_radius)?;
+        Ok(RandomSearch {
+            config,
+            start,
+            bounds,
+            evaluations: 0,
+            best: None,
+            pending: None,
+        })
+    }
+}
+
+impl Optimizer for RandomSearch {
+    fn name(&self) -> &'static str {
+        "random"
+    }
+
+    fn dim(&self) -> usize {
+        self.start.len()
+    }
+
+    fn ask(&mut self) -> Result<Vec<f64>> {
+        if let Some(p) = &self.pending {
+            return Ok(p.clone());
+        }
+        let centre = self.best.as_ref().map_or(&self.start, |b| &b.0);
+        let w = if self.evaluations == 0 {
+            self.start.clone()
+        } else {
+            let normal =
+                Normal::new(0.0, self.config.sigma).map_err(|e| Error::Domain(e.to_string()))?;
+            let mut rng = rng_for(self.config.seed, self.evaluations as u64);
+            let mut w: Vec<f64> = centre.iter().map(|c| c + normal.sample(&mut rng)).collect();
+            self.bounds.clamp(&mut w);
+            w
+        };
+        self.pending = Some(w.clone());
+        Ok(w)
+    }
+
+    fn tell(&mut self, weights: &[f64], reward: f64) -> Result<()> {
+        check_tell(self.dim(), weights, reward)?;
+        self.evaluations += 1;
+        if self.best.as_ref().is_none_or(|b| reward > b.1) {
+            self.best = Some((weights.to_vec(), reward));
+        }
+        self.pending = None;
+        Ok(())
+    }
+
+    fn best(&self) -> Option<(&[f64], f64)> {
+        self.best.as_ref().map(|(w, r)| (w.as_slice(), *r))
+    }
+
+    fn evaluations(&self) -> usize {
+        self.evaluations
+    }
+}
