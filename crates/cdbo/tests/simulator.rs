@@ -137,7 +137,7 @@ fn drive_straight(
             vehicle.shift(&mut s);
         }
         let k = track.index_at(s.x);
-        vehicle.step(&mut s, &c, track.sample(k), track.frame(k), dt);
+        vehicle.step(&mut s, &c, track.frame(k), dt);
     }
     (s, vehicle)
 }

@@ -242,13 +242,8 @@ impl Simulator {
                     });
                 }
             }
-            self.vehicle.step(
-                &mut state,
-                &controls,
-                track.sample(proj.index),
-                track.frame(proj.index),
-                cfg.dt,
-            );
+            self.vehicle
+                .step(&mut state, &controls, track.frame(proj.index), cfg.dt);
             step += 1;
             until_driver -= 1;
             let t = step as f64 * cfg.dt;
@@ -274,11 +269,10 @@ impl Simulator {
                 };
             }
             farthest = f64::max(farthest, distance);
-            let road = track.sample(proj.index);
-            let half_width = 0.5 * road.width + cfg.off_track_margin;
-            let failure = if proj.lateral.abs() > half_width {
+            let road = track.frame(proj.index);
+            let failure = if proj.lateral.abs() > road.half_width + cfg.off_track_margin {
                 Some(super::FailureReason::OffTrack)
-            } else if facing_away(&state, track.frame(proj.index))
+            } else if facing_away(&state, road)
                 || (state.vx < state.vy.abs() * INV_TAN_SPIN_SLIP_ANGLE
                     && state.speed() > SPIN_MIN_SPEED)
             {

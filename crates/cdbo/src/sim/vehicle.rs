@@ -24,7 +24,7 @@
 use super::powertrain::{EngineMap, Gearbox, ShiftMap};
 use super::tyre::TyreModel;
 use crate::car::{Car, Drive};
-use crate::track::{Frame, Sample};
+use crate::track::Frame;
 
 /// Gravity (m/s²).
 pub const G: f64 = 9.81;
@@ -205,8 +205,8 @@ impl Vehicle {
         self.driven[0] * s.omega[0] + self.driven[1] * s.omega[1]
     }
 
-    /// Advances the state by `dt` seconds on the road described by `road` and its `frame`.
-    pub fn step(&self, s: &mut State, c: &Controls, road: &Sample, frame: &Frame, dt: f64) {
+    /// Advances the state by `dt` seconds on the road described by `frame`.
+    pub fn step(&self, s: &mut State, c: &Controls, frame: &Frame, dt: f64) {
         let car = &self.car;
         let m = car.mass;
         let v2 = s.vx * s.vx + s.vy * s.vy;
@@ -256,7 +256,7 @@ impl Vehicle {
             let tyre = &self.tyres[k];
             let r = self.radius[k];
             let inv_denom = 1.0 / vt[k].abs().max(SLIP_SPEED_FLOOR);
-            let fmax = tyre.max_force(fz[k], road.friction);
+            let fmax = tyre.max_force(fz[k], frame.friction);
             let sx = (s.omega[k] * r - vt[k]) * inv_denom;
             let sy = -vl[k] * inv_denom;
             // ABS: ease the pressure while the wheel slides backwards past the threshold.

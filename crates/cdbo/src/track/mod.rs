@@ -67,14 +67,27 @@ pub struct Track {
     frames: Vec<Frame>,
 }
 
-/// Sines and cosines of a sample's angles, pre-computed once per track.
+/// What the physics step and the projection read of a sample, packed in one place and with
+/// its sines and cosines pre-computed once per track.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Frame {
-    /// sin and cos of the heading.
+    /// Station position (m).
+    pub x: f64,
+    /// Station position (m).
+    pub y: f64,
+    /// Arc length (m).
+    pub s: f64,
+    /// Curvature (1/m).
+    pub curvature: f64,
+    /// Half the road width (m).
+    pub half_width: f64,
+    /// Surface friction.
+    pub friction: f64,
+    /// sin of the heading.
     pub sin_heading: f64,
     /// cos of the heading.
     pub cos_heading: f64,
-    /// sin and cos of the road's pitch atan(grade).
+    /// sin of the road's pitch atan(grade).
     pub sin_pitch: f64,
     /// cos of the pitch.
     pub cos_pitch: f64,
@@ -90,6 +103,12 @@ impl Frame {
         let (sin_pitch, cos_pitch) = c.grade.atan().sin_cos();
         let (sin_banking, cos_banking) = c.banking.sin_cos();
         Frame {
+            x: c.x,
+            y: c.y,
+            s: c.s,
+            curvature: c.curvature,
+            half_width: 0.5 * c.width,
+            friction: c.friction,
             sin_heading,
             cos_heading,
             sin_pitch,
@@ -196,14 +215,14 @@ impl Track {
         let mut i = if hint < n { hint } else { hint % n };
         let half = 0.5 * self.ds;
         for _ in 0..n {
-            let c = &self.samples[i];
-            let (sin, cos) = (self.frames[i].sin_heading, self.frames[i].cos_heading);
+            let c = &self.frames[i];
+            let (sin, cos) = (c.sin_heading, c.cos_heading);
             let (dx, dy) = (x - c.x, y - c.y);
             let along = dx * cos + dy * sin;
             if along > half {
-                i = (i + 1) % n;
+                i = if i + 1 == n { 0 } else { i + 1 };
             } else if along < -half {
-                i = (i + n - 1) % n;
+                i = if i == 0 { n - 1 } else { i - 1 };
             } else {
                 // Second-order correction for the arc between stations (κ·along ≪ 1):
                 // lateral = l − κa²/2, station offset = a(1 + κl).
