@@ -365,3 +365,36 @@ fn bench_suggest_reports_its_keys() {
         assert!(v[key].as_f64().is_some(), "{key}");
     }
 }
+
+#[test]
+fn a_race_draws_its_figures() {
+    let out = std::env::temp_dir().join(format!("cdbo-cli-race-plots-{}", std::process::id()));
+    let run = cdbo(&[
+        "race",
+        "--laps",
+        "12",
+        "--kernels",
+        "8",
+        "--json",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    for name in ["learning_curve", "policy", "speed", "map"] {
+        assert_eq!(
+            &std::fs::read(out.join(format!("{name}.png"))).unwrap()[1..4],
+            b"PNG",
+            "{name}"
+        );
+        assert!(
+            std::fs::read_to_string(out.join(format!("{name}.svg")))
+                .unwrap()
+                .contains("<svg"),
+            "{name}"
+        );
+    }
+}

@@ -73,57 +73,56 @@ impl Figure for TrackMap<'_> {
     }
 }
 
-struct LapSpeed<'a> {
-    track: &'a Track,
-    lap: &'a LapResult,
-    limit: &'a Limit,
+/// A line chart: named series of (x, y) points.
+pub struct LineChart {
+    /// Title.
+    pub title: String,
+    /// Axis label.
+    pub x_label: String,
+    /// Axis label.
+    pub y_label: String,
+    /// (label, colour, points).
+    pub series: Vec<(String, RGBColor, Vec<(f64, f64)>)>,
 }
 
-/// Speed along the lap against the limit profile.
-pub fn lap_speed(path: &Path, track: &Track, lap: &LapResult, limit: &Limit) -> CliResult {
-    draw(path, &LapSpeed { track, lap, limit })
+impl LineChart {
+    fn ranges(&self) -> ((f64, f64), (f64, f64)) {
+        let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+        for &(x, y) in self.series.iter().flat_map(|s| s.2.iter()) {
+            (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
+        }
+        if x0 > x1 {
+            return ((0.0, 1.0), (0.0, 1.0));
+        }
+        let pad = 0.05 * (y1 - y0).max(1e-9);
+        ((x0, x1.max(x0 + 1e-9)), (y0 - pad, y1 + pad))
+    }
 }
 
-impl Figure for LapSpeed<'_> {
+impl Figure for LineChart {
     fn render<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> CliResult
     where
         DB::ErrorType: 'static,
     {
-        let (track, lap, limit) = (self.track, self.lap, self.limit);
-        let vmax = limit.speed.iter().copied().fold(10.0, f64::max) * 1.05;
+        let ((x0, x1), (y0, y1)) = self.ranges();
         let mut chart = ChartBuilder::on(root)
-            .caption(
-                format!("{}: speed along the lap", track.name),
-                ("sans-serif", 24),
-            )
+            .caption(&self.title, ("sans-serif", 24))
             .margin(15)
             .x_label_area_size(45)
             .y_label_area_size(60)
-            .build_cartesian_2d(0.0..track.length, 0.0..vmax)?;
+            .build_cartesian_2d(x0..x1, y0..y1)?;
         chart
             .configure_mesh()
-            .x_desc("distance (m)")
-            .y_desc("speed (m/s)")
+            .x_desc(&self.x_label)
+            .y_desc(&self.y_label)
             .draw()?;
-        let ds = track.ds;
-        chart
-            .draw_series(LineSeries::new(
-                limit
-                    .speed
-                    .iter()
-                    .enumerate()
-                    .map(|(i, v)| (i as f64 * ds, *v)),
-                RED.stroke_width(2),
-            ))?
-            .label("limit (QSS)")
-            .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED));
-        chart
-            .draw_series(LineSeries::new(
-                lap.trace.iter().map(|p| (p.distance_m, p.speed)),
-                BLUE.stroke_width(2),
-            ))?
-            .label("lap")
-            .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLUE));
+        for (label, colour, points) in &self.series {
+            let c = *colour;
+            chart
+                .draw_series(LineSeries::new(points.iter().copied(), c.stroke_width(2)))?
+                .label(label)
+                .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], c.stroke_width(2)));
+        }
         chart
             .configure_series_labels()
             .border_style(BLACK)
@@ -131,6 +130,55 @@ impl Figure for LapSpeed<'_> {
             .draw()?;
         Ok(())
     }
+}
+
+/// Speed along the lap against the limit profile.
+pub fn lap_speed(path: &Path, track: &Track, lap: &LapResult, limit: &Limit) -> CliResult {
+    draw(path, &speed_chart(track, &[("lap", BLUE, lap)], limit))
+}
+
+/// Speeds of several laps along the track with the limit's profile (paper Fig. 3b).
+pub fn speed_chart(
+    track: &Track,
+    laps: &[(&str, RGBColor, &LapResult)],
+    limit: &Limit,
+) -> LineChart {
+    let ds = track.ds;
+    let mut series = vec![(
+        "limit (QSS)".to_owned(),
+        RED,
+        limit
+            .speed
+            .iter()
+            .enumerate()
+            .map(|(i, v)| (i as f64 * ds, *v))
+            .collect(),
+    )];
+    for (label, colour, lap) in laps {
+        series.push((
+            (*label).to_owned(),
+            *colour,
+            lap.trace.iter().map(|p| (p.distance_m, p.speed)).collect(),
+        ));
+    }
+    LineChart {
+        title: format!("{}: speed along the lap", track.name),
+        x_label: "distance (m)".into(),
+        y_label: "speed (m/s)".into(),
+        series,
+    }
+}
+
+/// The track map coloured by a lap's speed.
+pub fn speed_map(path: &Path, track: &Track, lap: &LapResult) -> CliResult {
+    let speeds: Vec<(f64, f64)> = lap.trace.iter().map(|p| (p.distance_m, p.speed)).collect();
+    draw(
+        path,
+        &TrackMap {
+            track,
+            speeds: Some(&speeds),
+        },
+    )
 }
 
 fn track_map<DB: DrawingBackend>(

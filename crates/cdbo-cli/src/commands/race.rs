@@ -109,6 +109,7 @@ pub fn run(args: &RaceArgs, data: &DataPath) -> CliResult {
     bar.finish_and_clear();
     let wall_s = start.elapsed().as_secs_f64();
     write_outputs(&out, &outcome)?;
+    write_plots(&out, track, &car, &outcome)?;
     let best_lap = outcome
         .laps
         .iter()
@@ -209,6 +210,76 @@ fn write_outputs(out: &Path, o: &RaceOutcome) -> CliResult {
     laps.flush()?;
     write_policy(out, "best_policy", &o.best)?;
     write_policy(out, "initial_policy", &o.initial)?;
+    Ok(())
+}
+
+/// The learning curve, the policies (paper Fig. 3a), the speeds (Fig. 3b) and the map, as PNG
+/// and SVG.
+fn write_plots(
+    out: &Path,
+    track: cdbo::track::Track,
+    car: &cdbo::car::Car,
+    o: &RaceOutcome,
+) -> CliResult {
+    use super::plot::{LineChart, draw, speed_chart, speed_map};
+    use plotters::style::{BLACK, BLUE, GREEN, RED};
+    let mut sim = cdbo::sim::Simulator::new(track, car);
+    sim.config.trace = true;
+    let initial_lap = sim.lap(&mut o.initial.clone());
+    let best_lap = sim.lap(&mut o.best.clone());
+    let n = o.laps.len() as f64;
+    let flat = |v: f64| vec![(1.0, v), (n, v)];
+    let curve = LineChart {
+        title: format!("{}: best reward per lap", sim.track.name),
+        x_label: "lap".into(),
+        y_label: "reward L/T (m/s)".into(),
+        series: vec![
+            (
+                "best so far".into(),
+                BLUE,
+                o.laps.iter().map(|l| (l.lap as f64, l.best_mps)).collect(),
+            ),
+            ("demonstration".into(), BLACK, flat(o.demo.reward_mps)),
+            ("limit (QSS)".into(), RED, flat(o.limit.reward_mps)),
+        ],
+    };
+    let xs = (0..=500).map(|i| i as f64 / 500.0);
+    let policies = LineChart {
+        title: "Policies: throttle (+) / brake (−) along the lap".into(),
+        x_label: "x (fraction of the lap)".into(),
+        y_label: "a".into(),
+        series: vec![
+            (
+                "demonstration".into(),
+                BLACK,
+                o.demo_pairs.iter().step_by(5).copied().collect(),
+            ),
+            (
+                "initial π(w₀)".into(),
+                GREEN,
+                xs.clone().map(|x| (x, o.initial.action(x))).collect(),
+            ),
+            (
+                "best".into(),
+                BLUE,
+                xs.map(|x| (x, o.best.action(x))).collect(),
+            ),
+        ],
+    };
+    let speeds = speed_chart(
+        &sim.track,
+        &[
+            ("initial policy", GREEN, &initial_lap),
+            ("best policy", BLUE, &best_lap),
+        ],
+        &o.limit,
+    );
+    for ext in ["png", "svg"] {
+        draw(&out.join(format!("learning_curve.{ext}")), &curve)?;
+        draw(&out.join(format!("policy.{ext}")), &policies)?;
+        draw(&out.join(format!("speed.{ext}")), &speeds)?;
+        speed_map(&out.join(format!("map.{ext}")), &sim.track, &best_lap)?;
+    }
     Ok(())
 }
 
