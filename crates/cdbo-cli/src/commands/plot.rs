@@ -73,6 +73,9 @@ impl Figure for TrackMap<'_> {
     }
 }
 
+/// One line of a chart: its legend label, its colour and its points.
+pub type Series = (String, RGBColor, Vec<(f64, f64)>);
+
 /// A line chart: named series of (x, y) points.
 pub struct LineChart {
     /// Title.
@@ -82,7 +85,7 @@ pub struct LineChart {
     /// Axis label.
     pub y_label: String,
     /// (label, colour, points).
-    pub series: Vec<(String, RGBColor, Vec<(f64, f64)>)>,
+    pub series: Vec<Series>,
 }
 
 impl LineChart {
