@@ -15,14 +15,19 @@ fn shared() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared")
 }
 
-fn json(args: &[&str]) -> serde_json::Value {
+/// Runs and expects success.
+fn succeed(args: &[&str]) -> Output {
     let out = cdbo(args);
     assert!(
         out.status.success(),
-        "{}",
+        "{args:?}: {}",
         String::from_utf8_lossy(&out.stderr)
     );
-    serde_json::from_slice(&out.stdout).expect("JSON")
+    out
+}
+
+fn json(args: &[&str]) -> serde_json::Value {
+    serde_json::from_slice(&succeed(args).stdout).expect("JSON")
 }
 
 /// A scratch file with `content`, unique to this test.
@@ -97,22 +102,17 @@ fn traces_and_plots_are_written() {
     let trace = scratch("lap.csv", "");
     let png = scratch("lap.png", "");
     let svg = scratch("map.svg", "");
-    let out = cdbo(&[
+    succeed(&[
         "lap",
         "--trace",
         trace.to_str().unwrap(),
         "--plot",
         png.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let text = std::fs::read_to_string(&trace).unwrap();
     assert!(text.starts_with("t_s,distance_m,x,speed_mps") && text.lines().count() > 1000);
     assert_eq!(&std::fs::read(&png).unwrap()[1..4], b"PNG");
-    let out = cdbo(&[
+    succeed(&[
         "plot",
         "track",
         "ridgeway",
@@ -121,11 +121,6 @@ fn traces_and_plots_are_written() {
         "--trace",
         trace.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     assert!(std::fs::read_to_string(&svg).unwrap().contains("<svg"));
 }
 
@@ -281,10 +276,9 @@ fn a_short_race_writes_its_results() {
 #[test]
 fn policies_fit_to_a_trace_and_print_tables() {
     let trace = scratch("demo-trace.csv", "");
-    let out = cdbo(&["lap", "--trace", trace.to_str().unwrap()]);
-    assert!(out.status.success());
+    succeed(&["lap", "--trace", trace.to_str().unwrap()]);
     let weights = scratch("w0.json", "");
-    let out = cdbo(&[
+    succeed(&[
         "policy",
         "fit",
         "--demo",
@@ -294,12 +288,7 @@ fn policies_fit_to_a_trace_and_print_tables() {
         "-o",
         weights.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let out = cdbo(&[
+    let out = succeed(&[
         "policy",
         "table",
         weights.to_str().unwrap(),
@@ -369,7 +358,7 @@ fn bench_suggest_reports_its_keys() {
 #[test]
 fn a_race_draws_its_figures() {
     let out = std::env::temp_dir().join(format!("cdbo-cli-race-plots-{}", std::process::id()));
-    let run = cdbo(&[
+    succeed(&[
         "race",
         "--laps",
         "12",
@@ -379,11 +368,6 @@ fn a_race_draws_its_figures() {
         "--out",
         out.to_str().unwrap(),
     ]);
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
     for name in ["learning_curve", "policy", "speed", "map"] {
         assert_eq!(
             &std::fs::read(out.join(format!("{name}.png"))).unwrap()[1..4],

@@ -156,32 +156,13 @@ mod tests {
     use crate::track::{Piece, Track};
 
     fn straight(length: f64) -> Track {
-        let p = Piece {
-            length,
-            curvature: 0.0,
-            z0: 0.0,
-            z1: 0.0,
-            banking0: 0.0,
-            banking1: 0.0,
-            width: 12.0,
-            friction: 1.0,
-        };
-        Track::from_pieces("straight", "test", &[p], vec![])
+        Track::from_pieces("straight", "test", &[Piece::flat(length, 0.0)], vec![])
     }
 
     #[test]
     fn a_flat_circle_is_driven_at_the_grip_limit() {
         let r = 100.0;
-        let p = Piece {
-            length: std::f64::consts::TAU * r,
-            curvature: 1.0 / r,
-            z0: 0.0,
-            z1: 0.0,
-            banking0: 0.0,
-            banking1: 0.0,
-            width: 12.0,
-            friction: 1.0,
-        };
+        let p = Piece::flat(std::f64::consts::TAU * r, 1.0 / r);
         let t = Track::from_pieces("circle", "test", &[p], vec![]);
         let car = Car::spirit_300();
         let lim = limit_lap(&t, &car);

@@ -99,17 +99,7 @@ fn same_inputs_give_bit_identical_laps() {
 }
 
 fn straight(length: f64) -> Track {
-    let p = Piece {
-        length,
-        curvature: 0.0,
-        z0: 0.0,
-        z1: 0.0,
-        banking0: 0.0,
-        banking1: 0.0,
-        width: 12.0,
-        friction: 1.0,
-    };
-    Track::from_pieces("straight", "test", &[p], vec![])
+    Track::from_pieces("straight", "test", &[Piece::flat(length, 0.0)], vec![])
 }
 
 /// Drives the bare vehicle model straight ahead with fixed pedals for `seconds`.

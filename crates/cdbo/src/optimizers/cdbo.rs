@@ -15,7 +15,7 @@ use rand_distr::{Distribution, Normal};
 use serde::{Deserialize, Serialize};
 
 use super::coordinate_ascent::{AxisSearch, GpAcquisition, maximise};
-use super::{Optimizer, SearchBox, check_tell, rng_for};
+use super::{Best, Optimizer, SearchBox, check_tell, rng_for};
 use crate::acquisition::Acquisition;
 use crate::acquisition::ucb::DEFAULT_BETA;
 use crate::error::{Error, Result};
@@ -102,7 +102,7 @@ pub struct Cdbo {
     state: CdboState,
     bounds: SearchBox,
     gp: GaussianProcess,
-    best: Option<(Vec<f64>, f64)>,
+    best: Best,
     /// The pending suggestion and the length-scale bound it was made under.
     pending: Option<(Vec<f64>, f64)>,
     last_fit_at: usize,
@@ -180,7 +180,7 @@ impl Cdbo {
             state,
             bounds,
             gp,
-            best: None,
+            best: Best::default(),
             pending: None,
             last_fit_at: 0,
             last_af_evaluations: 0,
@@ -274,7 +274,7 @@ impl Cdbo {
             return Ok(w);
         }
         self.maybe_refit()?;
-        let start = self.best.as_ref().map_or(&self.state.w0, |b| &b.0).clone();
+        let start = self.best.get().map_or(&self.state.w0[..], |b| b.0).to_vec();
         let mut objective = GpAcquisition::new(&self.gp, self.state.config.acquisition, &start);
         let ascent = maximise(
             &mut objective,
@@ -321,15 +321,13 @@ impl Optimizer for Cdbo {
             .map_or(self.state.lengthscale_max, |(_, b)| b);
         self.state.bounds_used.push(bound);
         self.state.hyper = self.gp.hyper().clone();
-        if self.best.as_ref().is_none_or(|b| reward > b.1) {
-            self.best = Some((weights.to_vec(), reward));
-        }
+        self.best.offer(weights, reward);
         self.pending = None;
         Ok(())
     }
 
     fn best(&self) -> Option<(&[f64], f64)> {
-        self.best.as_ref().map(|(w, r)| (w.as_slice(), *r))
+        self.best.get()
     }
 
     fn evaluations(&self) -> usize {

@@ -18,7 +18,7 @@ use faer::{Mat, Side};
 use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
 
-use super::{Optimizer, SearchBox, check_tell, rng_for};
+use super::{Best, Optimizer, SearchBox, check_tell, rng_for};
 use crate::error::{Error, Result};
 
 /// Settings of a CMA-ES run.
@@ -142,7 +142,7 @@ pub struct CmaesState {
     /// Rewards told in total.
     pub evaluations: usize,
     /// The best (weights, reward) told.
-    pub best: Option<(Vec<f64>, f64)>,
+    pub best: Best,
     /// IPOP restarts so far (the population is λ·2^restarts).
     pub restarts: u32,
 }
@@ -187,7 +187,7 @@ impl Cmaes {
             population: Vec::new(),
             fitness: Vec::new(),
             evaluations: 0,
-            best: None,
+            best: Best::default(),
             restarts: 0,
             start,
             config,
@@ -392,10 +392,7 @@ impl Cmaes {
         let n = self.state.mean.len();
         let s = &mut self.state;
         s.restarts += 1;
-        s.mean = s
-            .best
-            .as_ref()
-            .map_or_else(|| s.start.clone(), |b| b.0.clone());
+        s.mean = s.best.get().map_or(&s.start[..], |b| b.0).to_vec();
         s.sigma = s.config.sigma0;
         s.cov = (0..n * n)
             .map(|k| if k % (n + 1) == 0 { 1.0 } else { 0.0 })
@@ -440,9 +437,7 @@ impl Optimizer for Cmaes {
         self.state.population[k] = y;
         self.state.fitness.push(-reward);
         self.state.evaluations += 1;
-        if self.state.best.as_ref().is_none_or(|b| reward > b.1) {
-            self.state.best = Some((weights.to_vec(), reward));
-        }
+        self.state.best.offer(weights, reward);
         if self.state.fitness.len() == self.params.lambda {
             self.update()?;
         }
@@ -450,7 +445,7 @@ impl Optimizer for Cmaes {
     }
 
     fn best(&self) -> Option<(&[f64], f64)> {
-        self.state.best.as_ref().map(|(w, r)| (w.as_slice(), *r))
+        self.state.best.get()
     }
 
     fn evaluations(&self) -> usize {

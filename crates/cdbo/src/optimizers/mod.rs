@@ -109,6 +109,26 @@ impl SearchBox {
     }
 }
 
+/// The best (weights, reward) told so far.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Best(Option<(Vec<f64>, f64)>);
+
+impl Best {
+    /// Records (weights, reward) if it beats the best; returns whether it did.
+    pub fn offer(&mut self, weights: &[f64], reward: f64) -> bool {
+        let better = self.0.as_ref().is_none_or(|b| reward > b.1);
+        if better {
+            self.0 = Some((weights.to_vec(), reward));
+        }
+        better
+    }
+
+    /// The best weights and reward.
+    pub fn get(&self) -> Option<(&[f64], f64)> {
+        self.0.as_ref().map(|(w, r)| (w.as_slice(), *r))
+    }
+}
+
 /// Checks a told (weights, reward) pair against the dimension.
 pub fn check_tell(dim: usize, weights: &[f64], reward: f64) -> Result<()> {
     if weights.len() != dim {

@@ -4,7 +4,7 @@
 use rand_distr::{Distribution, Normal};
 use serde::{Deserialize, Serialize};
 
-use super::{Optimizer, SearchBox, check_tell, rng_for};
+use super::{Best, Optimizer, SearchBox, check_tell, rng_for};
 use crate::error::{Error, Result};
 
 /// Settings of a random search.
@@ -35,7 +35,7 @@ pub struct RandomSearch {
     start: Vec<f64>,
     bounds: SearchBox,
     evaluations: usize,
-    best: Option<(Vec<f64>, f64)>,
+    best: Best,
     pending: Option<Vec<f64>>,
 }
 
@@ -59,7 +59,7 @@ impl RandomSearch {
             start,
             bounds,
             evaluations: 0,
-            best: None,
+            best: Best::default(),
             pending: None,
         })
     }
@@ -78,7 +78,7 @@ impl Optimizer for RandomSearch {
         if let Some(p) = &self.pending {
             return Ok(p.clone());
         }
-        let centre = self.best.as_ref().map_or(&self.start, |b| &b.0);
+        let centre = self.best.get().map_or(&self.start[..], |b| b.0);
         let w = if self.evaluations == 0 {
             self.start.clone()
         } else {
@@ -96,15 +96,13 @@ impl Optimizer for RandomSearch {
     fn tell(&mut self, weights: &[f64], reward: f64) -> Result<()> {
         check_tell(self.dim(), weights, reward)?;
         self.evaluations += 1;
-        if self.best.as_ref().is_none_or(|b| reward > b.1) {
-            self.best = Some((weights.to_vec(), reward));
-        }
+        self.best.offer(weights, reward);
         self.pending = None;
         Ok(())
     }
 
     fn best(&self) -> Option<(&[f64], f64)> {
-        self.best.as_ref().map(|(w, r)| (w.as_slice(), *r))
+        self.best.get()
     }
 
     fn evaluations(&self) -> usize {

@@ -360,6 +360,22 @@ pub struct Piece {
     pub friction: f64,
 }
 
+impl Piece {
+    /// A level, unbanked piece 12 m wide on a friction-1 surface.
+    pub fn flat(length: f64, curvature: f64) -> Piece {
+        Piece {
+            length,
+            curvature,
+            z0: 0.0,
+            z1: 0.0,
+            banking0: 0.0,
+            banking1: 0.0,
+            width: 12.0,
+            friction: 1.0,
+        }
+    }
+}
+
 /// Moves a pose along a circular arc of curvature `k` by arc length `d`:
 /// θ' = θ + k·d, x' = x + (sin θ' − sin θ)/k, y' = y − (cos θ' − cos θ)/k (a line when k = 0).
 #[inline]
@@ -382,14 +398,8 @@ mod tests {
 
     fn circle(radius: f64) -> Track {
         let p = Piece {
-            length: std::f64::consts::TAU * radius,
-            curvature: 1.0 / radius,
-            z0: 0.0,
-            z1: 0.0,
-            banking0: 0.0,
-            banking1: 0.0,
             width: 10.0,
-            friction: 1.0,
+            ..Piece::flat(std::f64::consts::TAU * radius, 1.0 / radius)
         };
         Track::from_pieces("circle", "test", &[p], vec![])
     }
