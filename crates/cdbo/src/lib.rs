@@ -21,6 +21,7 @@ pub mod drive;
 pub mod error;
 pub mod experiment;
 pub mod gp;
+pub mod interp;
 pub mod limit;
 pub mod optimizers;
 pub mod params;

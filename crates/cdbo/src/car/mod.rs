@@ -196,15 +196,7 @@ impl Car {
         if omega >= self.rev_limiter {
             return 0.0;
         }
-        let c = &self.torque_curve;
-        match c.partition_point(|&(w, _)| w <= omega) {
-            0 => c[0].1,
-            i if i == c.len() => c[i - 1].1,
-            i => {
-                let ((w0, t0), (w1, t1)) = (c[i - 1], c[i]);
-                t0 + (t1 - t0) * (omega - w0) / (w1 - w0)
-            }
-        }
+        crate::interp::linear(&self.torque_curve, omega)
     }
 
     /// Largest full-throttle torque between idle and the rev limiter (N·m).

@@ -72,15 +72,7 @@ impl PolicyTable {
 
     /// π(x).
     pub fn action(&self, x: f64) -> f64 {
-        let p = &self.points;
-        match p.partition_point(|&(xi, _)| xi <= x) {
-            0 => p[0].1,
-            i if i == p.len() => p[i - 1].1,
-            i => {
-                let ((x0, a0), (x1, a1)) = (p[i - 1], p[i]);
-                a0 + (a1 - a0) * (x - x0) / (x1 - x0)
-            }
-        }
+        crate::interp::linear(&self.points, x)
     }
 }
 

@@ -97,14 +97,7 @@ impl EngineMap {
         while i < c.len() && c[i].0 <= omega {
             i += 1;
         }
-        match i {
-            0 => c[0].1,
-            i if i == c.len() => c[i - 1].1,
-            i => {
-                let ((w0, t0), (w1, t1)) = (c[i - 1], c[i]);
-                t0 + (t1 - t0) * (omega - w0) / (w1 - w0)
-            }
-        }
+        crate::interp::linear_at(c, i, omega)
     }
 }
 
