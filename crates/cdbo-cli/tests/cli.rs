@@ -382,3 +382,39 @@ fn a_race_draws_its_figures() {
         );
     }
 }
+
+#[test]
+fn bench_optimizers_compares_every_method() {
+    let v = json(&[
+        "bench",
+        "optimizers",
+        "--problem",
+        "ackley",
+        "--dims",
+        "5",
+        "--evals",
+        "15",
+        "--seeds",
+        "2",
+        "--json",
+    ]);
+    let results = v["results"].as_array().unwrap();
+    let methods: Vec<&str> = results
+        .iter()
+        .map(|r| r["method"].as_str().unwrap())
+        .collect();
+    assert_eq!(methods, ["cdbo", "cmaes", "random"]);
+    for r in results {
+        assert!(
+            r["mean_best"].as_f64().unwrap() <= 0.0 && r["stderr_best"].as_f64().unwrap() >= 0.0
+        );
+    }
+    fails_with(
+        &["bench", "optimizers", "--problem", "nope"],
+        &["unknown problem", "hartmann6"],
+    );
+    fails_with(
+        &["bench", "optimizers", "--methods", "simplex"],
+        &["unknown method", "cdbo"],
+    );
+}

@@ -48,6 +48,58 @@ pub fn ackley(x: &[f64]) -> f64 {
     -(-20.0 * (-0.2 * sq.sqrt()).exp() - cos.exp() + 20.0 + std::f64::consts::E)
 }
 
+/// A test problem as the optimisers meet it: a reward to maximise over a box around a start.
+#[derive(Debug, Clone)]
+pub struct Problem {
+    /// Name.
+    pub name: String,
+    /// The start point w₀ (the box's centre).
+    pub start: Vec<f64>,
+    /// Half-width of the box.
+    pub radius: f64,
+    /// Dimensions that matter (for functions embedded in more dimensions).
+    effective: Vec<usize>,
+    reward: Reward,
+}
+
+/// A reward function of the effective coordinates.
+type Reward = fn(&[f64]) -> f64;
+
+/// The problems [`Problem::by_name`] knows.
+pub const PROBLEMS: &[&str] = &["hartmann6", "rosenbrock", "ackley"];
+
+impl Problem {
+    /// `hartmann6` (embedded in `dims` ≥ 6 dimensions on [0, 1], start 0.5), `rosenbrock` and
+    /// `ackley` (on [start − 2, start + 2], starts −0.5 and 1.2).
+    pub fn by_name(name: &str, dims: usize) -> Option<Problem> {
+        let all: Vec<usize> = (0..dims).collect();
+        let (start, radius, reward, effective) = match name {
+            "hartmann6" if dims >= 6 => (
+                0.5,
+                0.5,
+                hartmann6 as Reward,
+                (0..6).map(|k| k * dims / 6 + (dims / 12)).collect(),
+            ),
+            "rosenbrock" if dims >= 2 => (-0.5, 2.0, rosenbrock as Reward, all),
+            "ackley" if dims >= 1 => (1.2, 2.0, ackley as Reward, all),
+            _ => return None,
+        };
+        Some(Problem {
+            name: name.to_owned(),
+            start: vec![start; dims],
+            radius,
+            effective,
+            reward,
+        })
+    }
+
+    /// The reward at w.
+    pub fn reward(&self, w: &[f64]) -> f64 {
+        let x: Vec<f64> = self.effective.iter().map(|&d| w[d]).collect();
+        (self.reward)(&x)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

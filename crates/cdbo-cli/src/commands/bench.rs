@@ -14,6 +14,47 @@ pub enum BenchCommand {
     Sim(SimArgs),
     /// Time of one CDBO suggestion on a GP with N observations in D dimensions.
     Suggest(SuggestArgs),
+    /// Every method on a test problem: mean ± standard error of the best value, and time.
+    Optimizers(OptimizersArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct OptimizersArgs {
+    /// Problem: hartmann6 (embedded in --dims), rosenbrock, ackley.
+    #[arg(long, default_value = "hartmann6")]
+    problem: String,
+    /// Dimensions.
+    #[arg(long, default_value_t = 100)]
+    dims: usize,
+    /// Evaluations per run.
+    #[arg(long, default_value_t = 60)]
+    evals: usize,
+    /// Seeds (runs per method).
+    #[arg(long, default_value_t = 10)]
+    seeds: u64,
+    /// Methods, comma-separated.
+    #[arg(long, value_delimiter = ',', default_values_t = cdbo::optimizers::METHODS.iter().map(|m| m.to_string()).collect::<Vec<_>>())]
+    methods: Vec<String>,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Debug, Serialize)]
+struct MethodResult {
+    method: String,
+    mean_best: f64,
+    stderr_best: f64,
+    mean_seconds: f64,
+}
+
+#[derive(Debug, Serialize)]
+struct OptimizersBench {
+    problem: String,
+    dims: usize,
+    evals: usize,
+    seeds: u64,
+    results: Vec<MethodResult>,
 }
 
 #[derive(Debug, Args)]
@@ -75,7 +116,74 @@ pub fn run(cmd: &BenchCommand, data: &DataPath) -> CliResult {
     match cmd {
         BenchCommand::Sim(args) => sim(args, data),
         BenchCommand::Suggest(args) => suggest(args),
+        BenchCommand::Optimizers(args) => optimizers(args),
     }
+}
+
+/// Runs each method `seeds` times on the problem and reports the best values found.
+fn optimizers(args: &OptimizersArgs) -> CliResult {
+    use cdbo::benchmarks::{PROBLEMS, Problem};
+    let problem = Problem::by_name(&args.problem, args.dims).ok_or_else(|| {
+        format!(
+            "unknown problem {:?} in {} dimensions (available: {})",
+            args.problem,
+            args.dims,
+            PROBLEMS.join(", ")
+        )
+    })?;
+    if args.evals == 0 || args.seeds == 0 {
+        return Err("--evals and --seeds must be at least 1".into());
+    }
+    let mut results = Vec::new();
+    for method in &args.methods {
+        let (mut bests, mut seconds) = (Vec::new(), 0.0);
+        for seed in 0..args.seeds {
+            let mut opt = cdbo::optimizers::by_name(
+                method,
+                problem.start.clone(),
+                seed,
+                cdbo::acquisition::ucb::DEFAULT_BETA,
+                problem.radius,
+            )?;
+            let start = std::time::Instant::now();
+            for _ in 0..args.evals {
+                let w = opt.ask()?;
+                opt.tell(&w, problem.reward(&w))?;
+            }
+            seconds += start.elapsed().as_secs_f64();
+            bests.push(opt.best().map_or(f64::NAN, |b| b.1));
+        }
+        let k = bests.len() as f64;
+        let mean = bests.iter().sum::<f64>() / k;
+        let var = bests.iter().map(|b| (b - mean).powi(2)).sum::<f64>() / (k - 1.0).max(1.0);
+        results.push(MethodResult {
+            method: method.clone(),
+            mean_best: mean,
+            stderr_best: (var / k).sqrt(),
+            mean_seconds: seconds / k,
+        });
+    }
+    let b = OptimizersBench {
+        problem: args.problem.clone(),
+        dims: args.dims,
+        evals: args.evals,
+        seeds: args.seeds,
+        results,
+    };
+    if args.json {
+        return print_json(&b);
+    }
+    println!(
+        "{} in {} dimensions, {} evaluations, {} seeds (higher is better):",
+        b.problem, b.dims, b.evals, b.seeds
+    );
+    for r in &b.results {
+        println!(
+            "  {:<8} best {:>10.4} ± {:.4}   {:.3} s per run",
+            r.method, r.mean_best, r.stderr_best, r.mean_seconds
+        );
+    }
+    Ok(())
 }
 
 /// A GP of `observations` points around w₀ = 0 with a smooth synthetic reward, hyperparameters

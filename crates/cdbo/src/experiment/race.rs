@@ -117,6 +117,7 @@ pub fn race(
         initial.weights.clone(),
         config.seed,
         config.beta,
+        crate::optimizers::DEFAULT_BOX_RADIUS,
     )?;
     let mut laps = Vec::with_capacity(config.laps);
     let mut best = (initial.clone(), 0.0);

@@ -38,14 +38,22 @@ pub trait Optimizer {
 /// The methods [`by_name`] knows.
 pub const METHODS: &[&str] = &["cdbo", "cmaes", "random"];
 
-/// An optimiser by its command-line name, from w₀, a seed and the UCB β (used by the BO
-/// methods).
-pub fn by_name(name: &str, w0: Vec<f64>, seed: u64, beta: f64) -> Result<Box<dyn Optimizer>> {
+/// An optimiser by its command-line name, from w₀, a seed, the UCB β (used by the BO methods)
+/// and the half-width r of the search box around w₀; the evolution strategies start with
+/// σ = r/15 (0.1 for the policy box).
+pub fn by_name(
+    name: &str,
+    w0: Vec<f64>,
+    seed: u64,
+    beta: f64,
+    box_radius: f64,
+) -> Result<Box<dyn Optimizer>> {
     Ok(match name {
         "cdbo" => {
             let config = cdbo::CdboConfig {
                 seed,
                 acquisition: crate::acquisition::Acquisition::Ucb { beta },
+                box_radius,
                 ..cdbo::CdboConfig::default()
             };
             Box::new(cdbo::Cdbo::new(w0, config)?)
@@ -53,8 +61,8 @@ pub fn by_name(name: &str, w0: Vec<f64>, seed: u64, beta: f64) -> Result<Box<dyn
         "cmaes" => {
             let config = cmaes::CmaesConfig {
                 seed,
-                sigma0: 0.1,
-                box_radius: Some(DEFAULT_BOX_RADIUS),
+                sigma0: box_radius / 15.0,
+                box_radius: Some(box_radius),
                 ..cmaes::CmaesConfig::default()
             };
             Box::new(cmaes::Cmaes::new(w0, config)?)
@@ -63,7 +71,8 @@ pub fn by_name(name: &str, w0: Vec<f64>, seed: u64, beta: f64) -> Result<Box<dyn
             w0,
             random::RandomConfig {
                 seed,
-                ..random::RandomConfig::default()
+                sigma: box_radius / 15.0,
+                box_radius,
             },
         )?),
         other => {
