@@ -202,7 +202,7 @@ fn bad_track_files_give_one_clear_error() {
 #[test]
 fn a_short_race_writes_its_results() {
     let out = std::env::temp_dir().join(format!("cdbo-cli-race-{}", std::process::id()));
-    let v = json(&[
+    let args = &[
         "race",
         "--laps",
         "15",
@@ -213,7 +213,8 @@ fn a_short_race_writes_its_results() {
         "--json",
         "--out",
         out.to_str().unwrap(),
-    ]);
+    ];
+    let v = json(args);
     for key in [
         "method",
         "track",
@@ -258,18 +259,7 @@ fn a_short_race_writes_its_results() {
             > 100
     );
     // Same seed, same race.
-    let again = json(&[
-        "race",
-        "--laps",
-        "15",
-        "--kernels",
-        "10",
-        "--seed",
-        "3",
-        "--json",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let again = json(args);
     assert_eq!(again["best_reward_mps"], v["best_reward_mps"]);
 }
 
