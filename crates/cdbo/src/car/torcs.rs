@@ -178,10 +178,13 @@ pub fn from_params(p: &Params) -> Result<Car> {
         }
     };
     let diff = |name: &str| sec(name).num_or(f, "ratio", 1.0);
-    let final_drive = match drive {
-        Drive::Rear => diff("Rear Differential")?,
-        Drive::Front => diff("Front Differential")?,
-        Drive::All => diff("Central Differential")? * diff("Rear Differential")?,
+    let (final_drive, differential) = match drive {
+        Drive::Rear => (diff("Rear Differential")?, "Rear Differential"),
+        Drive::Front => (diff("Front Differential")?, "Front Differential"),
+        Drive::All => (
+            diff("Central Differential")? * diff("Rear Differential")?,
+            "Central Differential",
+        ),
     };
 
     let tyre = |name: &str| -> Result<Tyre> {
@@ -229,7 +232,7 @@ pub fn from_params(p: &Params) -> Result<Car> {
         tickover,
         engine_inertia,
         gears,
-        final_drive: positive(sec("Rear Differential"), "ratio", final_drive)?,
+        final_drive: positive(sec(differential), "ratio", final_drive)?,
         shift_time,
         drive,
         front_tyre: tyre("Front Right Wheel")?,
