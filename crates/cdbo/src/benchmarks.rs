@@ -28,6 +28,17 @@ pub fn hartmann6(x: &[f64]) -> f64 {
         .sum()
 }
 
+/// Branin on [0, 1]² (rescaled from x₁ ∈ [−5, 10], x₂ ∈ [0, 15]), minimum 0.397887 at three
+/// points, e.g. (π, 2.275) → (0.542773, 0.151667); returned negated.
+pub fn branin(u: &[f64]) -> f64 {
+    use std::f64::consts::PI;
+    let (x1, x2) = (15.0 * u[0] - 5.0, 15.0 * u[1]);
+    let b = 5.1 / (4.0 * PI * PI);
+    let c = 5.0 / PI;
+    let t = 1.0 / (8.0 * PI);
+    -((x2 - b * x1 * x1 + c * x1 - 6.0).powi(2) + 10.0 * (1.0 - t) * x1.cos() + 10.0)
+}
+
 /// Rosenbrock in any dimension, Σ 100(x_{i+1} − x_i²)² + (1 − x_i)², minimum 0 at (1, …, 1);
 /// returned negated.
 pub fn rosenbrock(x: &[f64]) -> f64 {
@@ -66,11 +77,11 @@ pub struct Problem {
 type Reward = fn(&[f64]) -> f64;
 
 /// The problems [`Problem::by_name`] knows.
-pub const PROBLEMS: &[&str] = &["hartmann6", "rosenbrock", "ackley"];
+pub const PROBLEMS: &[&str] = &["hartmann6", "branin", "rosenbrock", "ackley"];
 
 impl Problem {
-    /// `hartmann6` (embedded in `dims` ≥ 6 dimensions on [0, 1], start 0.5), `rosenbrock` and
-    /// `ackley` (on [start − 2, start + 2], starts −0.5 and 1.2).
+    /// `hartmann6` and `branin` (embedded in `dims` ≥ 6 or 2 dimensions on [0, 1], start 0.5),
+    /// `rosenbrock` and `ackley` (on [start − 2, start + 2], starts −0.5 and 1.2).
     pub fn by_name(name: &str, dims: usize) -> Option<Problem> {
         let all: Vec<usize> = (0..dims).collect();
         let (start, radius, reward, effective) = match name {
@@ -80,6 +91,7 @@ impl Problem {
                 hartmann6 as Reward,
                 (0..6).map(|k| k * dims / 6 + (dims / 12)).collect(),
             ),
+            "branin" if dims >= 2 => (0.5, 0.5, branin as Reward, vec![dims / 3, (2 * dims) / 3]),
             "rosenbrock" if dims >= 2 => (-0.5, 2.0, rosenbrock as Reward, all),
             "ackley" if dims >= 1 => (1.2, 2.0, ackley as Reward, all),
             _ => return None,
@@ -108,6 +120,8 @@ mod tests {
     fn optima_have_their_published_values() {
         let h = hartmann6(&[0.20169, 0.150011, 0.476874, 0.275332, 0.311652, 0.6573]);
         assert!((h - 3.32237).abs() < 1e-4, "{h}");
+        let b = branin(&[(std::f64::consts::PI + 5.0) / 15.0, 2.275 / 15.0]);
+        assert!((b + 0.397887).abs() < 1e-6, "{b}");
         assert_eq!(rosenbrock(&[1.0; 20]), 0.0);
         assert!(ackley(&[0.0; 20]).abs() < 1e-12);
         assert!(rosenbrock(&[0.0; 20]) < -18.0 && ackley(&[1.0; 20]) < -3.0);

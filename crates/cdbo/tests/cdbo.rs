@@ -1,7 +1,7 @@
 //! CDBO against random search on standard problems, determinism, resume and bad input.
 
 use cdbo::benchmarks::{ackley, hartmann6, rosenbrock};
-use cdbo::optimizers::cdbo::{Cdbo, CdboConfig};
+use cdbo::optimizers::bo::{Bo, BoConfig};
 use cdbo::optimizers::{Optimizer, SearchBox, rng_for};
 use rand_distr::{Distribution, Normal};
 
@@ -38,12 +38,12 @@ fn compare(name: &str, w0: Vec<f64>, radius: f64, f: &dyn Fn(&[f64]) -> f64, eva
     let seeds = 10;
     let (mut cdbo_sum, mut random_sum) = (0.0, 0.0);
     for seed in 0..seeds {
-        let config = CdboConfig {
+        let config = BoConfig {
             seed,
             box_radius: radius,
-            ..CdboConfig::default()
+            ..BoConfig::default()
         };
-        let mut opt = Cdbo::new(w0.clone(), config).unwrap();
+        let mut opt = Bo::new(w0.clone(), config).unwrap();
         cdbo_sum += run(&mut opt, f, evals);
         random_sum += random_search(&w0, radius, f, evals, seed);
     }
@@ -71,13 +71,13 @@ fn cdbo_beats_random_search_on_rosenbrock20_and_ackley20() {
 fn same_seed_same_run_and_resume_continues_it() {
     let w0 = vec![0.3; 12];
     let f = |w: &[f64]| ackley(w) + 30.0;
-    let config = CdboConfig {
+    let config = BoConfig {
         seed: 42,
         initial_samples: 5,
-        ..CdboConfig::default()
+        ..BoConfig::default()
     };
-    let mut a = Cdbo::new(w0.clone(), config.clone()).unwrap();
-    let mut b = Cdbo::new(w0.clone(), config).unwrap();
+    let mut a = Bo::new(w0.clone(), config.clone()).unwrap();
+    let mut b = Bo::new(w0.clone(), config).unwrap();
     let mut asked = Vec::new();
     for i in 0..25 {
         let (wa, wb) = (a.ask().unwrap(), b.ask().unwrap());
@@ -93,16 +93,16 @@ fn same_seed_same_run_and_resume_continues_it() {
     }
     // Save and resume mid-run: the next suggestion is the same.
     let saved = serde_json::to_string(a.state()).unwrap();
-    let state: cdbo::optimizers::cdbo::CdboState = serde_json::from_str(&saved).unwrap();
+    let state: cdbo::optimizers::bo::BoState = serde_json::from_str(&saved).unwrap();
     assert_eq!(&state, a.state(), "the JSON state round-trips exactly");
-    let mut resumed = Cdbo::resume(state).unwrap();
+    let mut resumed = Bo::resume(state).unwrap();
     assert_eq!(resumed.ask().unwrap(), a.ask().unwrap());
     assert_eq!(resumed.best().unwrap().1, a.best().unwrap().1);
 }
 
 #[test]
 fn bad_tells_are_refused_and_change_nothing() {
-    let mut opt = Cdbo::new(vec![0.0; 4], CdboConfig::default()).unwrap();
+    let mut opt = Bo::new(vec![0.0; 4], BoConfig::default()).unwrap();
     let w = opt.ask().unwrap();
     assert!(
         opt.tell(&w[..3], 1.0)
@@ -115,8 +115,8 @@ fn bad_tells_are_refused_and_change_nothing() {
     assert!(opt.tell(&[0.0, f64::NAN, 0.0, 0.0], 1.0).is_err());
     assert_eq!(opt.evaluations(), 0);
     assert_eq!(opt.ask().unwrap(), w);
-    assert!(Cdbo::new(vec![], CdboConfig::default()).is_err());
-    assert!(Cdbo::new(vec![f64::NAN], CdboConfig::default()).is_err());
+    assert!(Bo::new(vec![], BoConfig::default()).is_err());
+    assert!(Bo::new(vec![f64::NAN], BoConfig::default()).is_err());
 }
 
 mod cmaes {

@@ -20,7 +20,7 @@ pub enum BenchCommand {
 
 #[derive(Debug, Args)]
 pub struct OptimizersArgs {
-    /// Problem: hartmann6 (embedded in --dims), rosenbrock, ackley.
+    /// Problem: hartmann6 or branin (embedded in --dims), rosenbrock, ackley.
     #[arg(long, default_value = "hartmann6")]
     problem: String,
     /// Dimensions.
@@ -190,18 +190,24 @@ fn optimizers(args: &OptimizersArgs) -> CliResult {
 /// fitted once (timed), then `repeats` suggestions from clones of the same state.
 fn suggest(args: &SuggestArgs) -> CliResult {
     use cdbo::optimizers::Optimizer;
-    use cdbo::optimizers::cdbo::{Cdbo, CdboConfig};
+    use cdbo::optimizers::bo::{Bo, BoConfig, Maximiser};
+    use cdbo::optimizers::coordinate_ascent::AxisSearch;
     if args.observations < 2 || args.dims == 0 || args.repeats == 0 {
         return Err("--observations must be at least 2, --dims and --repeats at least 1".into());
     }
-    let mut config = CdboConfig {
+    let defaults = AxisSearch::default();
+    let search = AxisSearch {
+        scan: args.scan.unwrap_or(defaults.scan),
+        polish: args.polish.unwrap_or(defaults.polish),
+        ..defaults
+    };
+    let config = BoConfig {
         initial_samples: 0,
         refit_every: 0,
-        ..CdboConfig::default()
+        maximiser: Maximiser::CoordinateAscent(search),
+        ..BoConfig::default()
     };
-    config.search.scan = args.scan.unwrap_or(config.search.scan);
-    config.search.polish = args.polish.unwrap_or(config.search.polish);
-    let mut opt = Cdbo::new(vec![0.0; args.dims], config)?;
+    let mut opt = Bo::new(vec![0.0; args.dims], config)?;
     let mut rng = cdbo::optimizers::rng_for(7, 0);
     let normal = rand_distr::Normal::new(0.0, 0.3)?;
     for _ in 0..args.observations {

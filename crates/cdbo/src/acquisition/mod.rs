@@ -2,6 +2,7 @@
 //! mean μ(w) and standard deviation σ(w).
 
 pub mod ei;
+pub mod thompson;
 pub mod ucb;
 
 use serde::{Deserialize, Serialize};
@@ -30,5 +31,25 @@ impl Acquisition {
             Acquisition::Ucb { beta } => ucb::ucb(mean, var, beta),
             Acquisition::Ei { xi } => ei::expected_improvement(mean, var, best, xi),
         }
+    }
+}
+
+/// The index of the largest value (the first on ties).
+pub fn argmax(values: &[f64]) -> usize {
+    values
+        .iter()
+        .enumerate()
+        .fold((0, f64::NEG_INFINITY), |(bi, bv), (i, &v)| {
+            if v > bv { (i, v) } else { (bi, bv) }
+        })
+        .0
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn argmax_takes_the_first_largest() {
+        assert_eq!(super::argmax(&[1.0, 3.0, 3.0, -1.0]), 1);
+        assert_eq!(super::argmax(&[f64::NAN, -1.0]), 1);
     }
 }

@@ -273,6 +273,59 @@ impl GaussianProcess {
         self.predict_from_k(kv.as_mut())
     }
 
+    /// The joint posterior at many points (row-major, `dim` columns each): the means and the
+    /// covariance k(P, P) − VᵀV with V = L⁻¹k(W, P). Kernel matrices come from one matrix
+    /// product each, r² = ‖a‖² + ‖b‖² − 2a·b in scaled coordinates (rounding of order
+    /// 1e-16·‖a‖², harmless for sampling).
+    pub fn predict_joint(&self, points: &[f64]) -> (Vec<f64>, Mat<f64>) {
+        let (n, b) = (self.len(), points.len() / self.dim);
+        let mut v = self.cov_by_product(&self.x, points);
+        let means = (0..b)
+            .map(|j| self.mean + (0..n).map(|i| v[(i, j)] * self.alpha[i]).sum::<f64>())
+            .collect();
+        if n > 0 {
+            solve_lower_triangular_in_place(self.chol.as_ref(), v.as_mut(), Par::Seq);
+        }
+        let mut cov = self.cov_by_product(points, points);
+        faer::linalg::matmul::matmul(
+            cov.as_mut(),
+            faer::Accum::Add,
+            v.transpose(),
+            v.as_ref(),
+            -1.0,
+            Par::Seq,
+        );
+        (means, cov)
+    }
+
+    /// k(A, B) for row-major point sets, by one matrix product of the scaled coordinates.
+    fn cov_by_product(&self, a: &[f64], b: &[f64]) -> Mat<f64> {
+        let d = self.dim;
+        let scale: Vec<f64> = (0..d)
+            .map(|k| self.inv_l2[if self.inv_l2.len() == 1 { 0 } else { k }].sqrt())
+            .collect();
+        let scaled = |p: &[f64]| Mat::from_fn(p.len() / d, d, |i, k| p[i * d + k] * scale[k]);
+        let (sa, sb) = (scaled(a), scaled(b));
+        let norms = |m: &Mat<f64>| -> Vec<f64> {
+            (0..m.nrows())
+                .map(|i| (0..d).map(|k| m[(i, k)] * m[(i, k)]).sum())
+                .collect()
+        };
+        let (na, nb) = (norms(&sa), norms(&sb));
+        let dot = &sa * sb.transpose();
+        let (ra, rb) = (na.len(), nb.len());
+        let mut r2: Vec<f64> = (0..ra * rb)
+            .map(|idx| {
+                let (i, j) = (idx % ra, idx / ra);
+                na[i] + nb[j] - 2.0 * dot[(i, j)]
+            })
+            .collect();
+        self.hyper
+            .kernel
+            .apply_in_place(&mut r2, self.hyper.signal_var);
+        Mat::from_fn(ra, rb, |i, j| r2[j * ra + i])
+    }
+
     /// Posterior mean and variance of one point from its cross-covariance k(W, w*)
     /// (overwritten by L⁻¹k): column-oriented forward substitution, xⱼ = kⱼ/Lⱼⱼ then
     /// k[j+1..] −= xⱼ·L[j+1.., j], whose inner loop is a contiguous axpy that vectorises.

@@ -30,8 +30,12 @@ pub struct CmaesConfig {
     pub sigma0: f64,
     /// Population size λ (0: 4 + ⌊3 ln n⌋).
     pub population: usize,
-    /// Half-width of the search box around the start (`None`: no box).
-    pub box_radius: Option<f64>,
+    /// The box the search stays in (`None`: unbounded).
+    pub bounds: Option<SearchBox>,
+    /// Re-decompose C only every ⌈1/(10·n·(c₁ + c_μ))⌉ generations (Hansen's lazy update,
+    /// O(n³) amortised away) instead of every generation. For an inner loop that is never
+    /// saved: a resumed run decomposes its current C, so its samples would differ.
+    pub lazy_eigen: bool,
 }
 
 impl Default for CmaesConfig {
@@ -40,7 +44,8 @@ impl Default for CmaesConfig {
             seed: 0,
             sigma0: 0.3,
             population: 0,
-            box_radius: None,
+            bounds: None,
+            lazy_eigen: false,
         }
     }
 }
@@ -209,8 +214,13 @@ impl Cmaes {
             4 + (3.0 * (n as f64).ln()).floor() as usize
         };
         let lambda = base << state.restarts.min(16);
-        let bounds = match state.config.box_radius {
-            Some(r) => SearchBox::around(&state.start, r)?,
+        let bounds = match &state.config.bounds {
+            Some(b) if b.lower.len() == n && b.upper.len() == n => b.clone(),
+            Some(_) => {
+                return Err(Error::Domain(
+                    "corrupt CMA-ES state: the box does not match the dimension".into(),
+                ));
+            }
             None => SearchBox {
                 lower: vec![f64::NEG_INFINITY; n],
                 upper: vec![f64::INFINITY; n],
@@ -254,14 +264,6 @@ impl Cmaes {
         Ok(())
     }
 
-    /// B·(D ∘ z).
-    fn transform(&self, z: &[f64]) -> Vec<f64> {
-        let n = z.len();
-        (0..n)
-            .map(|i| (0..n).map(|k| self.b[(i, k)] * self.d[k] * z[k]).sum())
-            .collect()
-    }
-
     /// C^(−1/2)·y = B·(D⁻¹ ∘ Bᵀy).
     fn inv_sqrt(&self, y: &[f64]) -> Vec<f64> {
         let n = y.len();
@@ -277,10 +279,19 @@ impl Cmaes {
         let n = self.state.mean.len();
         let mut rng = rng_for(self.state.config.seed, self.state.generation);
         let sigma = self.state.sigma;
-        self.state.population = (0..self.params.lambda)
-            .map(|_| {
-                let z: Vec<f64> = (0..n).map(|_| StandardNormal.sample(&mut rng)).collect();
-                let y = self.transform(&z);
+        let lambda = self.params.lambda;
+        // Y = B·diag(D)·Z for the whole population in one matrix product.
+        let mut z = Mat::<f64>::zeros(n, lambda);
+        for k in 0..lambda {
+            for i in 0..n {
+                let g: f64 = StandardNormal.sample(&mut rng);
+                z[(i, k)] = self.d[i] * g;
+            }
+        }
+        let ys = &self.b * &z;
+        self.state.population = (0..lambda)
+            .map(|k| {
+                let y: Vec<f64> = ys.col(k).iter().copied().collect();
                 let mut x: Vec<f64> = self
                     .state
                     .mean
@@ -296,6 +307,19 @@ impl Cmaes {
             })
             .collect();
         self.state.fitness.clear();
+    }
+
+    /// The largest axis √λ_max(C) of the search distribution, relative to σ.
+    pub fn max_axis(&self) -> f64 {
+        self.d.iter().fold(0.0, |a, &d| a.max(d))
+    }
+
+    /// The current generation's individuals not yet told, in the order `ask` gives them: a
+    /// caller that scores a whole population in one batch tells them back in this order.
+    pub fn untold(&self) -> Vec<Vec<f64>> {
+        (self.state.fitness.len()..self.params.lambda)
+            .map(|k| self.point(k))
+            .collect()
     }
 
     fn point(&self, k: usize) -> Vec<f64> {
@@ -361,18 +385,23 @@ impl Cmaes {
         let sum_w: f64 = p.weights.iter().sum();
         let delta = (1.0 - hs) * p.cc * (2.0 - p.cc);
         let decay = 1.0 + p.c1 * delta - p.c1 - p.cmu * sum_w;
+        // Σₖ wₖ° yₖyₖᵀ as one product of n × λ matrices.
+        let weighted = Mat::from_fn(n, ys.len(), |i, k| wo[k] * ys[k][i]);
+        let plain = Mat::from_fn(n, ys.len(), |i, k| ys[k][i]);
+        let rank_mu = &weighted * plain.transpose();
         for i in 0..n {
             for j in 0..n {
-                let rank_mu: f64 = wo.iter().zip(&ys).map(|(w, y)| w * y[i] * y[j]).sum();
                 s.cov[i * n + j] =
-                    decay * s.cov[i * n + j] + p.c1 * s.pc[i] * s.pc[j] + p.cmu * rank_mu;
+                    decay * s.cov[i * n + j] + p.c1 * s.pc[i] * s.pc[j] + p.cmu * rank_mu[(i, j)];
             }
         }
         s.sigma *= ((p.cs / p.damps) * (ps_norm / p.chi_n - 1.0))
             .min(1.0)
             .exp();
         s.generation += 1;
-        let decomposed = self.decompose();
+        let lazy_period = (1.0 / (10.0 * nf * (p.c1 + p.cmu))).ceil().max(1.0) as u64;
+        let due = !s.config.lazy_eigen || s.generation % lazy_period == 0;
+        let decomposed = if due { self.decompose() } else { Ok(()) };
         let (dmin, dmax) = self.d.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), d| {
             (lo.min(*d), hi.max(*d))
         });
@@ -450,5 +479,9 @@ impl Optimizer for Cmaes {
 
     fn evaluations(&self) -> usize {
         self.state.evaluations
+    }
+
+    fn save(&self) -> super::Saved {
+        super::Saved::Cmaes(Box::new(self.state.clone()))
     }
 }

@@ -4,10 +4,14 @@
 //! informed with this initial solution"), counts one lap per evaluation, takes every random
 //! choice from its seed, and treats a failed lap (reward 0) as an ordinary observation.
 
-pub mod cdbo;
+pub mod bo;
 pub mod cmaes;
+pub mod cmaes_ascent;
 pub mod coordinate_ascent;
+pub mod linebo;
 pub mod random;
+pub mod rembo;
+pub mod turbo;
 
 use serde::{Deserialize, Serialize};
 
@@ -33,40 +37,114 @@ pub trait Optimizer {
 
     /// Number of rewards told.
     fn evaluations(&self) -> usize;
+
+    /// The whole state, to resume the run later with [`Saved::resume`] exactly where it is.
+    fn save(&self) -> Saved;
 }
 
-/// The methods [`by_name`] knows.
-pub const METHODS: &[&str] = &["cdbo", "cmaes", "random"];
+/// The saved state of an optimiser of any method, tagged with its kind.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case", tag = "kind", content = "state")]
+pub enum Saved {
+    /// CDBO or BO-CMA-ES.
+    Bo(Box<bo::BoState>),
+    /// Active CMA-ES.
+    Cmaes(Box<cmaes::CmaesState>),
+    /// Random search.
+    Random(Box<random::RandomState>),
+    /// REMBO.
+    Rembo(Box<rembo::RemboState>),
+    /// TuRBO-1.
+    Turbo(Box<turbo::TurboState>),
+    /// LineBO.
+    Linebo(Box<linebo::LineBoState>),
+}
 
-/// An optimiser by its command-line name, from w₀, a seed, the UCB β (used by the BO methods)
-/// and the half-width r of the search box around w₀; the evolution strategies start with
-/// σ = r/15 (0.1 for the policy box).
+impl Saved {
+    /// The optimiser, continuing exactly as the saved one would have.
+    pub fn resume(self) -> Result<Box<dyn Optimizer + Send>> {
+        Ok(match self {
+            Saved::Bo(s) => Box::new(bo::Bo::resume(*s)?),
+            Saved::Cmaes(s) => Box::new(cmaes::Cmaes::resume(*s)?),
+            Saved::Random(s) => Box::new(random::RandomSearch::resume(*s)?),
+            Saved::Rembo(s) => Box::new(rembo::Rembo::resume(*s)?),
+            Saved::Turbo(s) => Box::new(turbo::Turbo::resume(*s)?),
+            Saved::Linebo(s) => Box::new(linebo::LineBo::resume(*s)?),
+        })
+    }
+}
+
+/// The methods [`by_name`] knows: the paper's CDBO, its baselines, and later peers.
+pub const METHODS: &[&str] = &[
+    "cdbo",
+    "cmaes",
+    "bo-cmaes",
+    "rembo-5d",
+    "rembo-10d",
+    "turbo",
+    "linebo",
+    "random",
+];
+
+/// An optimiser by its command-line name, from w₀, a seed, the UCB β (used by the UCB
+/// methods) and the half-width r of the search box around w₀; the evolution strategies start
+/// with σ = r/15 (0.1 for the policy box).
 pub fn by_name(
     name: &str,
     w0: Vec<f64>,
     seed: u64,
     beta: f64,
     box_radius: f64,
-) -> Result<Box<dyn Optimizer>> {
+) -> Result<Box<dyn Optimizer + Send>> {
+    let bo = |maximiser| bo::BoConfig {
+        seed,
+        acquisition: crate::acquisition::Acquisition::Ucb { beta },
+        box_radius,
+        maximiser,
+        ..bo::BoConfig::default()
+    };
+    let rembo = |embedding_dim| rembo::RemboConfig {
+        seed,
+        embedding_dim,
+        box_radius,
+    };
     Ok(match name {
-        "cdbo" => {
-            let config = cdbo::CdboConfig {
-                seed,
-                acquisition: crate::acquisition::Acquisition::Ucb { beta },
-                box_radius,
-                ..cdbo::CdboConfig::default()
-            };
-            Box::new(cdbo::Cdbo::new(w0, config)?)
-        }
+        "cdbo" => Box::new(bo::Bo::new(
+            w0,
+            bo(bo::Maximiser::CoordinateAscent(Default::default())),
+        )?),
+        "bo-cmaes" => Box::new(bo::Bo::new(
+            w0,
+            bo(bo::Maximiser::Cmaes(Default::default())),
+        )?),
         "cmaes" => {
             let config = cmaes::CmaesConfig {
                 seed,
                 sigma0: box_radius / 15.0,
-                box_radius: Some(box_radius),
+                bounds: Some(SearchBox::around(&w0, box_radius)?),
                 ..cmaes::CmaesConfig::default()
             };
             Box::new(cmaes::Cmaes::new(w0, config)?)
         }
+        "rembo-5d" => Box::new(rembo::Rembo::new(w0, rembo(5))?),
+        "rembo-10d" => Box::new(rembo::Rembo::new(w0, rembo(10))?),
+        "turbo" => Box::new(turbo::Turbo::new(
+            w0,
+            turbo::TurboConfig {
+                seed,
+                box_radius,
+                ..turbo::TurboConfig::default()
+            },
+        )?),
+        "linebo" => Box::new(linebo::LineBo::new(
+            w0,
+            linebo::LineBoConfig {
+                seed,
+                box_radius,
+                beta,
+                ..linebo::LineBoConfig::default()
+            },
+        )?),
         "random" => Box::new(random::RandomSearch::new(
             w0,
             random::RandomConfig {

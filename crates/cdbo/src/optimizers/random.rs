@@ -28,14 +28,24 @@ impl Default for RandomConfig {
     }
 }
 
-/// Random search; its state is its settings, its start and what was told.
+/// Everything needed to resume a search.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RandomState {
+    /// Settings.
+    pub config: RandomConfig,
+    /// The start point.
+    pub start: Vec<f64>,
+    /// Rewards told.
+    pub evaluations: usize,
+    /// The best (weights, reward) told.
+    pub best: Best,
+}
+
+/// Random search.
 #[derive(Debug, Clone)]
 pub struct RandomSearch {
-    config: RandomConfig,
-    start: Vec<f64>,
+    state: RandomState,
     bounds: SearchBox,
-    evaluations: usize,
-    best: Best,
     pending: Option<Vec<f64>>,
 }
 
@@ -53,15 +63,26 @@ impl RandomSearch {
                 config.sigma
             )));
         }
-        let bounds = SearchBox::around(&start, config.box_radius)?;
-        Ok(RandomSearch {
+        RandomSearch::resume(RandomState {
             config,
             start,
-            bounds,
             evaluations: 0,
             best: Best::default(),
+        })
+    }
+
+    /// Rebuilds a search from its state.
+    pub fn resume(state: RandomState) -> Result<RandomSearch> {
+        Ok(RandomSearch {
+            bounds: SearchBox::around(&state.start, state.config.box_radius)?,
+            state,
             pending: None,
         })
+    }
+
+    /// The state to save.
+    pub fn state(&self) -> &RandomState {
+        &self.state
     }
 }
 
@@ -71,20 +92,21 @@ impl Optimizer for RandomSearch {
     }
 
     fn dim(&self) -> usize {
-        self.start.len()
+        self.state.start.len()
     }
 
     fn ask(&mut self) -> Result<Vec<f64>> {
         if let Some(p) = &self.pending {
             return Ok(p.clone());
         }
-        let centre = self.best.get().map_or(&self.start[..], |b| b.0);
-        let w = if self.evaluations == 0 {
-            self.start.clone()
+        let s = &self.state;
+        let centre = s.best.get().map_or(&s.start[..], |b| b.0);
+        let w = if s.evaluations == 0 {
+            s.start.clone()
         } else {
             let normal =
-                Normal::new(0.0, self.config.sigma).map_err(|e| Error::Domain(e.to_string()))?;
-            let mut rng = rng_for(self.config.seed, self.evaluations as u64);
+                Normal::new(0.0, s.config.sigma).map_err(|e| Error::Domain(e.to_string()))?;
+            let mut rng = rng_for(s.config.seed, s.evaluations as u64);
             let mut w: Vec<f64> = centre.iter().map(|c| c + normal.sample(&mut rng)).collect();
             self.bounds.clamp(&mut w);
             w
@@ -95,17 +117,21 @@ impl Optimizer for RandomSearch {
 
     fn tell(&mut self, weights: &[f64], reward: f64) -> Result<()> {
         check_tell(self.dim(), weights, reward)?;
-        self.evaluations += 1;
-        self.best.offer(weights, reward);
+        self.state.evaluations += 1;
+        self.state.best.offer(weights, reward);
         self.pending = None;
         Ok(())
     }
 
     fn best(&self) -> Option<(&[f64], f64)> {
-        self.best.get()
+        self.state.best.get()
     }
 
     fn evaluations(&self) -> usize {
-        self.evaluations
+        self.state.evaluations
+    }
+
+    fn save(&self) -> super::Saved {
+        super::Saved::Random(Box::new(self.state.clone()))
     }
 }

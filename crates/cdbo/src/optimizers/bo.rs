@@ -1,9 +1,12 @@
-//! Coordinate Descent Bayesian Optimisation (paper Alg. 2).
+//! Bayesian optimisation of lap rewards (paper Alg. 2): Coordinate Descent Bayesian
+//! Optimisation when the acquisition is maximised by coordinate ascent, standard BO-CMA-ES
+//! when it is maximised by CMA-ES.
 //!
 //! 1. Drive w₀, then S laps with w ~ N(w₀, σ₀²I) clamped to the search box.
 //! 2. Then, each lap: fit the GP's hyperparameters by maximum likelihood when due, choose
-//!    w = argmax h by stochastic coordinate ascent from the best weights so far
-//!    ([`super::coordinate_ascent`]), drive it, add (w, R) to the GP.
+//!    w = argmax h from the best weights so far, by stochastic coordinate ascent
+//!    ([`super::coordinate_ascent`], paper Alg. 1) or by CMA-ES ([`super::cmaes_ascent`]),
+//!    drive it, add (w, R) to the GP.
 //!
 //! The length-scales' upper bound adapts as in REMBO (Wang et al. 2016), applied by the paper
 //! to every BO method: when the chosen point's posterior standard deviation falls below
@@ -14,7 +17,8 @@
 use rand_distr::{Distribution, Normal};
 use serde::{Deserialize, Serialize};
 
-use super::coordinate_ascent::{AxisSearch, GpAcquisition, maximise};
+use super::cmaes_ascent::CmaesSearch;
+use super::coordinate_ascent::{AxisSearch, GpAcquisition};
 use super::{Best, Optimizer, SearchBox, check_tell, rng_for};
 use crate::acquisition::Acquisition;
 use crate::acquisition::ucb::DEFAULT_BETA;
@@ -25,9 +29,19 @@ use crate::gp::{GaussianProcess, Hyper, Kernel, Mean};
 /// σ(w_next) below this fraction of σ_f shrinks the length-scale upper bound.
 pub const LOW_UNCERTAINTY: f64 = 0.05;
 
-/// Settings of a CDBO run.
+/// How the acquisition is maximised.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case", tag = "kind")]
+pub enum Maximiser {
+    /// Stochastic coordinate ascent (CDBO, paper Alg. 1).
+    CoordinateAscent(AxisSearch),
+    /// Active CMA-ES in all coordinates at once (BO-CMA-ES).
+    Cmaes(CmaesSearch),
+}
+
+/// Settings of a BO run; the default is the paper's CDBO.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct CdboConfig {
+pub struct BoConfig {
     /// Seed of every random choice.
     pub seed: u64,
     /// Acquisition (UCB with β = 1 by default).
@@ -55,13 +69,13 @@ pub struct CdboConfig {
     pub refit_every: usize,
     /// Adam iterations per fit.
     pub fit_iterations: usize,
-    /// Coordinate-ascent settings.
-    pub search: AxisSearch,
+    /// How the acquisition is maximised.
+    pub maximiser: Maximiser,
 }
 
-impl Default for CdboConfig {
+impl Default for BoConfig {
     fn default() -> Self {
-        CdboConfig {
+        BoConfig {
             seed: 0,
             acquisition: Acquisition::Ucb { beta: DEFAULT_BETA },
             initial_samples: 10,
@@ -73,16 +87,16 @@ impl Default for CdboConfig {
             noise_var: 0.0,
             refit_every: 5,
             fit_iterations: 30,
-            search: AxisSearch::default(),
+            maximiser: Maximiser::CoordinateAscent(AxisSearch::default()),
         }
     }
 }
 
 /// Everything needed to resume a run: settings, w₀ and what was told.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct CdboState {
+pub struct BoState {
     /// Settings.
-    pub config: CdboConfig,
+    pub config: BoConfig,
     /// The demonstration's weights.
     pub w0: Vec<f64>,
     /// Told (weights, reward), in order.
@@ -96,10 +110,10 @@ pub struct CdboState {
     pub bounds_used: Vec<f64>,
 }
 
-/// The CDBO optimiser.
+/// A BO run (CDBO or BO-CMA-ES).
 #[derive(Debug, Clone)]
-pub struct Cdbo {
-    state: CdboState,
+pub struct Bo {
+    state: BoState,
     bounds: SearchBox,
     gp: GaussianProcess,
     best: Best,
@@ -113,7 +127,7 @@ pub struct Cdbo {
 }
 
 /// The hyperparameters a run starts from: length-scales half the box width, σ_f² = 1.
-fn initial_hyper(config: &CdboConfig, dim: usize) -> Hyper {
+fn initial_hyper(config: &BoConfig, dim: usize) -> Hyper {
     Hyper {
         kernel: config.kernel,
         lengthscales: vec![config.box_radius; if config.ard { dim } else { 1 }],
@@ -128,9 +142,9 @@ const LENGTHSCALE_MIN_FRACTION: f64 = 0.01;
 /// Largest length-scale searched at the start, relative to the box width.
 const LENGTHSCALE_MAX_FRACTION: f64 = 10.0;
 
-impl Cdbo {
+impl Bo {
     /// A new run from the demonstration's weights.
-    pub fn new(w0: Vec<f64>, config: CdboConfig) -> Result<Cdbo> {
+    pub fn new(w0: Vec<f64>, config: BoConfig) -> Result<Bo> {
         if w0.is_empty() {
             return Err(Error::Domain("CDBO needs at least one weight".into()));
         }
@@ -145,7 +159,7 @@ impl Cdbo {
         }
         let hyper = initial_hyper(&config, w0.len());
         let lengthscale_max = LENGTHSCALE_MAX_FRACTION * 2.0 * config.box_radius;
-        let state = CdboState {
+        let state = BoState {
             w0,
             observations: Vec::new(),
             hyper,
@@ -153,12 +167,12 @@ impl Cdbo {
             bounds_used: Vec::new(),
             config,
         };
-        Cdbo::resume(state)
+        Bo::resume(state)
     }
 
     /// Rebuilds a run from its state by replaying its observations and hyperparameter fits,
     /// so that it continues exactly as the uninterrupted run would.
-    pub fn resume(saved: CdboState) -> Result<Cdbo> {
+    pub fn resume(saved: BoState) -> Result<Bo> {
         if saved.bounds_used.len() != saved.observations.len() {
             return Err(Error::Domain(format!(
                 "corrupt CDBO state: {} observations but {} recorded bounds",
@@ -167,7 +181,7 @@ impl Cdbo {
             )));
         }
         let dim = saved.w0.len();
-        let mut state = CdboState {
+        let mut state = BoState {
             observations: Vec::new(),
             bounds_used: Vec::new(),
             hyper: initial_hyper(&saved.config, dim),
@@ -176,7 +190,7 @@ impl Cdbo {
         state.lengthscale_max = LENGTHSCALE_MAX_FRACTION * 2.0 * saved.config.box_radius;
         let bounds = SearchBox::around(&state.w0, state.config.box_radius)?;
         let gp = GaussianProcess::new(dim, state.hyper.clone())?;
-        let mut run = Cdbo {
+        let mut run = Bo {
             state,
             bounds,
             gp,
@@ -199,7 +213,7 @@ impl Cdbo {
     }
 
     /// The state to save.
-    pub fn state(&self) -> &CdboState {
+    pub fn state(&self) -> &BoState {
         &self.state
     }
 
@@ -275,14 +289,27 @@ impl Cdbo {
         }
         self.maybe_refit()?;
         let start = self.best.get().map_or(&self.state.w0[..], |b| b.0).to_vec();
-        let mut objective = GpAcquisition::new(&self.gp, self.state.config.acquisition, &start);
-        let ascent = maximise(
-            &mut objective,
-            &self.bounds,
-            &start,
-            &self.state.config.search,
-            &mut rng,
-        );
+        let acquisition = self.state.config.acquisition;
+        let ascent = match &self.state.config.maximiser {
+            Maximiser::CoordinateAscent(search) => {
+                let mut objective = GpAcquisition::new(&self.gp, acquisition, &start);
+                super::coordinate_ascent::maximise(
+                    &mut objective,
+                    &self.bounds,
+                    &start,
+                    search,
+                    &mut rng,
+                )
+            }
+            Maximiser::Cmaes(search) => super::cmaes_ascent::maximise(
+                &self.gp,
+                acquisition,
+                &self.bounds,
+                &start,
+                search,
+                rand::Rng::random(&mut rng),
+            )?,
+        };
         self.last_af_evaluations = ascent.evaluations;
         // Wang & de Freitas: too little uncertainty at the chosen point shrinks the bound.
         if ascent.var.sqrt() < LOW_UNCERTAINTY * self.gp.hyper().signal_var.sqrt() {
@@ -293,9 +320,12 @@ impl Cdbo {
     }
 }
 
-impl Optimizer for Cdbo {
+impl Optimizer for Bo {
     fn name(&self) -> &'static str {
-        "cdbo"
+        match self.state.config.maximiser {
+            Maximiser::CoordinateAscent(_) => "cdbo",
+            Maximiser::Cmaes(_) => "bo-cmaes",
+        }
     }
 
     fn dim(&self) -> usize {
@@ -332,5 +362,9 @@ impl Optimizer for Cdbo {
 
     fn evaluations(&self) -> usize {
         self.state.observations.len()
+    }
+
+    fn save(&self) -> super::Saved {
+        super::Saved::Bo(Box::new(self.state.clone()))
     }
 }

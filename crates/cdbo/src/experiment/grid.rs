@@ -1,0 +1,305 @@
+//! An experiment grid (paper Sec. V): tracks × policy sizes × methods × repeats, every run a
+//! [`race`](super::race) of the same number of laps. Written as TOML or named by a preset:
+//!
+//! ```toml
+//! laps = 300
+//! repeats = 4
+//! demo_speed = 15.0
+//! beta = 1.0
+//! methods = ["cdbo", "cmaes", "bo-cmaes", "rembo-5d", "rembo-10d"]
+//!
+//! [[tracks]]
+//! track = "forza"
+//! kernels = [10, 50, 100]
+//! ```
+//!
+//! Run r of every cell has seed r, so that the methods meet the same random numbers where
+//! they draw alike. The runs are listed in a fixed order; shard I of N takes every N-th run
+//! from the I-th, so shards partition the grid whatever machine runs them.
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+
+/// The policy sizes to race on one track.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrackGrid {
+    /// A built-in track, a file, or a name found in the data folders.
+    pub track: String,
+    /// Policy kernels M, one panel each.
+    pub kernels: Vec<usize>,
+}
+
+/// An experiment grid.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExperimentConfig {
+    /// Laps per run (the paper: 300).
+    pub laps: usize,
+    /// Runs per cell (the paper: 4).
+    pub repeats: usize,
+    /// Demonstration speed in m/s (the paper: 15).
+    #[serde(default = "default_demo_speed")]
+    pub demo_speed: f64,
+    /// UCB β (the paper: within [0.5, 2]).
+    #[serde(default = "default_beta")]
+    pub beta: f64,
+    /// Optimisers, by their command-line names.
+    pub methods: Vec<String>,
+    /// Tracks and their policy sizes.
+    pub tracks: Vec<TrackGrid>,
+}
+
+fn default_demo_speed() -> f64 {
+    crate::drive::demo::DEFAULT_TARGET_SPEED
+}
+
+fn default_beta() -> f64 {
+    crate::acquisition::ucb::DEFAULT_BETA
+}
+
+/// The presets [`ExperimentConfig::preset`] knows.
+pub const PRESETS: &[&str] = &["paper", "paper-plus", "quick"];
+
+/// The paper's baselines and CDBO.
+const PAPER_METHODS: [&str; 5] = ["cdbo", "cmaes", "bo-cmaes", "rembo-5d", "rembo-10d"];
+
+impl ExperimentConfig {
+    /// `paper`: Forza with 10/50/100 kernels and Allondaz with 10/30/50; CDBO, CMA-ES,
+    /// BO-CMA-ES, REMBO-5d and -10d; 4 repeats of 300 laps. `paper-plus`: the same with
+    /// TuRBO, LineBO and random search. `quick`: the built-in track, 10 and 20 kernels, four
+    /// methods, 2 repeats of 25 laps (for CI).
+    pub fn preset(name: &str) -> Option<ExperimentConfig> {
+        let paper_tracks = vec![
+            TrackGrid {
+                track: "forza".into(),
+                kernels: vec![10, 50, 100],
+            },
+            TrackGrid {
+                track: "allondaz".into(),
+                kernels: vec![10, 30, 50],
+            },
+        ];
+        let methods = |extra: &[&str]| -> Vec<String> {
+            PAPER_METHODS
+                .iter()
+                .chain(extra)
+                .map(|m| m.to_string())
+                .collect()
+        };
+        Some(match name {
+            "paper" => ExperimentConfig {
+                laps: 300,
+                repeats: 4,
+                demo_speed: default_demo_speed(),
+                beta: default_beta(),
+                methods: methods(&[]),
+                tracks: paper_tracks,
+            },
+            "paper-plus" => ExperimentConfig {
+                methods: methods(&["turbo", "linebo", "random"]),
+                ..ExperimentConfig::preset("paper")?
+            },
+            "quick" => ExperimentConfig {
+                laps: 25,
+                repeats: 2,
+                demo_speed: default_demo_speed(),
+                beta: default_beta(),
+                methods: ["cdbo", "cmaes", "bo-cmaes", "random"]
+                    .map(String::from)
+                    .to_vec(),
+                tracks: vec![TrackGrid {
+                    track: crate::track::builtin::DEFAULT.into(),
+                    kernels: vec![10, 20],
+                }],
+            },
+            _ => return None,
+        })
+    }
+
+    /// Reads a grid from TOML text; `origin` names the file in errors.
+    pub fn from_toml(text: &str, origin: &str) -> Result<ExperimentConfig> {
+        let config: ExperimentConfig =
+            toml::from_str(text).map_err(|e| Error::Domain(format!("{origin}: {e}")))?;
+        config
+            .check()
+            .map_err(|e| Error::Domain(format!("{origin}: {e}")))?;
+        Ok(config)
+    }
+
+    /// Checks the grid is non-empty, its methods known and its numbers sensible.
+    pub fn check(&self) -> Result<()> {
+        if self.laps == 0 || self.repeats == 0 {
+            return Err(Error::Domain("laps and repeats must be at least 1".into()));
+        }
+        if self.methods.is_empty() || self.tracks.is_empty() {
+            return Err(Error::Domain(
+                "the grid needs at least one method and one track".into(),
+            ));
+        }
+        if let Some(m) = self
+            .methods
+            .iter()
+            .find(|m| !crate::optimizers::METHODS.contains(&m.as_str()))
+        {
+            return Err(Error::Domain(format!(
+                "unknown method {m:?} (available: {})",
+                crate::optimizers::METHODS.join(", ")
+            )));
+        }
+        if let Some(t) = self
+            .tracks
+            .iter()
+            .find(|t| t.kernels.is_empty() || t.kernels.iter().any(|&k| k < 2))
+        {
+            return Err(Error::Domain(format!(
+                "track {:?}: kernels must be a non-empty list of sizes of at least 2",
+                t.track
+            )));
+        }
+        if !(self.demo_speed.is_finite() && self.demo_speed > 0.0) {
+            return Err(Error::Domain(format!(
+                "demo_speed must be positive, got {}",
+                self.demo_speed
+            )));
+        }
+        if !(self.beta.is_finite() && self.beta >= 0.0) {
+            return Err(Error::Domain(format!(
+                "beta must be non-negative, got {}",
+                self.beta
+            )));
+        }
+        Ok(())
+    }
+
+    /// Every run of the grid, in a fixed order: track, size, repeat, method.
+    pub fn runs(&self) -> Vec<RunSpec> {
+        let mut runs = Vec::new();
+        for t in &self.tracks {
+            for &kernels in &t.kernels {
+                for repeat in 0..self.repeats {
+                    for method in &self.methods {
+                        runs.push(RunSpec {
+                            track: t.track.clone(),
+                            kernels,
+                            method: method.clone(),
+                            repeat,
+                        });
+                    }
+                }
+            }
+        }
+        runs
+    }
+}
+
+/// One run of a grid.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+pub struct RunSpec {
+    /// Track name as the grid gives it.
+    pub track: String,
+    /// Policy kernels M.
+    pub kernels: usize,
+    /// Optimiser.
+    pub method: String,
+    /// Repeat index r, also the seed.
+    pub repeat: usize,
+}
+
+impl RunSpec {
+    /// A name unique in the grid, safe as a file name: `forza-m50-cdbo-r0`.
+    pub fn id(&self) -> String {
+        let track: String = self
+            .track
+            .chars()
+            .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+            .collect();
+        format!("{track}-m{}-{}-r{}", self.kernels, self.method, self.repeat)
+    }
+
+    /// The run's seed.
+    pub fn seed(&self) -> u64 {
+        self.repeat as u64
+    }
+}
+
+/// Shard I of N (`I/N`, 0 ≤ I < N): the runs whose position in the grid is I modulo N.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shard {
+    /// I.
+    pub index: usize,
+    /// N.
+    pub count: usize,
+}
+
+impl Shard {
+    /// Parses `I/N`.
+    pub fn parse(text: &str) -> Result<Shard> {
+        let bad = || {
+            Error::Domain(format!(
+                "--shard {text:?}: expected I/N with 0 ≤ I < N, e.g. 0/4"
+            ))
+        };
+        let (i, n) = text.split_once('/').ok_or_else(bad)?;
+        let (index, count): (usize, usize) = (
+            i.trim().parse().map_err(|_| bad())?,
+            n.trim().parse().map_err(|_| bad())?,
+        );
+        if count == 0 || index >= count {
+            return Err(bad());
+        }
+        Ok(Shard { index, count })
+    }
+
+    /// The shard's runs.
+    pub fn select(&self, runs: Vec<RunSpec>) -> Vec<RunSpec> {
+        runs.into_iter()
+            .enumerate()
+            .filter(|(k, _)| k % self.count == self.index)
+            .map(|(_, r)| r)
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_paper_grid_has_the_papers_cells() {
+        let paper = ExperimentConfig::preset("paper").unwrap();
+        assert_eq!(paper.runs().len(), 6 * 5 * 4);
+        let plus = ExperimentConfig::preset("paper-plus").unwrap();
+        assert_eq!(plus.runs().len(), 6 * 8 * 4);
+        for p in PRESETS {
+            ExperimentConfig::preset(p).unwrap().check().unwrap();
+        }
+    }
+
+    #[test]
+    fn shards_partition_the_grid() {
+        let runs = ExperimentConfig::preset("paper").unwrap().runs();
+        let mut all: Vec<RunSpec> = (0..7)
+            .flat_map(|i| Shard { index: i, count: 7 }.select(runs.clone()))
+            .collect();
+        all.sort();
+        let mut expected = runs.clone();
+        expected.sort();
+        assert_eq!(all, expected);
+        assert!(Shard::parse("3/3").is_err() && Shard::parse("a/2").is_err());
+        assert_eq!(Shard::parse("2/5").unwrap(), Shard { index: 2, count: 5 });
+    }
+
+    #[test]
+    fn toml_errors_name_the_file_and_the_problem() {
+        let e = ExperimentConfig::from_toml("laps = 3\nrepeats = 1\nmethods = [\"simplex\"]\ntracks = [{track = \"x\", kernels = [5]}]", "grid.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("grid.toml") && e.contains("simplex"), "{e}");
+        let e = ExperimentConfig::from_toml("laps = \"many\"", "g.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("g.toml") && e.contains("laps"), "{e}");
+    }
+}

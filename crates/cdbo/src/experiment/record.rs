@@ -1,0 +1,141 @@
+//! One finished run of a grid, as saved to `DIR/runs/ID.json`: what was run, the learning
+//! curve, the best policy and the time spent. A file exists only for a finished run (it is
+//! written to a temporary name and renamed), so an interrupted grid resumes by redoing the
+//! runs without one.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::grid::{ExperimentConfig, RunSpec};
+use super::race::{LapRecord, RaceConfig, race};
+use crate::car::Car;
+use crate::error::{Error, Result};
+use crate::track::Track;
+
+/// A finished run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunRecord {
+    /// Which run.
+    pub spec: RunSpec,
+    /// Laps of the run.
+    pub laps_planned: usize,
+    /// The track's own name and length.
+    pub track_name: String,
+    /// Track length (m).
+    pub length_m: f64,
+    /// Reward of the demonstration lap.
+    pub demo_reward_mps: f64,
+    /// Reward of the limit lap.
+    pub limit_reward_mps: f64,
+    /// Reward of the initial policy π(w₀).
+    pub initial_reward_mps: f64,
+    /// Best reward.
+    pub best_reward_mps: f64,
+    /// Best weights.
+    pub best_weights: Vec<f64>,
+    /// The policy's kernel length-scale.
+    pub lengthscale: f64,
+    /// Every lap.
+    pub laps: Vec<LapRecord>,
+    /// Wall-clock seconds of the run.
+    pub wall_s: f64,
+}
+
+impl RunRecord {
+    /// Seconds the optimiser spent in total.
+    pub fn optimizer_s(&self) -> f64 {
+        self.laps.iter().map(|l| l.optimizer_s).sum()
+    }
+
+    /// Seconds the simulator spent in total.
+    pub fn simulator_s(&self) -> f64 {
+        self.laps.iter().map(|l| l.simulator_s).sum()
+    }
+
+    /// Where run `spec` is saved under an experiment folder.
+    pub fn path(dir: &Path, spec: &RunSpec) -> PathBuf {
+        dir.join("runs").join(format!("{}.json", spec.id()))
+    }
+
+    /// Saves atomically: written to `ID.json.tmp`, then renamed.
+    pub fn save(&self, dir: &Path) -> Result<()> {
+        let path = RunRecord::path(dir, &self.spec);
+        let tmp = path.with_extension("json.tmp");
+        let io = |e: std::io::Error, p: &Path| Error::Domain(format!("{}: {e}", p.display()));
+        std::fs::create_dir_all(dir.join("runs")).map_err(|e| io(e, dir))?;
+        let text = serde_json::to_string(self).map_err(|e| Error::Domain(e.to_string()))?;
+        std::fs::write(&tmp, text).map_err(|e| io(e, &tmp))?;
+        std::fs::rename(&tmp, &path).map_err(|e| io(e, &path))
+    }
+
+    /// Loads one saved run.
+    pub fn load(path: &Path) -> Result<RunRecord> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| Error::Domain(format!("{}: {e}", path.display())))?;
+        serde_json::from_str(&text)
+            .map_err(|e| Error::Domain(format!("{}: not a cdbo run record: {e}", path.display())))
+    }
+
+    /// Every run saved under the experiment folders, the first copy of each run kept.
+    pub fn load_all(dirs: &[PathBuf]) -> Result<Vec<RunRecord>> {
+        let mut records: Vec<RunRecord> = Vec::new();
+        for dir in dirs {
+            let runs = dir.join("runs");
+            let entries = std::fs::read_dir(&runs).map_err(|e| {
+                Error::Domain(format!(
+                    "{}: {e} (expected the output folder of `cdbo experiment`)",
+                    runs.display()
+                ))
+            })?;
+            let mut paths: Vec<PathBuf> = entries
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|x| x == "json"))
+                .collect();
+            paths.sort();
+            for p in paths {
+                let r = RunRecord::load(&p)?;
+                if !records.iter().any(|o| o.spec == r.spec) {
+                    records.push(r);
+                }
+            }
+        }
+        records.sort_by(|a, b| a.spec.cmp(&b.spec));
+        Ok(records)
+    }
+}
+
+/// Races one run of the grid; `progress` is called after every lap.
+pub fn run(
+    spec: &RunSpec,
+    grid: &ExperimentConfig,
+    track: Track,
+    car: &Car,
+    progress: impl FnMut(&LapRecord),
+) -> Result<RunRecord> {
+    let start = std::time::Instant::now();
+    let config = RaceConfig {
+        method: spec.method.clone(),
+        kernels: spec.kernels,
+        laps: grid.laps,
+        seed: spec.seed(),
+        beta: grid.beta,
+        demo_speed: grid.demo_speed,
+    };
+    let (track_name, length_m) = (track.name.clone(), track.length);
+    let outcome = race(track, car, &config, progress)?;
+    Ok(RunRecord {
+        spec: spec.clone(),
+        laps_planned: grid.laps,
+        track_name,
+        length_m,
+        demo_reward_mps: outcome.demo.reward_mps,
+        limit_reward_mps: outcome.limit.reward_mps,
+        initial_reward_mps: outcome.laps.first().map_or(0.0, |l| l.reward_mps),
+        best_reward_mps: outcome.best_reward_mps,
+        best_weights: outcome.best.weights.clone(),
+        lengthscale: outcome.best.lengthscale,
+        laps: outcome.laps,
+        wall_s: start.elapsed().as_secs_f64(),
+    })
+}

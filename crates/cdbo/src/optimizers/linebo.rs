@@ -1,0 +1,276 @@
+//! LineBO, Bayesian optimisation restricted to lines (Kirschner et al. 2019).
+//!
+//! One GP over all laps (Matérn-5/2 ARD, hyperparameters re-fitted every `refit_every` laps);
+//! the search moves along one line at a time, ℓ(t) = w_line + t·d, through the best weights
+//! when the line begins. Directions alternate between a random coordinate axis
+//! (CoordinateLineBO) and a uniformly random unit vector (RandomLineBO). On a line, each lap
+//! maximises UCB μ + βσ over `grid` evenly spaced t where ℓ(t) is inside the box (one
+//! batched GP query); after `laps_per_line` laps a new line begins. The first lap is w₀.
+
+use rand::Rng;
+use rand_distr::{Distribution, StandardNormal};
+use serde::{Deserialize, Serialize};
+
+use super::{Best, Optimizer, SearchBox, check_tell, rng_for};
+use crate::acquisition::ucb::{DEFAULT_BETA, ucb};
+use crate::error::{Error, Result};
+use crate::gp::likelihood::{Bounds, fit};
+use crate::gp::{GaussianProcess, Hyper, Kernel, Mean};
+
+/// Settings of a LineBO run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LineBoConfig {
+    /// Seed of every random choice.
+    pub seed: u64,
+    /// Half-width r of the search box around w₀.
+    pub box_radius: f64,
+    /// UCB exploration weight β.
+    pub beta: f64,
+    /// Laps on each line.
+    pub laps_per_line: usize,
+    /// Values of t scored per lap.
+    pub grid: usize,
+    /// Re-fit the hyperparameters every this many laps.
+    pub refit_every: usize,
+    /// Adam iterations per fit.
+    pub fit_iterations: usize,
+}
+
+impl Default for LineBoConfig {
+    fn default() -> Self {
+        LineBoConfig {
+            seed: 0,
+            box_radius: super::DEFAULT_BOX_RADIUS,
+            beta: DEFAULT_BETA,
+            laps_per_line: 4,
+            grid: 200,
+            refit_every: 5,
+            fit_iterations: 30,
+        }
+    }
+}
+
+/// Everything needed to resume a run: the rest follows from replaying the told laps.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LineBoState {
+    /// Settings.
+    pub config: LineBoConfig,
+    /// The demonstration's weights.
+    pub w0: Vec<f64>,
+    /// Told (weights, reward), in order.
+    pub observations: Vec<(Vec<f64>, f64)>,
+}
+
+/// The current line: origin, unit direction, its index and laps driven on it.
+#[derive(Debug, Clone, PartialEq)]
+struct Line {
+    origin: Vec<f64>,
+    direction: Vec<f64>,
+    index: u64,
+    laps: usize,
+}
+
+/// A LineBO run.
+#[derive(Debug, Clone)]
+pub struct LineBo {
+    state: LineBoState,
+    bounds: SearchBox,
+    gp: GaussianProcess,
+    line: Line,
+    best: Best,
+    pending: Option<Vec<f64>>,
+}
+
+impl LineBo {
+    /// A new run from the demonstration's weights.
+    pub fn new(w0: Vec<f64>, config: LineBoConfig) -> Result<LineBo> {
+        LineBo::resume(LineBoState {
+            config,
+            w0,
+            observations: Vec::new(),
+        })
+    }
+
+    /// Rebuilds a run by replaying its told laps.
+    pub fn resume(saved: LineBoState) -> Result<LineBo> {
+        let dim = saved.w0.len();
+        if dim == 0 || saved.w0.iter().any(|w| !w.is_finite()) {
+            return Err(Error::Domain(
+                "LineBO needs a finite start point of at least one weight".into(),
+            ));
+        }
+        if saved.config.laps_per_line == 0 || saved.config.grid < 2 {
+            return Err(Error::Domain(
+                "LineBO needs at least one lap per line and a grid of two points".into(),
+            ));
+        }
+        let r = saved.config.box_radius;
+        let hyper = Hyper {
+            kernel: Kernel::Matern52,
+            lengthscales: vec![r; dim],
+            signal_var: 1.0,
+            noise_var: 0.0,
+            mean: Mean::Constant,
+        };
+        let mut run = LineBo {
+            bounds: SearchBox::around(&saved.w0, r)?,
+            gp: GaussianProcess::new(dim, hyper)?,
+            line: Line {
+                origin: saved.w0.clone(),
+                direction: vec![0.0; dim],
+                index: 0,
+                laps: 0,
+            },
+            best: Best::default(),
+            pending: None,
+            state: LineBoState {
+                observations: Vec::new(),
+                ..saved.clone()
+            },
+        };
+        run.line = run.line_through(saved.w0.clone(), 0);
+        for (w, r) in &saved.observations {
+            run.tell(w, *r)?;
+        }
+        Ok(run)
+    }
+
+    /// The state to save.
+    pub fn state(&self) -> &LineBoState {
+        &self.state
+    }
+
+    /// Line `index` through `origin`: a coordinate axis for even indices, a random unit
+    /// direction for odd ones.
+    fn line_through(&self, origin: Vec<f64>, index: u64) -> Line {
+        let dim = origin.len();
+        let mut rng = rng_for(self.state.config.seed, (1 << 40) + index);
+        let mut direction = vec![0.0; dim];
+        if index % 2 == 0 {
+            direction[rng.random_range(0..dim)] = 1.0;
+        } else {
+            for d in direction.iter_mut() {
+                *d = StandardNormal.sample(&mut rng);
+            }
+            let norm = direction
+                .iter()
+                .map(|d| d * d)
+                .sum::<f64>()
+                .sqrt()
+                .max(1e-300);
+            direction.iter_mut().for_each(|d| *d /= norm);
+        }
+        Line {
+            origin,
+            direction,
+            index,
+            laps: 0,
+        }
+    }
+
+    /// The range of t keeping origin + t·d inside the box.
+    fn t_range(&self) -> (f64, f64) {
+        let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
+        for (i, d) in self.line.direction.iter().enumerate() {
+            if d.abs() < 1e-15 {
+                continue;
+            }
+            let a = (self.bounds.lower[i] - self.line.origin[i]) / d;
+            let b = (self.bounds.upper[i] - self.line.origin[i]) / d;
+            lo = lo.max(a.min(b));
+            hi = hi.min(a.max(b));
+        }
+        (lo.min(0.0), hi.max(0.0))
+    }
+
+    fn on_line(&self, t: f64) -> Vec<f64> {
+        let mut w: Vec<f64> = self
+            .line
+            .origin
+            .iter()
+            .zip(&self.line.direction)
+            .map(|(o, d)| o + t * d)
+            .collect();
+        self.bounds.clamp(&mut w);
+        w
+    }
+
+    fn maybe_refit(&mut self) -> Result<()> {
+        let n = self.gp.len();
+        if n < 2 || n % self.state.config.refit_every.max(1) != 0 {
+            return Ok(());
+        }
+        let ys = self.gp.values();
+        let mean_sq = ys.iter().map(|y| y * y).sum::<f64>() / n as f64;
+        let width = 2.0 * self.state.config.box_radius;
+        let bounds = Bounds {
+            lengthscale: (0.01 * width, 10.0 * width),
+            signal_var: (1e-3 * mean_sq.max(1e-6), 1e2 * mean_sq.max(1e-6)),
+            noise_var: None,
+        };
+        fit(&mut self.gp, &bounds, self.state.config.fit_iterations)?;
+        Ok(())
+    }
+}
+
+impl Optimizer for LineBo {
+    fn name(&self) -> &'static str {
+        "linebo"
+    }
+
+    fn dim(&self) -> usize {
+        self.state.w0.len()
+    }
+
+    fn ask(&mut self) -> Result<Vec<f64>> {
+        if let Some(w) = &self.pending {
+            return Ok(w.clone());
+        }
+        let w = if self.state.observations.is_empty() {
+            self.state.w0.clone()
+        } else {
+            let (lo, hi) = self.t_range();
+            let grid = self.state.config.grid;
+            let ts: Vec<f64> = (0..grid)
+                .map(|k| lo + (hi - lo) * k as f64 / (grid - 1) as f64)
+                .collect();
+            let points: Vec<f64> = ts.iter().flat_map(|&t| self.on_line(t)).collect();
+            let beta = self.state.config.beta;
+            let scores: Vec<f64> = self
+                .gp
+                .predict_batch(&points)
+                .into_iter()
+                .map(|(m, v)| ucb(m, v, beta))
+                .collect();
+            self.on_line(ts[crate::acquisition::argmax(&scores)])
+        };
+        self.pending = Some(w.clone());
+        Ok(w)
+    }
+
+    fn tell(&mut self, weights: &[f64], reward: f64) -> Result<()> {
+        check_tell(self.dim(), weights, reward)?;
+        self.gp.add(weights, reward)?;
+        self.state.observations.push((weights.to_vec(), reward));
+        self.best.offer(weights, reward);
+        self.pending = None;
+        self.line.laps += 1;
+        if self.line.laps >= self.state.config.laps_per_line || self.state.observations.len() == 1 {
+            let origin = self.best.get().map_or(&self.state.w0[..], |b| b.0).to_vec();
+            self.line = self.line_through(origin, self.line.index + 1);
+        }
+        self.maybe_refit()
+    }
+
+    fn best(&self) -> Option<(&[f64], f64)> {
+        self.best.get()
+    }
+
+    fn evaluations(&self) -> usize {
+        self.state.observations.len()
+    }
+
+    fn save(&self) -> super::Saved {
+        super::Saved::Linebo(Box::new(self.state.clone()))
+    }
+}

@@ -1,0 +1,200 @@
+//! REMBO, Bayesian optimisation in a random embedding (Wang et al. 2016).
+//!
+//! A matrix A ∈ ℝ^{D×d} with N(0, 1) entries, drawn from the seed, embeds the low-dimensional
+//! box Y = [−√d, √d]^d in the weights: w(y) = w₀ + r·P(Ay), with P the projection onto
+//! [−1, 1]^D (REMBO's map into its normalised box X = [−1, 1]^D, here the search box
+//! [w₀ − r, w₀ + r]) and y = 0 giving the demonstration. After y = 0 and S initial samples
+//! y ~ N(0, (0.2√d)²I), a GP (Matérn-5/2 ARD as in REMBO, CDBO's hyperparameter scheme)
+//! models the reward over y; the next y maximises expected improvement (REMBO's
+//! acquisition) by coordinate ascent with three sweeps, cheap in d dimensions.
+
+use rand_distr::{Distribution, StandardNormal};
+use serde::{Deserialize, Serialize};
+
+use super::bo::{Bo, BoConfig, BoState, Maximiser};
+use super::coordinate_ascent::AxisSearch;
+use super::{Optimizer, check_tell, rng_for};
+use crate::acquisition::Acquisition;
+use crate::error::{Error, Result};
+use crate::gp::Kernel;
+
+/// Settings of a REMBO run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RemboConfig {
+    /// Seed of the embedding and of every other random choice.
+    pub seed: u64,
+    /// Dimension d of the embedding.
+    pub embedding_dim: usize,
+    /// Half-width r of the search box around w₀.
+    pub box_radius: f64,
+}
+
+/// Everything needed to resume a run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RemboState {
+    /// Settings.
+    pub config: RemboConfig,
+    /// The demonstration's weights.
+    pub w0: Vec<f64>,
+    /// The BO run in the embedding.
+    pub inner: BoState,
+}
+
+/// A REMBO run.
+#[derive(Debug, Clone)]
+pub struct Rembo {
+    config: RemboConfig,
+    w0: Vec<f64>,
+    /// A, row-major D × d.
+    embedding: Vec<f64>,
+    inner: Bo,
+    /// The embedded point of the pending suggestion and its weights.
+    pending: Option<(Vec<f64>, Vec<f64>)>,
+    best: super::Best,
+}
+
+/// σ of the initial samples around y = 0, relative to the half-width √d of Y.
+pub const INITIAL_SIGMA: f64 = 0.2;
+
+/// The stream of the embedding's draws (the inner BO run uses streams 0, 1, 2, …).
+const EMBEDDING_STREAM: u64 = u64::MAX;
+
+impl Rembo {
+    /// A new run from the demonstration's weights.
+    pub fn new(w0: Vec<f64>, config: RemboConfig) -> Result<Rembo> {
+        let d = config.embedding_dim;
+        if d == 0 || w0.is_empty() {
+            return Err(Error::Domain(
+                "REMBO needs at least one weight and an embedding of dimension ≥ 1".into(),
+            ));
+        }
+        let inner = BoConfig {
+            seed: config.seed,
+            acquisition: Acquisition::Ei { xi: 0.0 },
+            initial_sigma: INITIAL_SIGMA * (d as f64).sqrt(),
+            kernel: Kernel::Matern52,
+            box_radius: (d as f64).sqrt(),
+            maximiser: Maximiser::CoordinateAscent(AxisSearch {
+                sweeps: 3,
+                ..AxisSearch::default()
+            }),
+            ..BoConfig::default()
+        };
+        let state = RemboState {
+            inner: Bo::new(vec![0.0; d], inner)?.state().clone(),
+            w0,
+            config,
+        };
+        Rembo::resume(state)
+    }
+
+    /// Rebuilds a run from its state.
+    pub fn resume(state: RemboState) -> Result<Rembo> {
+        let (dim, d) = (state.w0.len(), state.config.embedding_dim);
+        if state.inner.w0.len() != d {
+            return Err(Error::Domain(format!(
+                "corrupt REMBO state: an embedding of dimension {d} but a {}-dimensional GP",
+                state.inner.w0.len()
+            )));
+        }
+        let mut rng = rng_for(state.config.seed, EMBEDDING_STREAM);
+        let embedding = (0..dim * d)
+            .map(|_| StandardNormal.sample(&mut rng))
+            .collect();
+        let inner = Bo::resume(state.inner)?;
+        let mut run = Rembo {
+            config: state.config,
+            w0: state.w0,
+            embedding,
+            inner,
+            pending: None,
+            best: super::Best::default(),
+        };
+        let told: Vec<(Vec<f64>, f64)> = run.inner.state().observations.clone();
+        for (y, r) in told {
+            run.best.offer(&run.weights(&y), r);
+        }
+        Ok(run)
+    }
+
+    /// The state to save.
+    pub fn state(&self) -> RemboState {
+        RemboState {
+            config: self.config.clone(),
+            w0: self.w0.clone(),
+            inner: self.inner.state().clone(),
+        }
+    }
+
+    /// w(y) = w₀ + r·P(Ay).
+    pub fn weights(&self, y: &[f64]) -> Vec<f64> {
+        let d = y.len();
+        let r = self.config.box_radius;
+        self.w0
+            .iter()
+            .enumerate()
+            .map(|(i, w)| {
+                let ay: f64 = self.embedding[i * d..(i + 1) * d]
+                    .iter()
+                    .zip(y)
+                    .map(|(a, y)| a * y)
+                    .sum();
+                w + r * ay.clamp(-1.0, 1.0)
+            })
+            .collect()
+    }
+}
+
+impl Optimizer for Rembo {
+    fn name(&self) -> &'static str {
+        match self.config.embedding_dim {
+            5 => "rembo-5d",
+            10 => "rembo-10d",
+            _ => "rembo",
+        }
+    }
+
+    fn dim(&self) -> usize {
+        self.w0.len()
+    }
+
+    fn ask(&mut self) -> Result<Vec<f64>> {
+        if let Some((_, w)) = &self.pending {
+            return Ok(w.clone());
+        }
+        let y = self.inner.ask()?;
+        let w = self.weights(&y);
+        self.pending = Some((y, w.clone()));
+        Ok(w)
+    }
+
+    /// Only the asked weights can be told: the GP lives in the embedding, and weights outside
+    /// its image have no point there.
+    fn tell(&mut self, weights: &[f64], reward: f64) -> Result<()> {
+        check_tell(self.dim(), weights, reward)?;
+        let y = match &self.pending {
+            Some((y, w)) if w.as_slice() == weights => y.clone(),
+            _ => {
+                return Err(Error::Domain(
+                    "REMBO can only be told the reward of the weights it asked for last".into(),
+                ));
+            }
+        };
+        self.inner.tell(&y, reward)?;
+        self.best.offer(weights, reward);
+        self.pending = None;
+        Ok(())
+    }
+
+    fn best(&self) -> Option<(&[f64], f64)> {
+        self.best.get()
+    }
+
+    fn evaluations(&self) -> usize {
+        self.inner.evaluations()
+    }
+
+    fn save(&self) -> super::Saved {
+        super::Saved::Rembo(Box::new(self.state()))
+    }
+}
