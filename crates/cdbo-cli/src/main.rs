@@ -23,6 +23,11 @@ struct Cli {
 enum Command {
     /// Learn a fast policy for a track: demonstration, then CDBO for N laps (the main job).
     Race(commands::race::RaceArgs),
+    /// Run a grid of races (a TOML file or a preset: paper, paper-plus, quick), resumable and
+    /// shardable.
+    Experiment(commands::experiment::ExperimentArgs),
+    /// Figures, tables and the paper's claims from experiment folders (shards are merged).
+    Report(commands::report::ReportArgs),
     /// Drive one lap and report its time, reward and the physical limit.
     Lap(commands::lap::LapArgs),
     /// The quasi-steady-state minimum lap time of a car on a track.
@@ -46,6 +51,8 @@ fn main() -> ExitCode {
     let data = cdbo::data_path::DataPath::new(&cli.data_dirs);
     let result = match cli.command {
         Command::Race(args) => commands::race::run(&args, &data),
+        Command::Experiment(args) => commands::experiment::run_grid(&args, &data),
+        Command::Report(args) => commands::report::run(&args, &data),
         Command::Lap(args) => commands::lap::run(&args, &data),
         Command::Limit(args) => commands::limit::run(&args, &data),
         Command::Track(cmd) => commands::track::run(&cmd, &data),

@@ -1,17 +1,14 @@
 //! Every method behind the `Optimizer` trait: determinism, save/resume, and the qualitative
 //! results of the papers that introduced the peers (TuRBO, LineBO, REMBO).
 
-use cdbo::acquisition::ucb::DEFAULT_BETA;
 use cdbo::benchmarks::Problem;
-use cdbo::optimizers::{METHODS, Optimizer, Saved, by_name};
+use cdbo::optimizers::{METHODS, Optimizer, Saved, Settings, by_name};
 
 fn optimiser(method: &str, problem: &Problem, seed: u64) -> Box<dyn Optimizer + Send> {
     by_name(
         method,
         problem.start.clone(),
-        seed,
-        DEFAULT_BETA,
-        problem.radius,
+        &Settings::problem(seed, problem.radius),
     )
     .unwrap()
 }
@@ -92,7 +89,7 @@ fn every_method_refuses_bad_tells_and_keeps_its_state() {
             "{method}: the pending suggestion changed"
         );
     }
-    assert!(by_name("simplex", vec![0.0], 0, 1.0, 1.0).is_err());
+    assert!(by_name("simplex", vec![0.0], &Settings::problem(0, 1.0)).is_err());
 }
 
 /// TuRBO (Eriksson et al. 2019, Fig. 3) and LineBO (Kirschner et al. 2019, Fig. 2) beat

@@ -138,13 +138,8 @@ fn optimizers(args: &OptimizersArgs) -> CliResult {
     for method in &args.methods {
         let (mut bests, mut seconds) = (Vec::new(), 0.0);
         for seed in 0..args.seeds {
-            let mut opt = cdbo::optimizers::by_name(
-                method,
-                problem.start.clone(),
-                seed,
-                cdbo::acquisition::ucb::DEFAULT_BETA,
-                problem.radius,
-            )?;
+            let settings = cdbo::optimizers::Settings::problem(seed, problem.radius);
+            let mut opt = cdbo::optimizers::by_name(method, problem.start.clone(), &settings)?;
             let start = std::time::Instant::now();
             for _ in 0..args.evals {
                 let w = opt.ask()?;

@@ -1,11 +1,13 @@
 //! One module per sub-command; shared argument groups here.
 
 pub mod bench;
+pub mod experiment;
 pub mod lap;
 pub mod limit;
 pub mod plot;
 pub mod policy;
 pub mod race;
+pub mod report;
 pub mod track;
 
 use clap::Args;

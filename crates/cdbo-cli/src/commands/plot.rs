@@ -53,6 +53,11 @@ pub fn run(cmd: &PlotCommand, data: &DataPath) -> CliResult {
 
 /// Something drawn on a drawing area of any backend.
 pub trait Figure {
+    /// Pixel size of the figure.
+    fn size(&self) -> (u32, u32) {
+        SIZE
+    }
+
     /// Draws the figure.
     fn render<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> CliResult
     where
@@ -131,6 +136,82 @@ impl Figure for LineChart {
             .border_style(BLACK)
             .background_style(WHITE.mix(0.8))
             .draw()?;
+        Ok(())
+    }
+}
+
+/// A curve with a shaded band: label, colour and (x, mean, half-width) points.
+pub type Band = (String, RGBColor, Vec<(f64, f64, f64)>);
+
+/// Side-by-side panels of curves with shaded bands (mean ± standard error), sharing the
+/// legend's colours: the paper's Fig. 4 and 5.
+pub struct Panels {
+    /// Title of each panel.
+    pub titles: Vec<String>,
+    /// Axis label.
+    pub x_label: String,
+    /// Axis label.
+    pub y_label: String,
+    /// The bands of each panel.
+    pub panels: Vec<Vec<Band>>,
+}
+
+impl Figure for Panels {
+    fn size(&self) -> (u32, u32) {
+        (520 * self.panels.len().max(1) as u32, 560)
+    }
+
+    fn render<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> CliResult
+    where
+        DB::ErrorType: 'static,
+    {
+        let areas = root.split_evenly((1, self.panels.len().max(1)));
+        for ((area, bands), title) in areas.iter().zip(&self.panels).zip(&self.titles) {
+            let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+            for &(x, m, h) in bands.iter().flat_map(|b| b.2.iter()) {
+                (x0, x1) = (x0.min(x), x1.max(x));
+                (y0, y1) = (y0.min(m - h), y1.max(m + h));
+            }
+            if x0 > x1 {
+                continue;
+            }
+            let pad = 0.05 * (y1 - y0).max(1e-9);
+            let mut chart = ChartBuilder::on(area)
+                .caption(title, ("sans-serif", 22))
+                .margin(12)
+                .x_label_area_size(40)
+                .y_label_area_size(55)
+                .build_cartesian_2d(x0..x1.max(x0 + 1e-9), (y0 - pad)..(y1 + pad))?;
+            chart
+                .configure_mesh()
+                .x_desc(&self.x_label)
+                .y_desc(&self.y_label)
+                .draw()?;
+            for (label, colour, points) in bands {
+                let c = *colour;
+                let outline: Vec<(f64, f64)> = points
+                    .iter()
+                    .map(|p| (p.0, p.1 + p.2))
+                    .chain(points.iter().rev().map(|p| (p.0, p.1 - p.2)))
+                    .collect();
+                chart.draw_series(std::iter::once(Polygon::new(outline, c.mix(0.2).filled())))?;
+                chart
+                    .draw_series(LineSeries::new(
+                        points.iter().map(|p| (p.0, p.1)),
+                        c.stroke_width(2),
+                    ))?
+                    .label(label)
+                    .legend(move |(x, y)| {
+                        PathElement::new([(x, y), (x + 20, y)], c.stroke_width(2))
+                    });
+            }
+            chart
+                .configure_series_labels()
+                .position(SeriesLabelPosition::LowerRight)
+                .border_style(BLACK)
+                .background_style(WHITE.mix(0.8))
+                .draw()?;
+        }
         Ok(())
     }
 }
@@ -316,13 +397,13 @@ pub fn draw(path: &Path, figure: &impl Figure) -> CliResult {
     });
     match path.extension().and_then(|e| e.to_str()) {
         Some("svg") => {
-            let root = SVGBackend::new(path, SIZE).into_drawing_area();
+            let root = SVGBackend::new(path, figure.size()).into_drawing_area();
             root.fill(&WHITE)?;
             figure.render(&root)?;
             root.present()?;
         }
         Some("png") => {
-            let root = BitMapBackend::new(path, SIZE).into_drawing_area();
+            let root = BitMapBackend::new(path, figure.size()).into_drawing_area();
             root.fill(&WHITE)?;
             figure.render(&root)?;
             root.present()

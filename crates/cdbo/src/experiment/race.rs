@@ -112,13 +112,9 @@ pub fn race(
     }
     let lengthscale = default_lengthscale(config.kernels);
     let initial = RkhsPolicy::fit(&demo_pairs, config.kernels, lengthscale, DEFAULT_RIDGE)?;
-    let mut optimizer = crate::optimizers::by_name(
-        &config.method,
-        initial.weights.clone(),
-        config.seed,
-        config.beta,
-        crate::optimizers::DEFAULT_BOX_RADIUS,
-    )?;
+    let settings = crate::optimizers::Settings::race(config.seed, config.beta);
+    let mut optimizer =
+        crate::optimizers::by_name(&config.method, initial.weights.clone(), &settings)?;
     let mut laps = Vec::with_capacity(config.laps);
     let mut best = (initial.clone(), 0.0);
     for lap in 1..=config.laps {

@@ -24,6 +24,8 @@ pub struct RunRecord {
     pub track_name: String,
     /// Track length (m).
     pub length_m: f64,
+    /// Speed of the demonstrator (m/s).
+    pub demo_speed: f64,
     /// Reward of the demonstration lap.
     pub demo_reward_mps: f64,
     /// Reward of the limit lap.
@@ -129,6 +131,7 @@ pub fn run(
         laps_planned: grid.laps,
         track_name,
         length_m,
+        demo_speed: grid.demo_speed,
         demo_reward_mps: outcome.demo.reward_mps,
         limit_reward_mps: outcome.limit.reward_mps,
         initial_reward_mps: outcome.laps.first().map_or(0.0, |l| l.reward_mps),

@@ -86,21 +86,57 @@ pub const METHODS: &[&str] = &[
     "random",
 ];
 
-/// An optimiser by its command-line name, from w₀, a seed, the UCB β (used by the UCB
-/// methods) and the half-width r of the search box around w₀; the evolution strategies start
-/// with σ = r/15 (0.1 for the policy box).
-pub fn by_name(
-    name: &str,
-    w0: Vec<f64>,
-    seed: u64,
-    beta: f64,
-    box_radius: f64,
-) -> Result<Box<dyn Optimizer + Send>> {
+/// What every method is told besides w₀.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Settings {
+    /// Seed of every random choice.
+    pub seed: u64,
+    /// UCB β of the UCB methods (CDBO, BO-CMA-ES, LineBO).
+    pub beta: f64,
+    /// Half-width r of the search box around w₀.
+    pub box_radius: f64,
+    /// The exploration scale around w₀: CDBO's initial σ₀ and the evolution strategies' σ.
+    pub sigma0: f64,
+}
+
+impl Settings {
+    /// For a race: the policy box (r = 1.5) and σ₀ = 0.03 for every method (CDBO's initial
+    /// samples; with σ = 0.1, most perturbations of a cruising demonstration brake the car to
+    /// a stop on Forza, and a search whose every lap fails learns nothing).
+    pub fn race(seed: u64, beta: f64) -> Settings {
+        Settings {
+            seed,
+            beta,
+            box_radius: DEFAULT_BOX_RADIUS,
+            sigma0: 0.03,
+        }
+    }
+
+    /// For a test problem on a box of half-width r: σ₀ = r/15.
+    pub fn problem(seed: u64, box_radius: f64) -> Settings {
+        Settings {
+            seed,
+            beta: crate::acquisition::ucb::DEFAULT_BETA,
+            box_radius,
+            sigma0: box_radius / 15.0,
+        }
+    }
+}
+
+/// An optimiser by its command-line name, from w₀ and the settings shared by every method.
+pub fn by_name(name: &str, w0: Vec<f64>, settings: &Settings) -> Result<Box<dyn Optimizer + Send>> {
+    let Settings {
+        seed,
+        beta,
+        box_radius,
+        sigma0,
+    } = *settings;
     let bo = |maximiser| bo::BoConfig {
         seed,
         acquisition: crate::acquisition::Acquisition::Ucb { beta },
         box_radius,
         maximiser,
+        initial_sigma: sigma0,
         ..bo::BoConfig::default()
     };
     let rembo = |embedding_dim| rembo::RemboConfig {
@@ -120,7 +156,7 @@ pub fn by_name(
         "cmaes" => {
             let config = cmaes::CmaesConfig {
                 seed,
-                sigma0: box_radius / 15.0,
+                sigma0,
                 bounds: Some(SearchBox::around(&w0, box_radius)?),
                 ..cmaes::CmaesConfig::default()
             };
@@ -149,7 +185,7 @@ pub fn by_name(
             w0,
             random::RandomConfig {
                 seed,
-                sigma: box_radius / 15.0,
+                sigma: sigma0,
                 box_radius,
             },
         )?),

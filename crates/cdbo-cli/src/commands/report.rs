@@ -1,0 +1,371 @@
+//! `cdbo report`: the paper's figures and tables from one or more experiment folders (the
+//! shards of a grid are merged): Fig. 4/5 learning curves, Fig. 3 best policy and speeds,
+//! Fig. 2 the policy length-scale's effect on the demonstration fit, Table 1 run times, and
+//! `results.md` checking the paper's claims with numbers.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+use plotters::style::{BLACK, BLUE, CYAN, GREEN, MAGENTA, RED, RGBColor};
+
+use super::plot::{LineChart, Panels, draw, speed_chart};
+use super::{CliResult, load_track};
+use cdbo::car::catalog as cars;
+use cdbo::data_path::DataPath;
+use cdbo::experiment::race::demonstrate;
+use cdbo::experiment::record::RunRecord;
+use cdbo::experiment::summary::{Curve, claims, curves, times};
+use cdbo::policy::RkhsPolicy;
+use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
+
+#[derive(Debug, Args)]
+pub struct ReportArgs {
+    /// Experiment folders written by `cdbo experiment` (shards of one grid are merged).
+    #[arg(required = true)]
+    dirs: Vec<PathBuf>,
+    /// Output folder (default: DIR/report for the first DIR).
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
+    /// Car the runs used.
+    #[arg(long, default_value = cars::DEFAULT)]
+    car: String,
+}
+
+/// A fixed colour per method, so that figures agree.
+fn colour(method: &str) -> RGBColor {
+    match method {
+        "cdbo" => BLUE,
+        "cmaes" => RED,
+        "bo-cmaes" => GREEN,
+        "rembo-5d" => MAGENTA,
+        "rembo-10d" => RGBColor(150, 80, 0),
+        "turbo" => CYAN,
+        "linebo" => RGBColor(120, 120, 120),
+        _ => BLACK,
+    }
+}
+
+/// Figure name of a track's learning curves: the paper's Fig. 4 (Forza) and 5 (Allondaz).
+fn curves_name(track: &str) -> String {
+    match track {
+        "forza" => "fig4_forza".into(),
+        "allondaz" => "fig5_allondaz".into(),
+        t => format!("curves_{t}"),
+    }
+}
+
+pub fn run(args: &ReportArgs, data: &DataPath) -> CliResult {
+    let records = RunRecord::load_all(&args.dirs)?;
+    if records.is_empty() {
+        return Err(format!(
+            "no finished runs under {} (run `cdbo experiment` first)",
+            args.dirs
+                .iter()
+                .map(|d| d.join("runs").display().to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+        .into());
+    }
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| args.dirs[0].join("report"));
+    std::fs::create_dir_all(&out).map_err(|e| format!("{}: {e}", out.display()))?;
+    let car = cars::find(&args.car, data)?;
+    let curves = curves(&records);
+    let mut tracks: Vec<String> = records.iter().map(|r| r.spec.track.clone()).collect();
+    tracks.dedup();
+    let mut figures = Vec::new();
+    for track in &tracks {
+        let name = curves_name(track);
+        learning_curves(&out, &name, track, &curves)?;
+        figures.push((
+            format!("Best reward vs laps on {track}, mean ± standard error"),
+            name,
+        ));
+        if let Some(best) = best_cdbo_run(&records, track) {
+            let t = load_track(track, data)?;
+            let names = best_policy_figures(&out, track, t.clone(), &car, best)?;
+            figures.push((
+                format!(
+                    "Best CDBO policy on {track} ({} kernels) against π(w₀)",
+                    best.spec.kernels
+                ),
+                names.0,
+            ));
+            figures.push((
+                format!("Speeds of π(w₀), the best CDBO policy and the limit on {track}"),
+                names.1,
+            ));
+            let name = lengthscale_figure(&out, track, t, &car, best)?;
+            figures.push((
+                format!("Fit of the demonstration on {track} for three length-scales"),
+                name,
+            ));
+        }
+    }
+    let table = table1(&records);
+    std::fs::write(out.join("table1.md"), &table)?;
+    let results = results_md(&records, &curves, &figures, &table);
+    std::fs::write(out.join("results.md"), results)?;
+    println!(
+        "{} runs from {} folder(s): report in {}",
+        records.len(),
+        args.dirs.len(),
+        out.display()
+    );
+    Ok(())
+}
+
+fn learning_curves(
+    out: &Path,
+    name: &str,
+    track: &str,
+    curves: &std::collections::BTreeMap<(String, usize, String), Curve>,
+) -> CliResult {
+    let mut sizes: Vec<usize> = curves
+        .keys()
+        .filter(|c| c.0 == track)
+        .map(|c| c.1)
+        .collect();
+    sizes.dedup();
+    let panels = Panels {
+        titles: sizes
+            .iter()
+            .map(|m| format!("{track}, {m} kernels"))
+            .collect(),
+        x_label: "lap".into(),
+        y_label: "best reward L/T (m/s)".into(),
+        panels: sizes
+            .iter()
+            .map(|&m| {
+                curves
+                    .iter()
+                    .filter(|(c, _)| c.0 == track && c.1 == m)
+                    .map(|(c, curve)| {
+                        (
+                            format!("{} ({} runs)", c.2, curve.runs),
+                            colour(&c.2),
+                            curve
+                                .mean
+                                .iter()
+                                .zip(&curve.se)
+                                .enumerate()
+                                .map(|(k, (m, s))| ((k + 1) as f64, *m, *s))
+                                .collect(),
+                        )
+                    })
+                    .collect()
+            })
+            .collect(),
+    };
+    for ext in ["png", "svg"] {
+        draw(&out.join(format!("{name}.{ext}")), &panels)?;
+    }
+    Ok(())
+}
+
+/// The best CDBO run on a track at its middle policy size.
+fn best_cdbo_run<'a>(records: &'a [RunRecord], track: &str) -> Option<&'a RunRecord> {
+    let cdbo: Vec<&RunRecord> = records
+        .iter()
+        .filter(|r| r.spec.track == track && r.spec.method == "cdbo")
+        .collect();
+    let mut sizes: Vec<usize> = cdbo.iter().map(|r| r.spec.kernels).collect();
+    sizes.sort();
+    sizes.dedup();
+    let middle = *sizes.get(sizes.len() / 2)?;
+    cdbo.into_iter()
+        .filter(|r| r.spec.kernels == middle)
+        .max_by(|a, b| a.best_reward_mps.total_cmp(&b.best_reward_mps))
+}
+
+/// Fig. 3: the best policy against π(w₀) (a) and their speeds against the limit (b).
+fn best_policy_figures(
+    out: &Path,
+    track_name: &str,
+    track: cdbo::track::Track,
+    car: &cdbo::car::Car,
+    best: &RunRecord,
+) -> Result<(String, String), Box<dyn std::error::Error>> {
+    let limit = cdbo::limit::limit_lap(&track, car);
+    let mut sim = cdbo::sim::Simulator::new(track, car);
+    let (_, demo) = demonstrate(&sim, best.demo_speed);
+    let initial = RkhsPolicy::fit(&demo, best.spec.kernels, best.lengthscale, DEFAULT_RIDGE)?;
+    let best_policy = RkhsPolicy::new(best.best_weights.clone(), best.lengthscale)?;
+    sim.config.trace = true;
+    let initial_lap = sim.lap(&mut initial.clone());
+    let best_lap = sim.lap(&mut best_policy.clone());
+    let xs = || (0..=500).map(|i| i as f64 / 500.0);
+    let policies = LineChart {
+        title: format!("{track_name}: policies ({} kernels)", best.spec.kernels),
+        x_label: "x (fraction of the lap)".into(),
+        y_label: "a (throttle + / brake −)".into(),
+        series: vec![
+            (
+                "initial π(w₀)".into(),
+                GREEN,
+                xs().map(|x| (x, initial.action(x))).collect(),
+            ),
+            (
+                format!("best CDBO ({:.2} m/s)", best.best_reward_mps),
+                BLUE,
+                xs().map(|x| (x, best_policy.action(x))).collect(),
+            ),
+        ],
+    };
+    let speeds = speed_chart(
+        &sim.track,
+        &[
+            ("initial π(w₀)", GREEN, &initial_lap),
+            ("best CDBO", BLUE, &best_lap),
+        ],
+        &limit,
+    );
+    let (a, b) = (
+        format!("fig3a_policy_{track_name}"),
+        format!("fig3b_speed_{track_name}"),
+    );
+    for ext in ["png", "svg"] {
+        draw(&out.join(format!("{a}.{ext}")), &policies)?;
+        draw(&out.join(format!("{b}.{ext}")), &speeds)?;
+    }
+    Ok((a, b))
+}
+
+/// Fig. 2: the demonstration and its ridge fits with ¼, 1 and 4 times the default length-scale
+/// 1/(M − 1), with each fit's RMS error.
+fn lengthscale_figure(
+    out: &Path,
+    track_name: &str,
+    track: cdbo::track::Track,
+    car: &cdbo::car::Car,
+    run: &RunRecord,
+) -> Result<String, Box<dyn std::error::Error>> {
+    let kernels = run.spec.kernels;
+    let sim = cdbo::sim::Simulator::new(track, car);
+    let (_, demo) = demonstrate(&sim, run.demo_speed);
+    let mut series = vec![(
+        "demonstration".to_owned(),
+        BLACK,
+        demo.iter().step_by(5).copied().collect::<Vec<_>>(),
+    )];
+    for (factor, c) in [(0.25, RED), (1.0, BLUE), (4.0, GREEN)] {
+        let l = factor * default_lengthscale(kernels);
+        let p = RkhsPolicy::fit(&demo, kernels, l, DEFAULT_RIDGE)?;
+        let rms = (demo
+            .iter()
+            .map(|(x, a)| (p.action(*x) - a).powi(2))
+            .sum::<f64>()
+            / demo.len() as f64)
+            .sqrt();
+        series.push((
+            format!("l = {l:.4} (RMS error {rms:.4})"),
+            c,
+            (0..=1000)
+                .map(|i| i as f64 / 1000.0)
+                .map(|x| (x, p.action(x)))
+                .collect(),
+        ));
+    }
+    let chart = LineChart {
+        title: format!("{track_name}: fitting the demonstration with {kernels} kernels"),
+        x_label: "x (fraction of the lap)".into(),
+        y_label: "a".into(),
+        series,
+    };
+    let name = format!("fig2_lengthscale_{track_name}");
+    for ext in ["png", "svg"] {
+        draw(&out.join(format!("{name}.{ext}")), &chart)?;
+    }
+    Ok(name)
+}
+
+/// Table 1: average seconds per run, by method (rows) and track / size (columns).
+fn table1(records: &[RunRecord]) -> String {
+    let times = times(records);
+    let mut columns: Vec<(String, usize)> = times.keys().map(|c| (c.0.clone(), c.1)).collect();
+    columns.dedup();
+    let mut methods: Vec<String> = Vec::new();
+    for c in times.keys() {
+        if !methods.contains(&c.2) {
+            methods.push(c.2.clone());
+        }
+    }
+    let mut s = String::from(
+        "Average time per run in seconds: optimiser (wall clock of the whole run incl. the simulator).\n\n| method |",
+    );
+    for (t, m) in &columns {
+        let _ = write!(s, " {t} {m} |");
+    }
+    s += "\n|---|";
+    s += &"---:|".repeat(columns.len());
+    s += "\n";
+    for method in &methods {
+        let _ = write!(s, "| {method} |");
+        for (t, m) in &columns {
+            match times.get(&(t.clone(), *m, method.clone())) {
+                Some((wall, opt, _, _)) => {
+                    let _ = write!(s, " {opt:.1} ({wall:.1}) |");
+                }
+                None => s += " – |",
+            }
+        }
+        s += "\n";
+    }
+    s
+}
+
+fn results_md(
+    records: &[RunRecord],
+    curves: &std::collections::BTreeMap<(String, usize, String), Curve>,
+    figures: &[(String, String)],
+    table: &str,
+) -> String {
+    let mut s = String::from("# Results\n\n");
+    let wall: f64 = records.iter().map(|r| r.wall_s).sum();
+    let _ = writeln!(
+        s,
+        "{} runs; {:.0} s of run time in total (summed over runs, not wall clock of the grid).\n",
+        records.len(),
+        wall
+    );
+    s += "## The paper's claims\n\n";
+    for c in claims(records) {
+        let verdict = match c.holds {
+            Some(true) => "**holds**",
+            Some(false) => "**does not hold**",
+            None => "cannot be checked on these runs",
+        };
+        let _ = writeln!(s, "- {}: {verdict}. {}", c.statement, c.evidence);
+    }
+    s += "\n## Final best reward (m/s), mean ± standard error\n\n| track | kernels | method | runs | best | × demonstration | % of limit |\n|---|---:|---|---:|---:|---:|---:|\n";
+    for ((t, m, method), curve) in curves {
+        let runs: Vec<&RunRecord> = records
+            .iter()
+            .filter(|r| &r.spec.track == t && r.spec.kernels == *m && &r.spec.method == method)
+            .collect();
+        let demo = runs.iter().map(|r| r.demo_reward_mps).sum::<f64>() / runs.len() as f64;
+        let limit = runs.iter().map(|r| r.limit_reward_mps).sum::<f64>() / runs.len() as f64;
+        let (mean, se) = curve.last();
+        let _ = writeln!(
+            s,
+            "| {t} | {m} | {method} | {} | {mean:.2} ± {se:.2} | {:.2} | {:.1} |",
+            curve.runs,
+            mean / demo,
+            100.0 * mean / limit
+        );
+    }
+    s += "\n## Run times (Table 1)\n\n";
+    s += table;
+    s += "\n## Figures\n\n";
+    for (caption, name) in figures {
+        let _ = writeln!(
+            s,
+            "- {caption}: [{name}.png]({name}.png) ([svg]({name}.svg))"
+        );
+    }
+    s
+}
