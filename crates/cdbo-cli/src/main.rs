@@ -28,6 +28,14 @@ enum Command {
     Experiment(commands::experiment::ExperimentArgs),
     /// Figures, tables and the paper's claims from experiment folders (shards are merged).
     Report(commands::report::ReportArgs),
+    /// A persistent ask/tell study for a real car: create, ask, tell, status, best, history,
+    /// export.
+    #[command(subcommand)]
+    Study(commands::study::StudyCommand),
+    /// Optimise with an external lap command, every lap saved to a study (resumable).
+    Optimize(commands::optimize::OptimizeArgs),
+    /// The simulator as a JSON-lines service on stdin/stdout for other optimisers.
+    ServeSim(commands::serve_sim::ServeSimArgs),
     /// Drive one lap and report its time, reward and the physical limit.
     Lap(commands::lap::LapArgs),
     /// The quasi-steady-state minimum lap time of a car on a track.
@@ -47,12 +55,21 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    // Like other Unix tools, end quietly when the reader of our output goes away
+    // (`cdbo study history | head`) instead of panicking on a failed print.
+    // SAFETY: restoring a signal's default action, before any other thread exists.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = Cli::parse();
     let data = cdbo::data_path::DataPath::new(&cli.data_dirs);
     let result = match cli.command {
         Command::Race(args) => commands::race::run(&args, &data),
         Command::Experiment(args) => commands::experiment::run_grid(&args, &data),
         Command::Report(args) => commands::report::run(&args, &data),
+        Command::Study(cmd) => commands::study::run(&cmd),
+        Command::Optimize(args) => commands::optimize::run(&args),
+        Command::ServeSim(args) => commands::serve_sim::run(&args, &data),
         Command::Lap(args) => commands::lap::run(&args, &data),
         Command::Limit(args) => commands::limit::run(&args, &data),
         Command::Track(cmd) => commands::track::run(&cmd, &data),

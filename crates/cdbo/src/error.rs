@@ -34,6 +34,9 @@ pub enum Error {
     /// A value given through the API or the command line is out of its domain.
     #[error("{0}")]
     Domain(String),
+    /// Something another process already did (a study's trial told twice).
+    #[error("{0}")]
+    Conflict(String),
 }
 
 impl Error {

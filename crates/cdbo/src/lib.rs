@@ -11,7 +11,8 @@
 //! - [`policy`]: policies π(x), the paper's RKHS policy and (x, a) tables.
 //! - [`gp`], [`acquisition`], [`optimizers`]: the Gaussian process, UCB / EI and the ask/tell
 //!   optimisers, CDBO first.
-//! - [`experiment`]: learning to race a track end to end.
+//! - [`experiment`]: learning to race a track end to end, and the paper's experiment grid.
+//! - [`study`]: persistent ask/tell studies for a real car; [`evaluator`]: sources of laps.
 
 pub mod acquisition;
 pub mod benchmarks;
@@ -19,6 +20,7 @@ pub mod car;
 pub mod data_path;
 pub mod drive;
 pub mod error;
+pub mod evaluator;
 pub mod experiment;
 pub mod gp;
 pub mod interp;
@@ -27,6 +29,7 @@ pub mod optimizers;
 pub mod params;
 pub mod policy;
 pub mod sim;
+pub mod study;
 pub mod track;
 
 pub use error::{Error, Result};

@@ -24,7 +24,8 @@ pub struct LapArgs {
     /// Hold this pedal command everywhere (1 = full throttle, -1 = full brake).
     #[arg(long, value_name = "A", allow_negative_numbers = true)]
     throttle: Option<f64>,
-    /// Drive a policy table: CSV rows `x,a`.
+    /// Drive a policy: a table of CSV rows `x,a`, or weights as JSON (`.json`, as written by
+    /// `cdbo race`, `cdbo policy fit` and `cdbo optimize`).
     #[arg(long, value_name = "FILE")]
     policy: Option<PathBuf>,
     /// Print JSON.
@@ -59,6 +60,9 @@ pub fn run(args: &LapArgs, data: &DataPath) -> CliResult {
                 return Err(format!("--throttle {a}: must be in [-1, 1]").into());
             }
             Box::new(ConstantPedal(a))
+        }
+        (_, _, Some(path)) if path.extension().is_some_and(|e| e == "json") => {
+            Box::new(super::policy::read_policy(path)?)
         }
         (_, _, Some(path)) => Box::new(PolicyTable::read_csv(path)?),
         (speed, _, _) => {

@@ -4,10 +4,13 @@ pub mod bench;
 pub mod experiment;
 pub mod lap;
 pub mod limit;
+pub mod optimize;
 pub mod plot;
 pub mod policy;
 pub mod race;
 pub mod report;
+pub mod serve_sim;
+pub mod study;
 pub mod track;
 
 use clap::Args;

@@ -89,7 +89,7 @@ pub fn read_policy(path: &Path) -> Result<RkhsPolicy, Box<dyn std::error::Error>
 }
 
 /// Reads `x,a` pairs; with more columns, uses the `x` and `pedal` (or `a`) columns by name.
-fn read_demo(path: &Path) -> Result<Vec<(f64, f64)>, Box<dyn std::error::Error>> {
+pub fn read_demo(path: &Path) -> Result<Vec<(f64, f64)>, Box<dyn std::error::Error>> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut lines = text
         .lines()

@@ -37,6 +37,19 @@ pub enum FailureReason {
     TimeLimit,
 }
 
+impl FailureReason {
+    /// The name used in JSON and CSV output (`off_track`, `spun`, …).
+    pub fn name(self) -> &'static str {
+        match self {
+            FailureReason::OffTrack => "off_track",
+            FailureReason::Spun => "spun",
+            FailureReason::Backwards => "backwards",
+            FailureReason::Stalled => "stalled",
+            FailureReason::TimeLimit => "time_limit",
+        }
+    }
+}
+
 /// Where and when a lap failed.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Failure {

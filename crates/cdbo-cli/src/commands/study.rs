@@ -1,0 +1,374 @@
+//! `cdbo study`: a persistent ask/tell study for optimising a real car, one lap at a time.
+
+use std::path::{Path, PathBuf};
+
+use clap::{Args, Subcommand, ValueEnum};
+
+use super::policy::{read_demo, read_policy};
+use super::{CliResult, print_json};
+use cdbo::policy::RkhsPolicy;
+use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
+use cdbo::study::{Outcome, Study, StudyConfig, Trial};
+
+/// The study's file: `--db FILE`, or `NAME.cdbo.db` in the current folder.
+#[derive(Debug, Args, Clone)]
+pub struct StudyName {
+    /// Study name.
+    name: String,
+    /// Study file (default: NAME.cdbo.db).
+    #[arg(long, value_name = "FILE")]
+    db: Option<PathBuf>,
+}
+
+impl StudyName {
+    pub fn path(&self) -> PathBuf {
+        self.db
+            .clone()
+            .unwrap_or_else(|| PathBuf::from(format!("{}.cdbo.db", self.name)))
+    }
+}
+
+/// How a policy is printed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Format {
+    /// Trial id, weights and an (x, a) table as JSON.
+    Json,
+    /// The (x, a) table as CSV, after a `# trial ID` comment line.
+    Csv,
+}
+
+#[derive(Debug, Args)]
+pub struct InitialPolicy {
+    /// Recorded (x, a) pairs of the initial controller (CSV with x,a columns): w₀ is their ridge fit.
+    #[arg(long, value_name = "demo.csv", conflicts_with = "weights")]
+    demo: Option<PathBuf>,
+    /// Initial weights (JSON written by `cdbo policy fit` or `cdbo race`).
+    #[arg(long, value_name = "w0.json")]
+    weights: Option<PathBuf>,
+    /// Policy kernels M.
+    #[arg(long)]
+    pub kernels: usize,
+    /// Policy length-scale (default 1/(M − 1)).
+    #[arg(long)]
+    lengthscale: Option<f64>,
+    /// Optimiser.
+    #[arg(long, default_value = "cdbo")]
+    method: String,
+    /// Seed of every random choice.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// UCB exploration weight β.
+    #[arg(long, default_value_t = cdbo::acquisition::ucb::DEFAULT_BETA)]
+    beta: f64,
+}
+
+impl InitialPolicy {
+    /// The study's settings from the demonstration or the weights.
+    pub fn config(&self) -> Result<StudyConfig, Box<dyn std::error::Error>> {
+        let lengthscale = self
+            .lengthscale
+            .unwrap_or_else(|| default_lengthscale(self.kernels));
+        let policy = match (&self.demo, &self.weights) {
+            (Some(demo), _) => {
+                RkhsPolicy::fit(&read_demo(demo)?, self.kernels, lengthscale, DEFAULT_RIDGE)
+                    .map_err(|e| format!("{}: {e}", demo.display()))?
+            }
+            (None, Some(w)) => read_policy(w)?,
+            (None, None) => {
+                return Err("give the initial policy: --demo demo.csv or --weights w0.json".into());
+            }
+        };
+        if policy.weights.len() != self.kernels {
+            return Err(format!(
+                "the initial policy has {} weights but --kernels is {}",
+                policy.weights.len(),
+                self.kernels
+            )
+            .into());
+        }
+        Ok(StudyConfig {
+            method: self.method.clone(),
+            kernels: self.kernels,
+            lengthscale: policy.lengthscale,
+            seed: self.seed,
+            beta: self.beta,
+            w0: policy.weights,
+        })
+    }
+}
+
+#[derive(Debug, Subcommand)]
+pub enum StudyCommand {
+    /// Create a study from an initial controller's demonstration or weights.
+    Create {
+        #[command(flatten)]
+        study: StudyName,
+        #[command(flatten)]
+        initial: InitialPolicy,
+    },
+    /// The next policy to drive (the pending one until it is told).
+    Ask {
+        #[command(flatten)]
+        study: StudyName,
+        /// Output format.
+        #[arg(long, value_enum, default_value = "json")]
+        format: Format,
+    },
+    /// Record a trial's result: a reward, a lap time and length, or a failure.
+    Tell {
+        #[command(flatten)]
+        study: StudyName,
+        /// Trial id (from `ask`).
+        #[arg(long)]
+        trial: i64,
+        /// The reward.
+        #[arg(long, conflicts_with_all = ["lap_time", "failed"], allow_negative_numbers = true)]
+        reward: Option<f64>,
+        /// Lap time in seconds (with --length: reward = length / time).
+        #[arg(
+            long,
+            requires = "length",
+            conflicts_with = "failed",
+            allow_negative_numbers = true
+        )]
+        lap_time: Option<f64>,
+        /// Lap length in metres.
+        #[arg(long, requires = "lap_time", allow_negative_numbers = true)]
+        length: Option<f64>,
+        /// The lap failed (reward 0).
+        #[arg(long)]
+        failed: bool,
+        /// Where it failed, as a fraction of the lap.
+        #[arg(long, requires = "failed", allow_negative_numbers = true)]
+        at: Option<f64>,
+    },
+    /// Progress: trials told, failures, the best reward.
+    Status {
+        #[command(flatten)]
+        study: StudyName,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
+    /// The best policy: weights and (x, a) table.
+    Best {
+        #[command(flatten)]
+        study: StudyName,
+        /// Output format.
+        #[arg(long, value_enum, default_value = "json")]
+        format: Format,
+    },
+    /// Every trial, as CSV (or JSON).
+    History {
+        #[command(flatten)]
+        study: StudyName,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Write the history (CSV, JSON), the best policy (JSON, CSV) and the learning curve (PNG,
+    /// SVG) to a folder.
+    Export {
+        #[command(flatten)]
+        study: StudyName,
+        /// Output folder (default: NAME-export).
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+    },
+}
+
+pub fn run(cmd: &StudyCommand) -> CliResult {
+    match cmd {
+        StudyCommand::Create { study, initial } => {
+            let config = initial.config()?;
+            let s = Study::create(&study.path(), config)?;
+            println!(
+                "created study {} in {} ({} kernels, {})",
+                study.name,
+                s.path().display(),
+                s.config().kernels,
+                s.config().method
+            );
+            Ok(())
+        }
+        StudyCommand::Ask { study, format } => {
+            let mut s = Study::open(&study.path())?;
+            let trial = s.ask()?;
+            print_policy(&s, &trial, *format)
+        }
+        StudyCommand::Tell {
+            study,
+            trial,
+            reward,
+            lap_time,
+            length,
+            failed,
+            at,
+        } => {
+            let outcome = match (reward, lap_time, length, failed) {
+                (Some(r), _, _, _) => Outcome::Reward(*r),
+                (None, Some(t), Some(l), _) => Outcome::Lap {
+                    time_s: *t,
+                    length_m: *l,
+                },
+                (None, None, None, true) => Outcome::Failed {
+                    at: *at,
+                    reason: None,
+                },
+                _ => return Err("give --reward R, --lap-time T --length L, or --failed".into()),
+            };
+            let mut s = Study::open(&study.path())?;
+            let r = s.tell(*trial, &outcome)?;
+            println!("trial {trial}: reward {r} saved");
+            Ok(())
+        }
+        StudyCommand::Status { study, json } => status(&Study::open(&study.path())?, *json),
+        StudyCommand::Best { study, format } => {
+            let s = Study::open(&study.path())?;
+            match s.best()? {
+                Some(t) => print_policy(&s, &t, *format),
+                None => Err(format!("{}: no trial has been told yet", s.path().display()).into()),
+            }
+        }
+        StudyCommand::History { study, json } => {
+            let s = Study::open(&study.path())?;
+            let h = s.history()?;
+            if *json {
+                return print_json(&h);
+            }
+            print!("{}", history_csv(&h));
+            Ok(())
+        }
+        StudyCommand::Export { study, out } => {
+            let s = Study::open(&study.path())?;
+            let out = out
+                .clone()
+                .unwrap_or_else(|| PathBuf::from(format!("{}-export", study.name)));
+            export(&s, &out)
+        }
+    }
+}
+
+fn policy_of(s: &Study, t: &Trial) -> Result<RkhsPolicy, cdbo::Error> {
+    RkhsPolicy::new(t.weights.clone(), s.config().lengthscale)
+}
+
+fn print_policy(s: &Study, t: &Trial, format: Format) -> CliResult {
+    let policy = policy_of(s, t)?;
+    match format {
+        Format::Json => {
+            let mut v = cdbo::evaluator::command::policy_json(&policy);
+            v["trial"] = t.id.into();
+            if let Some(r) = t.reward {
+                v["reward"] = r.into();
+            }
+            println!("{v}");
+        }
+        Format::Csv => {
+            println!("# trial {}", t.id);
+            println!("x,a");
+            for (x, a) in policy.table(cdbo::evaluator::command::TABLE_POINTS) {
+                println!("{x:.6},{a:.6}");
+            }
+        }
+    }
+    Ok(())
+}
+
+fn status(s: &Study, json: bool) -> CliResult {
+    let h = s.history()?;
+    let told = h.iter().filter(|t| t.reward.is_some()).count();
+    let failed = h.iter().filter(|t| t.failure.is_some()).count();
+    let pending = h.iter().find(|t| t.reward.is_none()).map(|t| t.id);
+    let best = s.best()?;
+    let c = s.config();
+    let v = serde_json::json!({
+        "study": s.path().display().to_string(),
+        "method": c.method,
+        "kernels": c.kernels,
+        "told": told,
+        "failed": failed,
+        "pending_trial": pending,
+        "best_trial": best.as_ref().map(|t| t.id),
+        "best_reward": best.as_ref().and_then(|t| t.reward),
+        "initial_reward": h.first().and_then(|t| t.reward),
+    });
+    if json {
+        return print_json(&v);
+    }
+    println!(
+        "{}: {} with {} kernels; {told} trials told ({failed} failed){}; best {}",
+        s.path().display(),
+        c.method,
+        c.kernels,
+        pending.map_or(String::new(), |p| format!(", trial {p} pending")),
+        best.map_or("none yet".into(), |t| format!(
+            "{:.4} (trial {})",
+            t.reward.unwrap_or_default(),
+            t.id
+        ))
+    );
+    Ok(())
+}
+
+fn history_csv(h: &[Trial]) -> String {
+    let mut s = String::from("trial,reward,best,lap_time_s,failure,x_fail\n");
+    let mut best = f64::NEG_INFINITY;
+    for t in h {
+        let Some(r) = t.reward else { continue };
+        best = best.max(r);
+        s += &format!(
+            "{},{r},{best},{},{},{}\n",
+            t.id,
+            t.lap_time_s.map_or(String::new(), |v| v.to_string()),
+            t.failure.clone().unwrap_or_default(),
+            t.x_fail.map_or(String::new(), |v| v.to_string())
+        );
+    }
+    s
+}
+
+fn export(s: &Study, out: &Path) -> CliResult {
+    use super::plot::{LineChart, draw};
+    std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
+    let h = s.history()?;
+    std::fs::write(out.join("history.csv"), history_csv(&h))?;
+    std::fs::write(out.join("history.json"), serde_json::to_string_pretty(&h)?)?;
+    if let Some(best) = s.best()? {
+        let p = policy_of(s, &best)?;
+        std::fs::write(
+            out.join("best_policy.json"),
+            serde_json::to_string_pretty(&cdbo::evaluator::command::policy_json(&p))?,
+        )?;
+        let mut csv = String::from("x,a\n");
+        for (x, a) in p.table(cdbo::evaluator::command::TABLE_POINTS) {
+            csv += &format!("{x:.6},{a:.6}\n");
+        }
+        std::fs::write(out.join("best_policy.csv"), csv)?;
+    }
+    let (mut points, mut best, mut raw) = (Vec::new(), f64::NEG_INFINITY, Vec::new());
+    for t in h.iter().filter(|t| t.reward.is_some()) {
+        let r = t.reward.unwrap_or_default();
+        best = best.max(r);
+        points.push((t.id as f64, best));
+        raw.push((t.id as f64, r));
+    }
+    let chart = LineChart {
+        title: "Learning curve".into(),
+        x_label: "trial".into(),
+        y_label: "reward".into(),
+        series: vec![
+            ("best so far".into(), plotters::style::BLUE, points),
+            (
+                "each trial".into(),
+                plotters::style::RGBColor(160, 160, 160),
+                raw,
+            ),
+        ],
+    };
+    for ext in ["png", "svg"] {
+        draw(&out.join(format!("learning_curve.{ext}")), &chart)?;
+    }
+    println!("exported {} trials to {}", h.len(), out.display());
+    Ok(())
+}

@@ -1,0 +1,368 @@
+//! Studies for a real car: the ask/tell workflow, bad input, external evaluators, crash
+//! safety under SIGKILL, and the simulator as a JSON-lines service.
+
+use std::io::{BufRead, BufReader, Write};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::Duration;
+
+const CDBO: &str = env!("CARGO_BIN_EXE_cdbo");
+
+fn cdbo(dir: &Path, args: &[&str]) -> Output {
+    Command::new(CDBO)
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("runs")
+}
+
+fn ok(dir: &Path, args: &[&str]) -> String {
+    let out = cdbo(dir, args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+/// Expects failure with one clear error line containing `needle`.
+fn fails(dir: &Path, args: &[&str], needle: &str) {
+    let out = cdbo(dir, args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{args:?} succeeded");
+    assert!(!err.contains("panicked"), "{err}");
+    let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("error:")).collect();
+    assert_eq!(lines.len(), 1, "{err}");
+    assert!(lines[0].contains(needle), "{:?} lacks {needle:?}", lines[0]);
+}
+
+fn fresh_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("cdbo-study-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// A demonstration recorded on the built-in track.
+fn demo(dir: &Path) {
+    ok(
+        dir,
+        &["lap", "--demo", "15", "--trace", "demo.csv", "--json"],
+    );
+}
+
+fn history(dir: &Path, db: &str) -> Vec<serde_json::Value> {
+    let text = ok(dir, &["study", "history", "s", "--db", db, "--json"]);
+    serde_json::from_str::<Vec<serde_json::Value>>(&text).unwrap()
+}
+
+const EVALUATOR: &str = "{cdbo} lap --policy {policy} --json";
+
+fn optimize_args<'a>(db: &'a str, laps: &'a str, evaluator: &'a str) -> Vec<&'a str> {
+    vec![
+        "optimize",
+        "--evaluator",
+        evaluator,
+        "--kernels",
+        "6",
+        "--laps",
+        laps,
+        "--db",
+        db,
+        "--demo",
+        "demo.csv",
+        "--seed",
+        "4",
+    ]
+}
+
+#[test]
+fn ask_tell_workflow_and_bad_input() {
+    let dir = fresh_dir("workflow");
+    demo(&dir);
+    ok(
+        &dir,
+        &[
+            "study",
+            "create",
+            "car",
+            "--kernels",
+            "8",
+            "--demo",
+            "demo.csv",
+        ],
+    );
+    fails(
+        &dir,
+        &[
+            "study",
+            "create",
+            "car",
+            "--kernels",
+            "8",
+            "--demo",
+            "demo.csv",
+        ],
+        "already exists",
+    );
+    let ask: serde_json::Value = serde_json::from_str(&ok(&dir, &["study", "ask", "car"])).unwrap();
+    assert_eq!(ask["trial"], 1);
+    assert_eq!(ask["weights"].as_array().unwrap().len(), 8);
+    assert_eq!(ask["table"].as_array().unwrap().len(), 1001);
+    // Asking again returns the same pending trial.
+    let again: serde_json::Value =
+        serde_json::from_str(&ok(&dir, &["study", "ask", "car"])).unwrap();
+    assert_eq!(ask, again);
+    let csv = ok(&dir, &["study", "ask", "car", "--format", "csv"]);
+    assert!(csv.starts_with("# trial 1\nx,a\n"));
+    fails(
+        &dir,
+        &["study", "tell", "car", "--trial", "7", "--reward", "1"],
+        "no trial 7",
+    );
+    fails(
+        &dir,
+        &["study", "tell", "car", "--trial", "1", "--reward", "NaN"],
+        "finite",
+    );
+    fails(
+        &dir,
+        &["study", "tell", "car", "--trial", "1", "--reward", "inf"],
+        "finite",
+    );
+    fails(
+        &dir,
+        &[
+            "study",
+            "tell",
+            "car",
+            "--trial",
+            "1",
+            "--lap-time",
+            "-3",
+            "--length",
+            "100",
+        ],
+        "lap time",
+    );
+    ok(
+        &dir,
+        &[
+            "study",
+            "tell",
+            "car",
+            "--trial",
+            "1",
+            "--lap-time",
+            "200",
+            "--length",
+            "3000",
+        ],
+    );
+    fails(
+        &dir,
+        &["study", "tell", "car", "--trial", "1", "--reward", "3"],
+        "already told",
+    );
+    let t2: serde_json::Value = serde_json::from_str(&ok(&dir, &["study", "ask", "car"])).unwrap();
+    assert_eq!(t2["trial"], 2);
+    ok(
+        &dir,
+        &[
+            "study", "tell", "car", "--trial", "2", "--failed", "--at", "0.25",
+        ],
+    );
+    let status: serde_json::Value =
+        serde_json::from_str(&ok(&dir, &["study", "status", "car", "--json"])).unwrap();
+    assert_eq!(status["told"], 2);
+    assert_eq!(status["failed"], 1);
+    assert_eq!(status["best_reward"], 15.0);
+    let best: serde_json::Value =
+        serde_json::from_str(&ok(&dir, &["study", "best", "car"])).unwrap();
+    assert_eq!(best["trial"], 1);
+    let hist = ok(&dir, &["study", "history", "car"]);
+    assert_eq!(hist.lines().count(), 3);
+    assert!(hist.contains("2,0,15,,failed,0.25"), "{hist}");
+    ok(&dir, &["study", "export", "car", "--out", "exp"]);
+    for f in [
+        "history.csv",
+        "history.json",
+        "best_policy.json",
+        "best_policy.csv",
+        "learning_curve.png",
+    ] {
+        assert!(dir.join("exp").join(f).is_file(), "{f}");
+    }
+    fails(&dir, &["study", "ask", "nobody"], "no such study");
+    std::fs::write(dir.join("junk.db"), "not a database at all").unwrap();
+    fails(
+        &dir,
+        &["study", "status", "x", "--db", "junk.db"],
+        "not an SQLite database",
+    );
+    fails(
+        &dir,
+        &[
+            "study",
+            "create",
+            "w",
+            "--kernels",
+            "5",
+            "--demo",
+            "demo.csv",
+            "--method",
+            "simplex",
+        ],
+        "unknown method",
+    );
+    assert!(
+        !dir.join("w.cdbo.db").exists(),
+        "a failed create left a file"
+    );
+}
+
+#[test]
+fn optimize_records_failed_commands_with_their_reason() {
+    let dir = fresh_dir("failing");
+    demo(&dir);
+    let out = ok(
+        &dir,
+        &optimize_args(
+            "f.db",
+            "3",
+            "case $(wc -c < {policy}) in *) echo crashed >&2; exit 4;; esac",
+        ),
+    );
+    assert_eq!(
+        out.matches("saved (failed: the command exited").count(),
+        3,
+        "{out}"
+    );
+    let out = ok(&dir, &optimize_args("g.db", "2", "echo fast"));
+    assert_eq!(out.matches("unparsable output").count(), 2, "{out}");
+    let out = ok(
+        &dir,
+        &[
+            optimize_args("h.db", "1", "sleep 3"),
+            vec!["--timeout", "0.2"],
+        ]
+        .concat(),
+    );
+    assert!(out.contains("timeout"), "{out}");
+}
+
+/// `cdbo optimize` killed with SIGKILL at 50+ random moments loses nothing it reported as
+/// saved, and ends with exactly the trials of an uninterrupted run.
+#[test]
+fn sigkill_at_random_moments_loses_nothing() {
+    let dir = fresh_dir("sigkill");
+    demo(&dir);
+    let evaluator = EVALUATOR.replace("{cdbo}", CDBO);
+    let laps = "30";
+    ok(&dir, &optimize_args("reference.db", laps, &evaluator));
+    let reference = history(&dir, "reference.db");
+    assert_eq!(reference.len(), 30);
+
+    let mut seed: u64 = 0x2545_f491_4f6c_dd1d;
+    let mut random_ms = |max: u64| {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        seed % max
+    };
+    let (mut kills, mut finished) = (0, false);
+    let mut saved: Vec<(u64, f64)> = Vec::new();
+    while !finished {
+        let mut child = Command::new(CDBO)
+            .args(optimize_args("killed.db", laps, &evaluator))
+            .current_dir(&dir)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        let stdout = child.stdout.take().unwrap();
+        let reader = std::thread::spawn(move || {
+            BufReader::new(stdout)
+                .lines()
+                .map_while(Result::ok)
+                .filter_map(|l| {
+                    let rest = l.strip_prefix("trial ")?;
+                    let (id, rest) = rest.split_once(": reward ")?;
+                    let reward = rest.split_whitespace().next()?;
+                    Some((id.parse().ok()?, reward.parse().ok()?))
+                })
+                .collect::<Vec<(u64, f64)>>()
+        });
+        if kills < 50 {
+            std::thread::sleep(Duration::from_millis(random_ms(80)));
+            if child.try_wait().unwrap().is_none() {
+                child.kill().unwrap(); // SIGKILL
+                kills += 1;
+            }
+        }
+        let status = child.wait().unwrap();
+        finished = status.success();
+        saved.extend(reader.join().unwrap());
+        // Everything reported as saved is in the study, with the reported reward.
+        if dir.join("killed.db").exists() {
+            let h = history(&dir, "killed.db");
+            for (id, reward) in &saved {
+                let t = h
+                    .iter()
+                    .find(|t| t["id"].as_u64() == Some(*id))
+                    .unwrap_or_else(|| panic!("trial {id} reported saved but lost"));
+                assert_eq!(t["reward"].as_f64(), Some(*reward), "trial {id}");
+            }
+        }
+    }
+    assert!(kills >= 50, "only {kills} kills");
+    let killed = history(&dir, "killed.db");
+    assert_eq!(killed.len(), reference.len());
+    for (a, b) in killed.iter().zip(&reference) {
+        assert_eq!(
+            a["weights"], b["weights"],
+            "trial {} differs after resuming",
+            a["id"]
+        );
+        assert_eq!(a["reward"], b["reward"]);
+    }
+}
+
+#[test]
+fn serve_sim_answers_json_lines() {
+    let mut child = Command::new(CDBO)
+        .args(["serve-sim", "--kernels", "8"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdin = child.stdin.take().unwrap();
+    let mut lines = BufReader::new(child.stdout.take().unwrap()).lines();
+    let mut ask = |line: &str| -> serde_json::Value {
+        writeln!(stdin, "{line}").unwrap();
+        serde_json::from_str(&lines.next().unwrap().unwrap()).unwrap()
+    };
+    let info = ask(r#"{"info": true}"#);
+    assert_eq!(info["dim"], 8);
+    let w0 = info["w0"].clone();
+    let lap = ask(&format!(r#"{{"weights": {w0}}}"#));
+    assert!(lap["reward_mps"].as_f64().unwrap() > 10.0, "{lap}");
+    assert!(lap["failure"].is_null());
+    let brake = ask(r#"{"weights": [-1, -1, -1, -1, -1, -1, -1, -1]}"#);
+    assert_eq!(brake["reward_mps"], 0.0);
+    assert_eq!(brake["failure"]["reason"], "stalled");
+    for bad in [
+        "{",
+        r#"{"weights": [1, 2]}"#,
+        r#"{"weights": [1, "a", 1, 1, 1, 1, 1, 1]}"#,
+        "[]",
+    ] {
+        let e = ask(bad);
+        assert!(e["error"].is_string(), "{bad}: {e}");
+    }
+    // Still serving after the errors.
+    assert_eq!(ask(&format!(r#"{{"weights": {w0}}}"#)), lap);
+    drop(stdin);
+    assert!(child.wait().unwrap().success());
+}

@@ -1,0 +1,219 @@
+//! An external command as the evaluator: a real car's lap timer, another simulator, a script.
+//!
+//! For each lap the policy is written as JSON — `{"weights": […], "lengthscale": l,
+//! "table": [[x, a], …]}` — to a file, and the command runs through `sh -c` with `{policy}`
+//! replaced by that file's (quoted) path. Its standard output gives the reward: a number, or a
+//! JSON object with `reward` (or `reward_mps`), or `{"failed": true, "at": x, "reason": …}`.
+//! A non-zero exit, a timeout or output that parses as neither is a failed lap with the reason.
+
+use std::io::Read;
+use std::path::PathBuf;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use super::{Evaluator, Outcome};
+use crate::error::{Error, Result};
+use crate::policy::RkhsPolicy;
+
+/// Points of the (x, a) table written with each policy.
+pub const TABLE_POINTS: usize = 1001;
+
+/// An external command evaluating policies.
+#[derive(Debug, Clone)]
+pub struct CommandEvaluator {
+    /// The command line, with `{policy}` where the policy file's path goes.
+    pub template: String,
+    /// Longest a lap may take.
+    pub timeout: Duration,
+    /// Where the policy file is written.
+    pub policy_file: PathBuf,
+    /// The policy kernels' length-scale.
+    pub lengthscale: f64,
+}
+
+/// The policy file's content.
+pub fn policy_json(policy: &RkhsPolicy) -> serde_json::Value {
+    serde_json::json!({
+        "weights": policy.weights,
+        "lengthscale": policy.lengthscale,
+        "table": policy.table(TABLE_POINTS).iter().map(|(x, a)| [*x, *a]).collect::<Vec<_>>(),
+    })
+}
+
+/// `'text'` for `sh`, with single quotes escaped.
+fn shell_quote(text: &str) -> String {
+    format!("'{}'", text.replace('\'', r"'\''"))
+}
+
+/// The outcome a command's standard output reports.
+pub fn parse_output(stdout: &str) -> Outcome {
+    let text = stdout.trim();
+    let last = text.lines().last().unwrap_or("").trim();
+    if let Ok(r) = last.parse::<f64>() {
+        return if r.is_finite() {
+            Outcome::Reward(r)
+        } else {
+            Outcome::Failed {
+                at: None,
+                reason: Some(format!("the command reported a non-finite reward {last}")),
+            }
+        };
+    }
+    let unparsable = || Outcome::Failed {
+        at: None,
+        reason: Some(format!(
+            "unparsable output {:?} (expected a number or a JSON object with \"reward\")",
+            text.chars().take(200).collect::<String>()
+        )),
+    };
+    let Ok(serde_json::Value::Object(v)) = serde_json::from_str::<serde_json::Value>(text) else {
+        return unparsable();
+    };
+    if v.get("failed").and_then(|f| f.as_bool()) == Some(true) {
+        return Outcome::Failed {
+            at: v.get("at").and_then(|x| x.as_f64()),
+            reason: Some(
+                v.get("reason")
+                    .and_then(|r| r.as_str())
+                    .unwrap_or("reported failed")
+                    .to_owned(),
+            ),
+        };
+    }
+    match v
+        .get("reward")
+        .or_else(|| v.get("reward_mps"))
+        .and_then(|r| r.as_f64())
+    {
+        Some(r) if r.is_finite() => Outcome::Reward(r),
+        _ => unparsable(),
+    }
+}
+
+impl Evaluator for CommandEvaluator {
+    fn evaluate(&mut self, weights: &[f64]) -> Result<Outcome> {
+        let policy = RkhsPolicy::new(weights.to_vec(), self.lengthscale)?;
+        let file = &self.policy_file;
+        let text = serde_json::to_string(&policy_json(&policy))
+            .map_err(|e| Error::Domain(e.to_string()))?;
+        std::fs::write(file, text).map_err(|e| Error::Io {
+            path: file.clone(),
+            source: e,
+        })?;
+        let line = self
+            .template
+            .replace("{policy}", &shell_quote(&file.display().to_string()));
+        let mut child = Command::new("sh")
+            .arg("-c")
+            .arg(&line)
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .map_err(|e| Error::Domain(format!("cannot run `sh -c {line}`: {e}")))?;
+        let mut pipe_out = child.stdout.take();
+        let mut pipe_err = child.stderr.take();
+        let out = std::thread::spawn(move || {
+            let mut s = String::new();
+            if let Some(p) = pipe_out.as_mut() {
+                let _ = p.read_to_string(&mut s);
+            }
+            s
+        });
+        let err = std::thread::spawn(move || {
+            let mut s = String::new();
+            if let Some(p) = pipe_err.as_mut() {
+                let _ = p.read_to_string(&mut s);
+            }
+            s
+        });
+        let start = Instant::now();
+        let status = loop {
+            match child.try_wait() {
+                Ok(Some(status)) => break status,
+                Ok(None) if start.elapsed() > self.timeout => {
+                    let _ = child.kill();
+                    let _ = child.wait();
+                    return Ok(Outcome::Failed {
+                        at: None,
+                        reason: Some(format!(
+                            "timeout: no result after {:.1} s",
+                            self.timeout.as_secs_f64()
+                        )),
+                    });
+                }
+                Ok(None) => std::thread::sleep(Duration::from_millis(5)),
+                Err(e) => return Err(Error::Domain(format!("waiting for `{line}`: {e}"))),
+            }
+        };
+        let stdout = out.join().unwrap_or_default();
+        let stderr = err.join().unwrap_or_default();
+        if !status.success() {
+            let tail: String = stderr
+                .trim()
+                .lines()
+                .last()
+                .unwrap_or("")
+                .chars()
+                .take(200)
+                .collect();
+            return Ok(Outcome::Failed {
+                at: None,
+                reason: Some(format!("the command exited with {status}: {tail}")),
+            });
+        }
+        Ok(parse_output(&stdout))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn outputs_parse_as_rewards_or_failures() {
+        assert_eq!(parse_output("lap done\n23.5\n"), Outcome::Reward(23.5));
+        assert_eq!(parse_output(r#"{"reward": 12}"#), Outcome::Reward(12.0));
+        assert_eq!(
+            parse_output(r#"{"reward_mps": 7.5, "x": 1}"#),
+            Outcome::Reward(7.5)
+        );
+        assert_eq!(
+            parse_output(r#"{"failed": true, "at": 0.4, "reason": "spun"}"#),
+            Outcome::Failed {
+                at: Some(0.4),
+                reason: Some("spun".into())
+            }
+        );
+        for bad in ["", "fast!", "NaN", r#"{"reward": "x"}"#] {
+            assert!(
+                matches!(parse_output(bad), Outcome::Failed { .. }),
+                "{bad:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn exit_codes_and_timeouts_are_failed_laps() {
+        let dir = std::env::temp_dir().join(format!("cdbo-cmd-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut e = CommandEvaluator {
+            template: "test -s {policy} && echo 3.25".into(),
+            timeout: Duration::from_secs(5),
+            policy_file: dir.join("p.json"),
+            lengthscale: 0.5,
+        };
+        assert_eq!(e.evaluate(&[0.1, 0.2]).unwrap(), Outcome::Reward(3.25));
+        e.template = "echo boom >&2; exit 3".into();
+        let Outcome::Failed { reason, .. } = e.evaluate(&[0.1, 0.2]).unwrap() else {
+            panic!()
+        };
+        assert!(reason.unwrap().contains("boom"));
+        e.template = "sleep 5".into();
+        e.timeout = Duration::from_millis(100);
+        let Outcome::Failed { reason, .. } = e.evaluate(&[0.1, 0.2]).unwrap() else {
+            panic!()
+        };
+        assert!(reason.unwrap().contains("timeout"));
+    }
+}
