@@ -29,6 +29,7 @@ pub mod optimizers;
 pub mod params;
 pub mod policy;
 pub mod sim;
+pub mod simd;
 pub mod study;
 pub mod track;
 

@@ -331,6 +331,16 @@ impl GaussianProcess {
     /// k[j+1..] −= xⱼ·L[j+1.., j], whose inner loop is a contiguous axpy that vectorises.
     pub fn predict_one_from_k(&self, k: &mut [f64]) -> (f64, f64) {
         let mean = self.mean + k.iter().zip(&self.alpha).map(|(a, b)| a * b).sum::<f64>();
+        let vv = crate::simd::wide(
+            #[inline(always)]
+            || self.forward_substitute_norm2(k),
+        );
+        (mean, (self.hyper.signal_var - vv).max(0.0))
+    }
+
+    /// Overwrites k by L⁻¹k column by column and returns ‖L⁻¹k‖².
+    #[inline(always)]
+    fn forward_substitute_norm2(&self, k: &mut [f64]) -> f64 {
         let n = k.len();
         let mut vv = 0.0;
         for j in 0..n {
@@ -347,7 +357,7 @@ impl GaussianProcess {
                 *ki -= x * lij;
             }
         }
-        (mean, (self.hyper.signal_var - vv).max(0.0))
+        vv
     }
 
     /// Posterior mean and variance from the cross-covariance columns k(W, w*) (overwritten).
