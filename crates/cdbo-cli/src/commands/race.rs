@@ -19,7 +19,7 @@ pub struct RaceArgs {
     /// Policy kernels M (the paper: 10 to 100).
     #[arg(long, default_value_t = 30)]
     kernels: usize,
-    /// Optimiser.
+    /// Optimiser: cdbo, cmaes, bo-cmaes, rembo-5d, rembo-10d, turbo, linebo, random.
     #[arg(long, default_value = "cdbo")]
     method: String,
     /// Laps (the paper: 300).
