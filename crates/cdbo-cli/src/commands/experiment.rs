@@ -145,10 +145,23 @@ pub fn run_grid(args: &ExperimentArgs, data: &DataPath) -> CliResult {
         })
     })?;
     bar.finish_and_clear();
+    let wall_s = start.elapsed().as_secs_f64();
+    // One line per invocation, so that the report can say how long the grid took.
+    let session = serde_json::json!({
+        "runs": runs.len(),
+        "skipped": skipped,
+        "jobs": jobs,
+        "shard": args.shard,
+        "wall_s": wall_s,
+    });
+    let mut log = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(out.join("sessions.jsonl"))?;
+    std::io::Write::write_all(&mut log, format!("{session}\n").as_bytes())?;
     println!(
-        "{} runs done in {:.1} s; figures and tables: cdbo report {}",
+        "{} runs done in {wall_s:.1} s; figures and tables: cdbo report {}",
         runs.len(),
-        start.elapsed().as_secs_f64(),
         out.display()
     );
     Ok(())

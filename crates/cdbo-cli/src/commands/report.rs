@@ -108,7 +108,8 @@ pub fn run(args: &ReportArgs, data: &DataPath) -> CliResult {
     }
     let table = table1(&records);
     std::fs::write(out.join("table1.md"), &table)?;
-    let results = results_md(&records, &curves, &figures, &table);
+    let sessions = sessions(&args.dirs);
+    let results = results_md(&records, &curves, &figures, &table, &sessions);
     std::fs::write(out.join("results.md"), results)?;
     println!(
         "{} runs from {} folder(s): report in {}",
@@ -318,20 +319,48 @@ fn table1(records: &[RunRecord]) -> String {
     s
 }
 
+/// The `cdbo experiment` invocations logged in the folders: (runs, jobs, wall seconds).
+fn sessions(dirs: &[PathBuf]) -> Vec<(u64, u64, f64)> {
+    dirs.iter()
+        .filter_map(|d| std::fs::read_to_string(d.join("sessions.jsonl")).ok())
+        .flat_map(|text| {
+            text.lines()
+                .filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
+                .map(|v| {
+                    (
+                        v["runs"].as_u64().unwrap_or(0),
+                        v["jobs"].as_u64().unwrap_or(0),
+                        v["wall_s"].as_f64().unwrap_or(0.0),
+                    )
+                })
+                .collect::<Vec<_>>()
+        })
+        .collect()
+}
+
 fn results_md(
     records: &[RunRecord],
     curves: &std::collections::BTreeMap<(String, usize, String), Curve>,
     figures: &[(String, String)],
     table: &str,
+    sessions: &[(u64, u64, f64)],
 ) -> String {
     let mut s = String::from("# Results\n\n");
     let wall: f64 = records.iter().map(|r| r.wall_s).sum();
     let _ = writeln!(
         s,
-        "{} runs; {:.0} s of run time in total (summed over runs, not wall clock of the grid).\n",
+        "{} runs; {:.0} s of run time in total, summed over the runs.",
         records.len(),
         wall
     );
+    for (runs, jobs, t) in sessions.iter().filter(|s| s.0 > 0) {
+        let _ = writeln!(
+            s,
+            "`cdbo experiment` ran {runs} of them in {:.1} min of wall clock with {jobs} parallel jobs.",
+            t / 60.0
+        );
+    }
+    s += "\n";
     s += "## The paper's claims\n\n";
     for c in claims(records) {
         let verdict = match c.holds {
