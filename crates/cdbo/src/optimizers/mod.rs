@@ -143,6 +143,7 @@ pub fn by_name(name: &str, w0: Vec<f64>, settings: &Settings) -> Result<Box<dyn 
         seed,
         embedding_dim,
         box_radius,
+        sigma0,
     };
     Ok(match name {
         "cdbo" => Box::new(bo::Bo::new(

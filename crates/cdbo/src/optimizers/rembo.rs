@@ -4,7 +4,7 @@
 //! box Y = [−√d, √d]^d in the weights: w(y) = w₀ + r·P(Ay), with P the projection onto
 //! [−1, 1]^D (REMBO's map into its normalised box X = [−1, 1]^D, here the search box
 //! [w₀ − r, w₀ + r]) and y = 0 giving the demonstration. After y = 0 and S initial samples
-//! y ~ N(0, (0.2√d)²I), a GP (Matérn-5/2 ARD as in REMBO, CDBO's hyperparameter scheme)
+//! that move w by σ₀ as CDBO's do, a GP (Matérn-5/2 ARD as in REMBO, CDBO's hyperparameter scheme)
 //! models the reward over y; the next y maximises expected improvement (REMBO's
 //! acquisition) by coordinate ascent with three sweeps, cheap in d dimensions.
 
@@ -27,6 +27,10 @@ pub struct RemboConfig {
     pub embedding_dim: usize,
     /// Half-width r of the search box around w₀.
     pub box_radius: f64,
+    /// The exploration scale σ₀ around w₀ in the weights: the initial samples are
+    /// y ~ N(0, σ_y²I) with σ_y = σ₀/(r√d), since each wᵢ − w₀ᵢ = r·Σⱼ Aᵢⱼyⱼ then has
+    /// standard deviation σ₀ (before the projection).
+    pub sigma0: f64,
 }
 
 /// Everything needed to resume a run.
@@ -53,9 +57,6 @@ pub struct Rembo {
     best: super::Best,
 }
 
-/// σ of the initial samples around y = 0, relative to the half-width √d of Y.
-pub const INITIAL_SIGMA: f64 = 0.2;
-
 /// The stream of the embedding's draws (the inner BO run uses streams 0, 1, 2, …).
 const EMBEDDING_STREAM: u64 = u64::MAX;
 
@@ -71,7 +72,7 @@ impl Rembo {
         let inner = BoConfig {
             seed: config.seed,
             acquisition: Acquisition::Ei { xi: 0.0 },
-            initial_sigma: INITIAL_SIGMA * (d as f64).sqrt(),
+            initial_sigma: config.sigma0 / (config.box_radius * (d as f64).sqrt()),
             kernel: Kernel::Matern52,
             box_radius: (d as f64).sqrt(),
             maximiser: Maximiser::CoordinateAscent(AxisSearch {
