@@ -329,6 +329,42 @@ fn sigkill_at_random_moments_loses_nothing() {
     }
 }
 
+/// Two `cdbo optimize` processes on one study share it: each trial is told once, and the
+/// study ends as a single uninterrupted run would.
+#[test]
+fn two_processes_on_one_study_do_not_corrupt_it() {
+    let dir = fresh_dir("two");
+    demo(&dir);
+    let evaluator = EVALUATOR.replace("{cdbo}", CDBO);
+    ok(&dir, &optimize_args("alone.db", "12", &evaluator));
+    // Create the study first, so that the two processes do not race to create it.
+    ok(&dir, &optimize_args("shared.db", "0", &evaluator));
+    let spawn = || {
+        Command::new(CDBO)
+            .args(optimize_args("shared.db", "12", &evaluator))
+            .current_dir(&dir)
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap()
+    };
+    let (a, b) = (spawn(), spawn());
+    for child in [a, b] {
+        let out = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success() || err.contains("busy"), "{err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+    // Whatever the interleaving, finish the study and compare.
+    ok(&dir, &optimize_args("shared.db", "12", &evaluator));
+    let (shared, alone) = (history(&dir, "shared.db"), history(&dir, "alone.db"));
+    assert_eq!(shared.len(), 12);
+    for (a, b) in shared.iter().zip(&alone) {
+        assert_eq!(a["weights"], b["weights"]);
+        assert_eq!(a["reward"], b["reward"]);
+    }
+}
+
 #[test]
 fn serve_sim_answers_json_lines() {
     let mut child = Command::new(CDBO)
