@@ -110,8 +110,16 @@ impl Study {
         )?;
         let state =
             serde_json::to_string(&optimizer.save()).map_err(|e| Error::Domain(e.to_string()))?;
+        // Built under a temporary name and renamed into place once complete, so that a
+        // create killed half-way leaves no half-made study behind.
+        let building = path.with_file_name(format!(
+            ".{}.creating-{}",
+            path.file_name()
+                .map_or("study".into(), |n| n.to_string_lossy()),
+            std::process::id()
+        ));
         let err = |e| sql_error(path, e);
-        let mut conn = Connection::open(path).map_err(err)?;
+        let mut conn = Connection::open(&building).map_err(err)?;
         configure(&conn).map_err(err)?;
         let tx = conn.transaction().map_err(err)?;
         tx.execute_batch(
@@ -143,12 +151,27 @@ impl Study {
         tx.pragma_update(None, "user_version", SCHEMA_VERSION)
             .map_err(err)?;
         tx.commit().map_err(err)?;
-        Ok(Study {
+        // Closing the only connection checkpoints the WAL into the file.
+        conn.close().map_err(|(_, e)| err(e))?;
+        // A hard link never replaces a study another process created meanwhile.
+        let placed = match std::fs::hard_link(&building, path) {
+            Ok(()) => std::fs::remove_file(&building),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                let _ = std::fs::remove_file(&building);
+                return Err(Error::Domain(format!(
+                    "{}: already exists; open it, or choose another name",
+                    path.display()
+                )));
+            }
+            Err(_) => std::fs::rename(&building, path),
+        };
+        placed.map_err(|e| Error::Io {
             path: path.to_owned(),
-            conn,
-            config,
-            optimizer: Some((optimizer, 0)),
-        })
+            source: e,
+        })?;
+        let mut study = Study::open(path)?;
+        study.optimizer = Some((optimizer, 0));
+        Ok(study)
     }
 
     /// Opens an existing study.
