@@ -4,9 +4,10 @@
 //! others fixed, inside the search box. Along axis i only one term of each squared distance to
 //! the n observations changes, r²ⱼ(v) = r²ⱼ − sᵢ(wᵢ − Xⱼᵢ)² + sᵢ(v − Xⱼᵢ)² (sᵢ = 1/lᵢ²), so a
 //! candidate costs O(n) kernel values plus one triangular solve. Each axis gets a coarse scan of
-//! `scan` evenly spaced values (one batched solve), then, where the scan beat the current value,
-//! a COBYLA polish from the best of them (the paper's per-axis optimiser), stopping at the
-//! evaluation budget.
+//! `scan` evenly spaced values (one batched solve), then a COBYLA polish from the best of them
+//! and the current value (the paper's per-axis optimiser), stopping at the evaluation budget.
+//! (Polishing only the axes whose scan improved saves 11 % of a suggestion's time but lost
+//! 2.3 m/s on Forza with 50 kernels, seed 0: kept.)
 
 use rand::seq::SliceRandom;
 
