@@ -13,6 +13,7 @@
 //!   optimisers, CDBO first.
 //! - [`experiment`]: learning to race a track end to end, and the paper's experiment grid.
 //! - [`study`]: persistent ask/tell studies for a real car; [`evaluator`]: sources of laps.
+//! - [`benchmarks`]: standard test functions; [`simd`]: AVX2 for the hottest loops.
 
 pub mod acquisition;
 pub mod benchmarks;

@@ -146,7 +146,9 @@ impl Bo {
     /// A new run from the demonstration's weights.
     pub fn new(w0: Vec<f64>, config: BoConfig) -> Result<Bo> {
         if w0.is_empty() {
-            return Err(Error::Domain("CDBO needs at least one weight".into()));
+            return Err(Error::Domain(
+                "Bayesian optimisation needs at least one weight".into(),
+            ));
         }
         if let Some(i) = w0.iter().position(|w| !w.is_finite()) {
             return Err(Error::Domain(format!("initial weight {i} is {}", w0[i])));
@@ -175,7 +177,7 @@ impl Bo {
     pub fn resume(saved: BoState) -> Result<Bo> {
         if saved.bounds_used.len() != saved.observations.len() {
             return Err(Error::Domain(format!(
-                "corrupt CDBO state: {} observations but {} recorded bounds",
+                "corrupt BO state: {} observations but {} recorded bounds",
                 saved.observations.len(),
                 saved.bounds_used.len()
             )));
