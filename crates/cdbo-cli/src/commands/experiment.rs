@@ -134,13 +134,20 @@ pub fn run_grid(args: &ExperimentArgs, data: &DataPath) -> CliResult {
             record.save(&out).map_err(|e| e.to_string())?;
             let k = done.fetch_add(1, Ordering::Relaxed) + 1;
             bar.set_message(format!("{k}/{} runs", runs.len()));
-            bar.println(format!(
-                "{}: best {:.2} m/s ({:.0} % of the limit) in {:.1} s",
+            let line = format!(
+                "{k}/{}: {}: best {:.2} m/s ({:.0} % of the limit) in {:.1} s",
+                runs.len(),
                 spec.id(),
                 record.best_reward_mps,
                 100.0 * record.best_reward_mps / record.limit_reward_mps,
                 record.wall_s
-            ));
+            );
+            // Without a terminal (a batch job's log) the bar is hidden: print plainly.
+            if bar.is_hidden() {
+                println!("{line}");
+            } else {
+                bar.println(line);
+            }
             Ok(())
         })
     })?;
