@@ -58,7 +58,7 @@ pub fn run(args: &OptimizeArgs) -> CliResult {
     let mut evaluator = CommandEvaluator {
         template: args.evaluator.clone(),
         timeout: Duration::from_secs_f64(args.timeout),
-        policy_file: PathBuf::from(format!("{}.policy.json", args.db.display())),
+        policy_file: PathBuf::new(),
         lengthscale: study.config().lengthscale,
     };
     let mut out = std::io::stdout().lock();
@@ -72,7 +72,17 @@ pub fn run(args: &OptimizeArgs) -> CliResult {
             break;
         }
         let trial = study.ask()?;
-        let outcome = evaluator.evaluate(&trial.weights)?;
+        // One file per trial and process: two processes on one study may drive the same
+        // trial at once, and neither may read the other's half-written file.
+        evaluator.policy_file = PathBuf::from(format!(
+            "{}.trial-{}.pid-{}.json",
+            args.db.display(),
+            trial.id,
+            std::process::id()
+        ));
+        let outcome = evaluator.evaluate(&trial.weights);
+        let _ = std::fs::remove_file(&evaluator.policy_file);
+        let outcome = outcome?;
         let reward = match study.tell(trial.id, &outcome) {
             Ok(r) => r,
             // Another process on the same study told this trial first: go on from there.
