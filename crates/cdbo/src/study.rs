@@ -326,6 +326,11 @@ impl Study {
         }
     }
 
+    /// Number of told trials.
+    pub fn told(&self) -> Result<usize> {
+        told_count(&self.conn).map_err(|e| sql_error(&self.path, e))
+    }
+
     /// Every trial, in order.
     pub fn history(&self) -> Result<Vec<Trial>> {
         let err = |e| sql_error(&self.path, e);

@@ -63,12 +63,7 @@ pub fn run(args: &OptimizeArgs) -> CliResult {
     };
     let mut out = std::io::stdout().lock();
     loop {
-        let told = study
-            .history()?
-            .iter()
-            .filter(|t| t.reward.is_some())
-            .count();
-        if told >= args.laps {
+        if study.told()? >= args.laps {
             break;
         }
         let trial = study.ask()?;

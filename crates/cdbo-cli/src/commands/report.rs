@@ -86,8 +86,9 @@ pub fn run(args: &ReportArgs, data: &DataPath) -> CliResult {
             name,
         ));
         if let Some(best) = best_cdbo_run(&records, track) {
-            let t = load_track(track, data)?;
-            let names = best_policy_figures(&out, track, t.clone(), &car, best)?;
+            let sim = cdbo::sim::Simulator::new(load_track(track, data)?, &car);
+            let (_, demo) = demonstrate(&sim, best.demo_speed);
+            let names = best_policy_figures(&out, track, sim, &car, &demo, best)?;
             figures.push((
                 format!(
                     "Best CDBO policy on {track} ({} kernels) against π(w₀)",
@@ -99,7 +100,7 @@ pub fn run(args: &ReportArgs, data: &DataPath) -> CliResult {
                 format!("Speeds of π(w₀), the best CDBO policy and the limit on {track}"),
                 names.1,
             ));
-            let name = lengthscale_figure(&out, track, t, &car, best)?;
+            let name = lengthscale_figure(&out, track, &demo, best.spec.kernels)?;
             figures.push((
                 format!("Fit of the demonstration on {track} for three length-scales"),
                 name,
@@ -187,14 +188,13 @@ fn best_cdbo_run<'a>(records: &'a [RunRecord], track: &str) -> Option<&'a RunRec
 fn best_policy_figures(
     out: &Path,
     track_name: &str,
-    track: cdbo::track::Track,
+    mut sim: cdbo::sim::Simulator,
     car: &cdbo::car::Car,
+    demo: &[(f64, f64)],
     best: &RunRecord,
 ) -> Result<(String, String), Box<dyn std::error::Error>> {
-    let limit = cdbo::limit::limit_lap(&track, car);
-    let mut sim = cdbo::sim::Simulator::new(track, car);
-    let (_, demo) = demonstrate(&sim, best.demo_speed);
-    let initial = RkhsPolicy::fit(&demo, best.spec.kernels, best.lengthscale, DEFAULT_RIDGE)?;
+    let limit = cdbo::limit::limit_lap(&sim.track, car);
+    let initial = RkhsPolicy::fit(demo, best.spec.kernels, best.lengthscale, DEFAULT_RIDGE)?;
     let best_policy = RkhsPolicy::new(best.best_weights.clone(), best.lengthscale)?;
     sim.config.trace = true;
     let initial_lap = sim.lap(&mut initial.clone());
@@ -241,13 +241,9 @@ fn best_policy_figures(
 fn lengthscale_figure(
     out: &Path,
     track_name: &str,
-    track: cdbo::track::Track,
-    car: &cdbo::car::Car,
-    run: &RunRecord,
+    demo: &[(f64, f64)],
+    kernels: usize,
 ) -> Result<String, Box<dyn std::error::Error>> {
-    let kernels = run.spec.kernels;
-    let sim = cdbo::sim::Simulator::new(track, car);
-    let (_, demo) = demonstrate(&sim, run.demo_speed);
     let mut series = vec![(
         "demonstration".to_owned(),
         BLACK,
@@ -255,7 +251,7 @@ fn lengthscale_figure(
     )];
     for (factor, c) in [(0.25, RED), (1.0, BLUE), (4.0, GREEN)] {
         let l = factor * default_lengthscale(kernels);
-        let p = RkhsPolicy::fit(&demo, kernels, l, DEFAULT_RIDGE)?;
+        let p = RkhsPolicy::fit(demo, kernels, l, DEFAULT_RIDGE)?;
         let rms = (demo
             .iter()
             .map(|(x, a)| (p.action(*x) - a).powi(2))

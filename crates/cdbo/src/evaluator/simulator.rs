@@ -30,3 +30,33 @@ impl Evaluator for SimEvaluator {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::car::Car;
+    use crate::experiment::race::demonstrate;
+
+    /// The evaluator reports the simulator's own lap: the time of a completed lap over the
+    /// track's length, and where and why a failed lap failed.
+    #[test]
+    fn outcomes_are_the_simulators_laps() {
+        let track = crate::track::builtin::load("ridgeway").unwrap().unwrap();
+        let sim = Simulator::new(track, &Car::spirit_300());
+        let (_, demo) = demonstrate(&sim, 15.0);
+        let policy = RkhsPolicy::fit(&demo, 8, 1.0 / 7.0, 1e-3).unwrap();
+        let mut e = SimEvaluator {
+            sim: sim.clone(),
+            lengthscale: policy.lengthscale,
+        };
+        let lap = sim.lap(&mut policy.clone());
+        let outcome = e.evaluate(&policy.weights).unwrap();
+        assert_eq!(outcome.reward().unwrap(), lap.reward_mps);
+        assert!(lap.reward_mps > 10.0);
+        let Outcome::Failed { at, reason } = e.evaluate(&[-1.0; 8]).unwrap() else {
+            panic!("full braking completed a lap")
+        };
+        assert_eq!(reason.as_deref(), Some("stalled"));
+        assert!(at.is_some_and(|x| x < 0.05), "{at:?}");
+    }
+}

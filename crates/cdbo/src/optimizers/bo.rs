@@ -354,7 +354,6 @@ impl Optimizer for Bo {
         self.state.bounds_used.push(bound);
         self.state.hyper = self.gp.hyper().clone();
         self.best.offer(weights, reward);
-        self.pending = None;
         Ok(())
     }
 
