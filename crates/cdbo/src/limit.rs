@@ -49,9 +49,7 @@ pub fn limit_lap(track: &Track, car: &Car) -> Limit {
     let (a, b, l) = (car.cg_to_front(), car.cg_to_rear(), car.wheelbase);
     let static_load = [m * G * b / l, m * G * a / l];
     let rolling = 0.5 * (car.front_tyre.rolling_resistance + car.rear_tyre.rolling_resistance);
-    let grip = |axle: usize, fz: f64, friction: f64| {
-        fz * tyres[axle].mu * friction * tyres[axle].load_factor(fz / 2.0)
-    };
+    let grip = |axle: usize, fz: f64, friction: f64| tyres[axle].axle_max_force(fz, friction);
     let total_grip = |v: f64, friction: f64| {
         let d = car.downforce(v);
         grip(0, static_load[0] + d[0], friction) + grip(1, static_load[1] + d[1], friction)

@@ -9,6 +9,13 @@
 //! (λ_max − λ_min)), which is 1 at the operating load F_op and rises to λ_max at zero load.
 //! Longitudinal and lateral forces share this one budget along the slip vector:
 //! Fₓ = F·sₓ/s, F_y = F·s_y/s (the friction ellipse of combined slip).
+//!
+//! The single-track model lumps an axle's two tyres: its budget is F_z·μ·μ_surface·λ(F_z/2),
+//! the load sensitivity taken at the load of one tyre, as TORCS applies it per wheel.
+//!
+//! In the hot loop the shape is read as g(u) = f(√u)/√u on u = s² = sₓ² + s_y²: f is odd, so
+//! g is smooth in u, and Fₓ = F_max·g(u)·sₓ, F_y = F_max·g(u)·s_y need neither a square root
+//! nor a division.
 
 use super::table::HermiteTable;
 use crate::car::Tyre;
@@ -37,8 +44,8 @@ pub struct TyreModel {
     inv_operating_load: f64,
     /// Slip magnitude at which the force peaks.
     pub peak_slip: f64,
-    /// f and f′ of the shape, tabulated on s ∈ [0, 2].
-    shape_table: HermiteTable,
+    /// g(u) = f(√u)/√u and g′(u), tabulated on u = s² ∈ [0, 1].
+    ratio_table: HermiteTable,
     /// λ and dλ/dz of the load sensitivity, tabulated on z = F_z/F_op ∈ [0, 8].
     load_table: HermiteTable,
 }
@@ -58,12 +65,13 @@ impl TyreModel {
             load_k,
             inv_operating_load: 1.0 / t.operating_load,
             peak_slip: 0.0,
-            shape_table: HermiteTable::new(1.0, 0, |_| (0.0, 0.0)),
+            ratio_table: HermiteTable::new(1.0, 0, |_| (0.0, 0.0)),
             load_table: HermiteTable::new(1.0, 0, |_| (0.0, 0.0)),
         };
         m.peak_slip = m.find_peak_slip();
-        // Steps 1/2048 and 1/256 keep the interpolation error below 1e-11.
-        m.shape_table = HermiteTable::new(1.0 / 2048.0, 4096, |s| m.shape_exact(s));
+        // Steps 1/16384 and 1/256 keep the interpolation error of the force below 1e-10 of
+        // the budget, and of λ below 1e-11.
+        m.ratio_table = HermiteTable::new(1.0 / 16384.0, 16384, |u| m.ratio_exact(u));
         m.load_table = HermiteTable::new(1.0 / 256.0, 2048, |z| {
             let e = (LOAD_FACTOR_MAX - LOAD_FACTOR_MIN) * (load_k * z).exp();
             (LOAD_FACTOR_MIN + e, load_k * e)
@@ -81,19 +89,34 @@ impl TyreModel {
         }
     }
 
-    /// Largest force the tyre can give under load `fz` on a surface of friction `surface` (N).
+    /// Largest force an axle of two such tyres can give under its load `fz` on a surface of
+    /// friction `surface` (N): F_z·μ·μ_surface·λ(F_z/2).
     #[inline]
-    pub fn max_force(&self, fz: f64, surface: f64) -> f64 {
-        fz * self.mu * surface * self.load_factor(fz)
+    pub fn axle_max_force(&self, fz: f64, surface: f64) -> f64 {
+        fz * self.mu * surface * self.load_factor(0.5 * fz)
     }
 
-    /// The shape f(s) and f′(s) for s ≥ 0: the tabulated values up to s = 2 (error below
-    /// 1e-11), the formula beyond.
+    /// g(u) = f(√u)/√u and g′(u) for u = s² ≥ 0: the tabulated values up to u = 1, the
+    /// formula beyond.
     #[inline]
-    pub fn shape(&self, s: f64) -> (f64, f64) {
-        self.shape_table
-            .eval(s)
-            .unwrap_or_else(|| self.shape_exact(s))
+    pub fn ratio(&self, u: f64) -> (f64, f64) {
+        self.ratio_table
+            .eval(u)
+            .unwrap_or_else(|| self.ratio_exact(u))
+    }
+
+    /// g(u) = f(√u)/√u and g′(u) = (f′(s)·s − f(s))/(2s³), evaluated directly; below
+    /// u = 1e-8 from the series f(s) = BC·s + a₃s³ + O(s⁵), g = BC + a₃u, with
+    /// a₃ = −B³C(1 + E)/3 − (BC)³/6.
+    pub fn ratio_exact(&self, u: f64) -> (f64, f64) {
+        let (b, c) = (self.b, self.c);
+        let a3 = -b.powi(3) * c * (1.0 + self.e) / 3.0 - (b * c).powi(3) / 6.0;
+        if u < 1e-8 {
+            return (b * c + a3 * u, a3);
+        }
+        let s = u.sqrt();
+        let (f, df) = self.shape_exact(s);
+        (f / s, (df * s - f) / (2.0 * u * s))
     }
 
     /// The Magic-Formula shape f(s) = sin(C·atan(B·s·(1 − E) + E·atan(B·s))) and its
@@ -108,32 +131,18 @@ impl TyreModel {
     }
 
     /// Forces for slip (sₓ, s_y) with grip budget `fmax` = F_z·μ·μ_r·λ, and their
-    /// derivatives with respect to sₓ:
-    /// Fₓ = fmax·f(s)·sₓ/s, F_y = fmax·f(s)·s_y/s,
-    /// ∂Fₓ/∂sₓ = fmax·[f′·sₓ²/s² + f·s_y²/s³], ∂F_y/∂sₓ = fmax·sₓs_y·[f′/s² − f/s³].
+    /// derivatives with respect to sₓ, with u = sₓ² + s_y²:
+    /// Fₓ = fmax·g(u)·sₓ, F_y = fmax·g(u)·s_y,
+    /// ∂Fₓ/∂sₓ = fmax·[g + 2sₓ²·g′], ∂F_y/∂sₓ = fmax·2sₓs_y·g′.
     #[inline]
     pub fn forces(&self, sx: f64, sy: f64, fmax: f64) -> Forces {
-        let s2 = sx * sx + sy * sy;
-        if s2 < 1e-24 {
-            let k0 = self.b * self.c * fmax; // f′(0) = B·C
-            return Forces {
-                fx: k0 * sx,
-                fy: k0 * sy,
-                dfx_dsx: k0,
-                dfy_dsx: 0.0,
-            };
-        }
-        let s = s2.sqrt();
-        let (f, df) = self.shape(s);
-        let inv_s = 1.0 / s;
-        let inv_s2 = inv_s * inv_s;
-        let (fs, dfs2) = (f * inv_s, df * inv_s2);
-        let fs3 = fs * inv_s2;
+        let (g, dg) = self.ratio(sx * sx + sy * sy);
+        let (fg, two_dg_sx) = (fmax * g, fmax * 2.0 * dg * sx);
         Forces {
-            fx: fmax * fs * sx,
-            fy: fmax * fs * sy,
-            dfx_dsx: fmax * (dfs2 * sx * sx + fs3 * sy * sy),
-            dfy_dsx: fmax * sx * sy * (dfs2 - fs3),
+            fx: fg * sx,
+            fy: fg * sy,
+            dfx_dsx: fg + two_dg_sx * sx,
+            dfy_dsx: two_dg_sx * sy,
         }
     }
 
@@ -176,8 +185,8 @@ mod tests {
         let c = 2.0 - 0.6f64.asin() * 2.0 / std::f64::consts::PI;
         assert!((m.c - c).abs() < 1e-12 && (m.b - 16.0 / c).abs() < 1e-12);
         // The peak is 1 (sin = 1) and beyond it the force falls to the dynamic level.
-        assert!((m.shape(m.peak_slip).0 - 1.0).abs() < 1e-9);
-        assert!(m.shape(1.0).0 < 0.95);
+        assert!((m.shape_exact(m.peak_slip).0 - 1.0).abs() < 1e-9);
+        assert!(m.shape_exact(1.0).0 < 0.95);
     }
 
     #[test]
@@ -207,14 +216,22 @@ mod tests {
     fn the_table_matches_the_formula() {
         let m = TyreModel::new(&Car::spirit_300().rear_tyre);
         for i in 0..30_000 {
-            let s = i as f64 * 1e-4 + 3.3e-6;
-            let ((f, df), (g, dg)) = (m.shape(s), m.shape_exact(s));
-            assert!((f - g).abs() < 1e-10, "f at {s}: {f} vs {g}");
+            // Slips up to 1.5, past the table's end at s = 1, denser near the peak.
+            let s = (i as f64 / 30_000.0).powi(2) * 1.5 + 3.3e-6;
+            let (g, dg) = m.ratio(s * s);
+            let (f, df) = m.shape_exact(s);
+            assert!((g * s - f).abs() < 2e-10, "f at {s}: {} vs {f}", g * s);
+            // f′(s) = g + 2u·g′ (from f = √u·g).
+            let slope = g + 2.0 * s * s * dg;
             assert!(
-                (df - dg).abs() < 1e-6 * dg.abs().max(1.0),
-                "f' at {s}: {df} vs {dg}"
+                (slope - df).abs() < 1e-6 * df.abs().max(1.0),
+                "f' at {s}: {slope} vs {df}"
             );
         }
+        // The series just below u = 1e-8 joins the formula just above it: g moves by g′·Δu.
+        let (near, exact) = (m.ratio_exact(0.99e-8), m.ratio_exact(1.01e-8));
+        assert!((near.0 + near.1 * 0.02e-8 - exact.0).abs() < 1e-10);
+        assert!((near.1 - exact.1).abs() < 1e-5 * exact.1.abs());
     }
 
     #[test]
@@ -240,7 +257,7 @@ mod tests {
             assert!(
                 (fd - m.shape_exact(s).1).abs() < 1e-5 * fd.abs().max(1.0),
                 "s {s}: {fd} vs {}",
-                m.shape(s).1
+                m.shape_exact(s).1
             );
         }
     }

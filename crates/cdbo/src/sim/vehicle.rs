@@ -127,6 +127,7 @@ pub struct Vehicle {
     a: f64,
     b: f64,
     inv_yaw_inertia: f64,
+    inv_mass: f64,
     rolling: f64,
     /// m·g·b/L and m·g·a/L: the axles' static loads on level ground (N).
     static_load: [f64; 2],
@@ -172,6 +173,7 @@ impl Vehicle {
             a: car.cg_to_front(),
             b: car.cg_to_rear(),
             inv_yaw_inertia: 1.0 / car.yaw_inertia(),
+            inv_mass: 1.0 / car.mass,
             rolling: 0.5 * (car.front_tyre.rolling_resistance + car.rear_tyre.rolling_resistance),
             car: car.clone(),
         }
@@ -226,14 +228,18 @@ impl Vehicle {
             -s.vx * sin_d + front_lat * cos_d,
             s.vy - self.b * s.yaw_rate,
         ];
+        // 1 / max(|v_t|, v₀): the slips' common denominator, per axle.
+        let inv_denom = [
+            1.0 / vt[0].abs().max(SLIP_SPEED_FLOOR),
+            1.0 / vt[1].abs().max(SLIP_SPEED_FLOOR),
+        ];
 
         // Drive torque. Traction control eases the throttle while the driven axle's combined
         // slip, with the wheel spinning faster than the road, passes the aid threshold.
         let mut throttle = c.throttle();
         let k = if self.driven[1] > 0.0 { 1 } else { 0 };
-        let inv_denom = 1.0 / vt[k].abs().max(SLIP_SPEED_FLOOR);
-        let spin = (s.omega[k] * self.radius[k] - vt[k]) * inv_denom;
-        let lateral = vl[k] * inv_denom;
+        let spin = (s.omega[k] * self.radius[k] - vt[k]) * inv_denom[k];
+        let lateral = vl[k] * inv_denom[k];
         let combined2 = spin * spin + lateral * lateral;
         let threshold = self.aid_threshold[k];
         if spin > 0.0 && combined2 > threshold * threshold {
@@ -255,8 +261,8 @@ impl Vehicle {
         for k in 0..2 {
             let tyre = &self.tyres[k];
             let r = self.radius[k];
-            let inv_denom = 1.0 / vt[k].abs().max(SLIP_SPEED_FLOOR);
-            let fmax = tyre.max_force(fz[k], frame.friction);
+            let inv_denom = inv_denom[k];
+            let fmax = tyre.axle_max_force(fz[k], frame.friction);
             let sx = (s.omega[k] * r - vt[k]) * inv_denom;
             let sy = -vl[k] * inv_denom;
             // ABS: ease the pressure while the wheel slides backwards past the threshold.
@@ -281,14 +287,12 @@ impl Vehicle {
             let dsx = (new_omega - s.omega[k]) * r * inv_denom;
             s.omega[k] = new_omega;
             // Forces at the new spin, to first order, kept inside the grip budget.
-            let (mut x, mut y) = (f.fx + f.dfx_dsx * dsx, f.fy + f.dfy_dsx * dsx);
-            let norm2 = x * x + y * y;
-            if norm2 > fmax * fmax {
-                let scale = fmax / norm2.sqrt();
-                (x, y) = (x * scale, y * scale);
-            }
-            fx[k] = x;
-            fy[k] = y;
+            let (x, y) = (f.fx + f.dfx_dsx * dsx, f.fy + f.dfy_dsx * dsx);
+            (fx[k], fy[k]) = if x * x + y * y > fmax * fmax {
+                scale_to_budget(x, y, fmax)
+            } else {
+                (x, y)
+            };
         }
 
         // Body forces and moments.
@@ -303,7 +307,7 @@ impl Vehicle {
         let force_y = fx[0] * sin_d + fy[0] * cos_d + fy[1] - m * G * frame.sin_banking * along;
         let moment = self.a * (fx[0] * sin_d + fy[0] * cos_d) - self.b * fy[1];
 
-        let inv_m = 1.0 / m;
+        let inv_m = self.inv_mass;
         let ax = force_x * inv_m;
         s.vx += dt * (ax + s.vy * s.yaw_rate);
         s.vy += dt * (force_y * inv_m - s.vx * s.yaw_rate);
@@ -329,9 +333,19 @@ impl Vehicle {
         s.x += dt * (s.vx * cos_y - s.vy * sin_y);
         s.y += dt * (s.vx * sin_y + s.vy * cos_y);
         // Load transfer follows the acceleration with a short lag (suspension pitch).
-        s.ax += (ax - s.ax) * (dt / PITCH_TIME_CONSTANT).min(1.0);
+        s.ax += (ax - s.ax) * (dt * PITCH_RATE).min(1.0);
     }
 }
 
-/// Time constant of the longitudinal load transfer (s), standing in for pitch dynamics.
-const PITCH_TIME_CONSTANT: f64 = 0.05;
+/// (x, y) scaled to the length `fmax`. Rarely needed, so kept out of line: the hot path
+/// then skips its square root and division instead of computing them speculatively.
+#[cold]
+#[inline(never)]
+fn scale_to_budget(x: f64, y: f64, fmax: f64) -> (f64, f64) {
+    let scale = fmax / (x * x + y * y).sqrt();
+    (x * scale, y * scale)
+}
+
+/// 1 / time constant of the longitudinal load transfer (1/s): the pitch dynamics follow
+/// the acceleration with a 50 ms lag.
+const PITCH_RATE: f64 = 20.0;
