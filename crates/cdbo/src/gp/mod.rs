@@ -10,7 +10,6 @@ pub mod kernel;
 pub mod likelihood;
 
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
-use faer::reborrow::ReborrowMut;
 use faer::{Mat, MatMut, Par, Side};
 use serde::{Deserialize, Serialize};
 
@@ -65,6 +64,12 @@ pub struct GaussianProcess {
     mean: f64,
     /// Lower Cholesky factor of K.
     chol: Mat<f64>,
+    /// The same factor's rows, packed: row i (its i + 1 entries up to the diagonal) starts
+    /// at i(i + 1)/2. A new observation appends a row; one-point solves read it in memory
+    /// order.
+    rows: Vec<f64>,
+    /// 1/Lᵢᵢ.
+    inv_diag: Vec<f64>,
     alpha: Vec<f64>,
     jitter: f64,
 }
@@ -81,6 +86,8 @@ impl GaussianProcess {
             y: Vec::new(),
             mean: 0.0,
             chol: Mat::zeros(0, 0),
+            rows: Vec::new(),
+            inv_diag: Vec::new(),
             alpha: Vec::new(),
             jitter: 0.0,
         })
@@ -162,24 +169,25 @@ impl GaussianProcess {
             )));
         }
         let n = self.len();
-        let mut l = Mat::from_fn(n, 1, |i, _| self.k(self.input(i), w));
-        if n > 0 {
-            solve_lower_triangular_in_place(self.chol.as_ref(), l.as_mut(), Par::Seq);
-        }
-        let ll: f64 = (0..n).map(|i| l[(i, 0)] * l[(i, 0)]).sum();
+        let mut l: Vec<f64> = (0..n).map(|i| self.k(self.input(i), w)).collect();
+        let ll = self.forward_substitute_norm2(&mut l);
         let d2 = self.hyper.signal_var + self.hyper.noise_var + self.jitter - ll;
         self.x.extend_from_slice(w);
         self.y.push(z);
         if d2 > 1e-12 * self.hyper.signal_var && d2.is_finite() {
+            let d = d2.sqrt();
             let mut chol = Mat::zeros(n + 1, n + 1);
             chol.as_mut()
                 .submatrix_mut(0, 0, n, n)
                 .copy_from(self.chol.as_ref());
-            for j in 0..n {
-                chol[(n, j)] = l[(j, 0)];
+            for (j, lj) in l.iter().enumerate() {
+                chol[(n, j)] = *lj;
             }
-            chol[(n, n)] = d2.sqrt();
+            chol[(n, n)] = d;
             self.chol = chol;
+            self.rows.extend_from_slice(&l);
+            self.rows.push(d);
+            self.inv_diag.push(1.0 / d);
             self.update_alpha();
             Ok(())
         } else {
@@ -230,6 +238,11 @@ impl GaussianProcess {
             if let Ok(llt) = k.llt(Side::Lower) {
                 let l = llt.L().to_owned();
                 if (0..n).all(|i| l[(i, i)].is_finite() && l[(i, i)] > 0.0) {
+                    self.rows = (0..n)
+                        .flat_map(|i| (0..=i).map(move |j| (i, j)))
+                        .map(|(i, j)| l[(i, j)])
+                        .collect();
+                    self.inv_diag = (0..n).map(|i| 1.0 / l[(i, i)]).collect();
                     self.chol = l;
                     self.jitter = jitter * self.hyper.signal_var;
                     self.update_alpha();
@@ -249,9 +262,9 @@ impl GaussianProcess {
             Mean::Constant => self.y.iter().sum::<f64>() / n.max(1) as f64,
         };
         let mut a = Mat::from_fn(n, 1, |i, _| self.y[i] - self.mean);
-        solve_lower_triangular_in_place(self.chol.as_ref(), a.as_mut(), Par::Seq);
+        solve_lower_triangular_in_place(self.cholesky(), a.as_mut(), Par::Seq);
         faer::linalg::triangular_solve::solve_upper_triangular_in_place(
-            self.chol.as_ref().transpose(),
+            self.cholesky().transpose(),
             a.as_mut(),
             Par::Seq,
         );
@@ -260,17 +273,17 @@ impl GaussianProcess {
 
     /// Posterior mean and variance at one point.
     pub fn predict(&self, w: &[f64]) -> (f64, f64) {
-        let mut kv = Mat::from_fn(self.len(), 1, |i, _| self.k(self.input(i), w));
-        self.predict_from_k(kv.as_mut())[0]
+        let mut k: Vec<f64> = (0..self.len()).map(|i| self.k(self.input(i), w)).collect();
+        self.predict_from_k(&mut k)[0]
     }
 
     /// Posterior mean and variance at many points (row-major, `dim` columns each).
     pub fn predict_batch(&self, points: &[f64]) -> Vec<(f64, f64)> {
-        let b = points.len() / self.dim;
-        let mut kv = Mat::from_fn(self.len(), b, |i, j| {
-            self.k(self.input(i), &points[j * self.dim..(j + 1) * self.dim])
-        });
-        self.predict_from_k(kv.as_mut())
+        let mut k: Vec<f64> = points
+            .chunks_exact(self.dim)
+            .flat_map(|p| (0..self.len()).map(move |i| self.k(self.input(i), p)))
+            .collect();
+        self.predict_from_k(&mut k)
     }
 
     /// The joint posterior at many points (row-major, `dim` columns each): the means and the
@@ -284,7 +297,7 @@ impl GaussianProcess {
             .map(|j| self.mean + (0..n).map(|i| v[(i, j)] * self.alpha[i]).sum::<f64>())
             .collect();
         if n > 0 {
-            solve_lower_triangular_in_place(self.chol.as_ref(), v.as_mut(), Par::Seq);
+            solve_lower_triangular_in_place(self.cholesky(), v.as_mut(), Par::Seq);
         }
         let mut cov = self.cov_by_product(points, points);
         faer::linalg::matmul::matmul(
@@ -326,60 +339,39 @@ impl GaussianProcess {
         Mat::from_fn(ra, rb, |i, j| r2[j * ra + i])
     }
 
-    /// Posterior mean and variance of one point from its cross-covariance k(W, w*)
-    /// (overwritten by L⁻¹k): column-oriented forward substitution, xⱼ = kⱼ/Lⱼⱼ then
-    /// k[j+1..] −= xⱼ·L[j+1.., j], whose inner loop is a contiguous axpy that vectorises.
-    pub fn predict_one_from_k(&self, k: &mut [f64]) -> (f64, f64) {
-        let mean = self.mean + k.iter().zip(&self.alpha).map(|(a, b)| a * b).sum::<f64>();
-        let vv = crate::simd::wide(
-            #[inline(always)]
-            || self.forward_substitute_norm2(k),
-        );
-        (mean, (self.hyper.signal_var - vv).max(0.0))
-    }
-
-    /// Overwrites k by L⁻¹k column by column and returns ‖L⁻¹k‖².
-    #[inline(always)]
-    fn forward_substitute_norm2(&self, k: &mut [f64]) -> f64 {
-        let n = k.len();
-        let mut vv = 0.0;
-        for j in 0..n {
-            let col = self
-                .chol
-                .col(j)
-                .try_as_col_major()
-                .map(|c| c.as_slice())
-                .unwrap_or_default();
-            let x = k[j] / col[j];
-            k[j] = x;
-            vv += x * x;
-            for (ki, lij) in k[j + 1..].iter_mut().zip(&col[j + 1..]) {
-                *ki -= x * lij;
-            }
+    /// Posterior means and variances from cross-covariances k(W, w*), one column of n = len()
+    /// values per point, stored one after another (overwritten by L⁻¹k):
+    /// μ = m + kᵀα, σ² = σ_f² − ‖L⁻¹k‖².
+    pub fn predict_from_k(&self, k: &mut [f64]) -> Vec<(f64, f64)> {
+        let n = self.len();
+        if n == 0 {
+            let points = k.len().max(1);
+            return vec![(self.mean, self.hyper.signal_var); points];
         }
-        vv
-    }
-
-    /// Posterior mean and variance from the cross-covariance columns k(W, w*) (overwritten).
-    pub fn predict_from_k(&self, mut kv: MatMut<'_, f64>) -> Vec<(f64, f64)> {
-        let (n, b) = (kv.nrows(), kv.ncols());
-        if b == 1
-            && let Some(col) = kv.rb_mut().col_mut(0).try_as_col_major_mut()
-        {
-            return vec![self.predict_one_from_k(col.as_slice_mut())];
-        }
-        let means: Vec<f64> = (0..b)
-            .map(|j| self.mean + (0..n).map(|i| kv[(i, j)] * self.alpha[i]).sum::<f64>())
+        let means: Vec<f64> = k
+            .chunks_exact(n)
+            .map(|col| self.mean + crate::simd::dot(col, &self.alpha))
             .collect();
-        if n > 0 {
-            solve_lower_triangular_in_place(self.chol.as_ref(), kv.as_mut(), Par::Seq);
-        }
-        (0..b)
-            .map(|j| {
-                let vv: f64 = (0..n).map(|i| kv[(i, j)] * kv[(i, j)]).sum();
-                (means[j], (self.hyper.signal_var - vv).max(0.0))
-            })
+        let norms = if k.len() == n {
+            vec![self.forward_substitute_norm2(k)]
+        } else {
+            // Several columns: faer's blocked triangular solve is faster here.
+            let points = k.len() / n;
+            let kv = MatMut::from_column_major_slice_mut(k, n, points);
+            solve_lower_triangular_in_place(self.cholesky(), kv, Par::Seq);
+            k.chunks_exact(n).map(|x| crate::simd::dot(x, x)).collect()
+        };
+        means
+            .into_iter()
+            .zip(norms)
+            .map(|(m, vv)| (m, (self.hyper.signal_var - vv).max(0.0)))
             .collect()
+    }
+
+    /// Overwrites k (len() values) by x = L⁻¹k and returns ‖x‖² (see
+    /// [`crate::simd::forward_substitute`]).
+    fn forward_substitute_norm2(&self, k: &mut [f64]) -> f64 {
+        crate::simd::forward_substitute(&self.rows, &self.inv_diag, k)
     }
 
     fn check_point(&self, w: &[f64]) -> Result<()> {

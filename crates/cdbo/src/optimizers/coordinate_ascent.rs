@@ -63,12 +63,14 @@ pub trait AxisObjective {
 }
 
 /// The acquisition of a GP as an [`AxisObjective`], caching the squared distances r²ⱼ of the
-/// current point to every observation.
+/// current point to every observation, and the observations by axis (column d holds every
+/// observation's coordinate d, so that a scan along d reads contiguous memory).
 pub struct GpAcquisition<'a> {
     gp: &'a GaussianProcess,
     acq: Acquisition,
     best: f64,
     r2: Vec<f64>,
+    columns: Vec<f64>,
 }
 
 impl<'a> GpAcquisition<'a> {
@@ -82,7 +84,21 @@ impl<'a> GpAcquisition<'a> {
         let r2 = (0..gp.len())
             .map(|j| crate::gp::scaled_sq_dist(point, gp.input(j), gp.inv_l2()))
             .collect();
-        GpAcquisition { gp, acq, best, r2 }
+        let columns = (0..gp.dim())
+            .flat_map(|d| (0..gp.len()).map(move |j| gp.input(j)[d]))
+            .collect();
+        GpAcquisition {
+            gp,
+            acq,
+            best,
+            r2,
+            columns,
+        }
+    }
+
+    fn column(&self, axis: usize) -> &[f64] {
+        let n = self.gp.len();
+        &self.columns[axis * n..(axis + 1) * n]
     }
 
     fn scale(&self, axis: usize) -> f64 {
@@ -99,16 +115,15 @@ impl AxisObjective for GpAcquisition<'_> {
         let (current, scale) = (point[axis], self.scale(axis));
         // Column-major n × B buffer of r², turned into kernel values in one vectorised pass.
         let mut buf = vec![0.0; n * values.len()];
+        let xs = self.column(axis);
         for (c, v) in values.iter().enumerate() {
             let col = &mut buf[c * n..(c + 1) * n];
-            for (j, out) in col.iter_mut().enumerate() {
-                let xj = gp.input(j)[axis];
-                *out = self.r2[j] + scale * ((v - xj) * (v - xj) - (current - xj) * (current - xj));
+            for ((out, r2), xj) in col.iter_mut().zip(&self.r2).zip(xs) {
+                *out = r2 + scale * ((v - xj) * (v - xj) - (current - xj) * (current - xj));
             }
         }
         h.kernel.apply_in_place(&mut buf, h.signal_var);
-        let kv = faer::MatMut::from_column_major_slice_mut(&mut buf, n, values.len());
-        gp.predict_from_k(kv)
+        gp.predict_from_k(&mut buf)
             .into_iter()
             .map(|(m, v)| (self.acq.value(m, v, self.best), v))
             .collect()
@@ -116,8 +131,9 @@ impl AxisObjective for GpAcquisition<'_> {
 
     fn moved(&mut self, axis: usize, from: f64, to: f64) {
         let s = self.scale(axis);
-        for (j, r) in self.r2.iter_mut().enumerate() {
-            let xj = self.gp.input(j)[axis];
+        let n = self.gp.len();
+        let xs = &self.columns[axis * n..(axis + 1) * n];
+        for (r, xj) in self.r2.iter_mut().zip(xs) {
             *r = (*r - s * (from - xj) * (from - xj) + s * (to - xj) * (to - xj)).max(0.0);
         }
     }
@@ -166,16 +182,25 @@ pub fn maximise(
                 .polish
                 .min(settings.budget.saturating_sub(evaluations));
             if polish >= 3 {
-                let count = std::cell::Cell::new(0usize);
+                // Every point COBYLA tries is scored once; the best of them is kept.
+                let tried = std::cell::Cell::new((0usize, best_v, best_h, best_var));
                 let obj = &*objective;
                 let p = &point;
                 let f = |x: &[f64], _: &mut ()| {
-                    count.set(count.get() + 1);
-                    -obj.along(p, i, &[x[0]])[0].0
+                    let v = x[0].clamp(lo, hi);
+                    let (hv, vv) = obj.along(p, i, &[v])[0];
+                    let (count, bv, bh, bvar) = tried.get();
+                    tried.set(if hv > bh {
+                        (count + 1, v, hv, vv)
+                    } else {
+                        (count + 1, bv, bh, bvar)
+                    });
+                    -hv
                 };
                 let step = (hi - lo) / (2.0 * (scan - 1).max(1) as f64);
                 let cons: Vec<&dyn cobyla::Func<()>> = vec![];
-                let result = cobyla::minimize(
+                // Its own answer is among the points it tried, so only `tried` is read.
+                let _ = cobyla::minimize(
                     f,
                     &[best_v],
                     &[(lo, hi)],
@@ -185,15 +210,9 @@ pub fn maximise(
                     cobyla::RhoBeg::All(step),
                     None,
                 );
-                evaluations += count.get();
-                let x = match result {
-                    Ok((_, x, _)) | Err((_, x, _)) => x[0].clamp(lo, hi),
-                };
-                let (hv, vv) = objective.along(&point, i, &[x])[0];
-                evaluations += 1;
-                if hv > best_h {
-                    (best_v, best_h, best_var) = (x, hv, vv);
-                }
+                let count;
+                (count, best_v, best_h, best_var) = tried.get();
+                evaluations += count;
             }
             if best_v != point[i] {
                 objective.moved(i, point[i], best_v);
