@@ -112,27 +112,47 @@ impl Kernel {
         }
     }
 
-    /// dκ/d(r²) as a function of r², used for length-scale gradients. For the exponential
-    /// kernel it is −e^(−r)/(2r), unbounded at r = 0 where every term it multiplies vanishes;
-    /// 0 is returned there.
-    #[inline]
-    pub fn d_of_r2(self, r2: f64) -> f64 {
-        match self {
-            Kernel::Exponential => {
-                if r2 <= 0.0 {
-                    0.0
-                } else {
-                    let r = r2.sqrt();
-                    -(-r).exp() / (2.0 * r)
-                }
-            }
-            Kernel::Matern32 => -1.5 * (-SQRT3 * r2.sqrt()).exp(),
-            Kernel::Matern52 => {
-                let a = SQRT5 * r2.sqrt();
-                -(5.0 / 6.0) * (1.0 + a) * (-a).exp()
-            }
-            Kernel::SquaredExponential => -0.5 * (-0.5 * r2).exp(),
-        }
+    /// For each squared scaled distance r² in `r2`, the kernel value σ_f²·κ(r²) into `values`
+    /// and its slope σ_f²·dκ/d(r²) into `slopes` (for length-scale gradients), vectorised
+    /// like [`Kernel::apply_in_place`]. Slopes: exponential −e^(−r)/(2r), unbounded at r = 0
+    /// where every term it multiplies vanishes (0 is returned there); Matérn-3/2
+    /// −(3/2)e^(−√3r); Matérn-5/2 −(5/6)(1 + √5r)e^(−√5r); squared exponential −½e^(−r²/2).
+    pub fn values_and_slopes(
+        self,
+        r2: &[f64],
+        signal_var: f64,
+        values: &mut [f64],
+        slopes: &mut [f64],
+    ) {
+        let out = values.iter_mut().zip(slopes.iter_mut()).zip(r2);
+        crate::simd::wide(
+            #[inline(always)]
+            || match self {
+                Kernel::Exponential => out.for_each(|((k, dk), v)| {
+                    let r = v.max(0.0).sqrt();
+                    let e = signal_var * exp_nonpositive(-r);
+                    *k = e;
+                    *dk = if r > 0.0 { -e / (2.0 * r) } else { 0.0 };
+                }),
+                Kernel::Matern32 => out.for_each(|((k, dk), v)| {
+                    let a = SQRT3 * v.max(0.0).sqrt();
+                    let e = signal_var * exp_nonpositive(-a);
+                    *k = (1.0 + a) * e;
+                    *dk = -1.5 * e;
+                }),
+                Kernel::Matern52 => out.for_each(|((k, dk), v)| {
+                    let a = SQRT5 * v.max(0.0).sqrt();
+                    let e = signal_var * exp_nonpositive(-a);
+                    *k = (1.0 + a + a * a / 3.0) * e;
+                    *dk = -(5.0 / 6.0) * (1.0 + a) * e;
+                }),
+                Kernel::SquaredExponential => out.for_each(|((k, dk), v)| {
+                    let e = signal_var * exp_nonpositive(-0.5 * v.max(0.0));
+                    *k = e;
+                    *dk = -0.5 * e;
+                }),
+            },
+        )
     }
 
     /// The name used on the command line.
@@ -205,14 +225,14 @@ mod tests {
             Kernel::Matern52,
             Kernel::SquaredExponential,
         ] {
-            for r2 in [0.01, 0.3, 1.0, 2.5] {
+            let r2 = [0.01, 0.3, 1.0, 2.5];
+            let (mut values, mut slopes) = ([0.0; 4], [0.0; 4]);
+            k.values_and_slopes(&r2, 2.0, &mut values, &mut slopes);
+            for ((r2, v), dk) in r2.iter().zip(values).zip(slopes) {
                 let h = 1e-7;
-                let fd = (k.of_r2(r2 + h) - k.of_r2(r2 - h)) / (2.0 * h);
-                assert!(
-                    (fd - k.d_of_r2(r2)).abs() < 1e-6,
-                    "{k:?} at {r2}: {fd} vs {}",
-                    k.d_of_r2(r2)
-                );
+                let fd = 2.0 * (k.of_r2(r2 + h) - k.of_r2(r2 - h)) / (2.0 * h);
+                assert!((v - 2.0 * k.of_r2(*r2)).abs() < 1e-14);
+                assert!((fd - dk).abs() < 1e-6, "{k:?} at {r2}: {fd} vs {dk}");
             }
         }
     }

@@ -6,8 +6,9 @@
 //! ∂K/∂log σ_f² = K_f (the noise-free part), ∂K/∂log σ_n² = σ_n²I,
 //! ∂Kᵢⱼ/∂log l_d = σ_f²·κ′(r²ᵢⱼ)·(−2(w_id − w_jd)²/l_d²).
 
+use faer::linalg::matmul::triangular::{self, BlockStructure};
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
-use faer::{Mat, Par};
+use faer::{Accum, Mat, Par};
 use serde::{Deserialize, Serialize};
 
 use super::{GaussianProcess, Hyper};
@@ -30,43 +31,81 @@ pub fn log_likelihood(gp: &GaussianProcess) -> f64 {
 
 /// The gradient of [`log_likelihood`] in (log l₁, …, log l_L, log σ_f², log σ_n²); the last
 /// entry is present only when `with_noise`.
+///
+/// With W = ααᵀ − K⁻¹ and, for i ≠ j, cᵢⱼ = Wᵢⱼ·σ_f²κ′(r²ᵢⱼ): ∂/∂log σ_f² = ½ Σᵢⱼ Wᵢⱼ(K_f)ᵢⱼ,
+/// and for the ARD length-scales ∂/∂log l_d = −s_d Σᵢⱼ cᵢⱼ(x_id − x_jd)²
+/// = −2s_d [Σᵢ x_id² Σⱼ cᵢⱼ − Σᵢ x_id (CX)_id] (s_d = 1/l_d²), one matrix product for all d,
+/// with X centred in each dimension (the differences are unchanged and cancel less).
 pub fn log_likelihood_gradient(gp: &GaussianProcess, with_noise: bool) -> Vec<f64> {
     let n = gp.len();
     let dim = gp.dim();
     let h = gp.hyper();
     let inv_l2 = gp.inv_l2();
-    // K⁻¹ = L⁻ᵀL⁻¹.
+    // K⁻¹ = L⁻ᵀL⁻¹, its upper triangle only, from the triangular factors.
     let mut linv = Mat::<f64>::identity(n, n);
     solve_lower_triangular_in_place(gp.cholesky(), linv.as_mut(), Par::Seq);
-    let kinv = linv.transpose() * &linv;
+    let mut kinv = Mat::<f64>::zeros(n, n);
+    triangular::matmul(
+        kinv.as_mut(),
+        BlockStructure::TriangularUpper,
+        Accum::Replace,
+        linv.transpose(),
+        BlockStructure::TriangularUpper,
+        linv.as_ref(),
+        BlockStructure::TriangularLower,
+        1.0,
+        Par::Seq,
+    );
     let a = gp.alpha();
-    let w = |i: usize, j: usize| a[i] * a[j] - kinv[(i, j)];
     let nl = h.lengthscales.len();
+    let ard = nl > 1;
     let mut grad = vec![0.0; nl + 1 + usize::from(with_noise)];
+    let columns = gp.inputs_by_dim();
+    let mut c = Mat::<f64>::zeros(if ard { n } else { 0 }, if ard { n } else { 0 });
+    let (mut r2, mut kf, mut dk) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let mut trace_w = 0.0;
     for i in 0..n {
-        let xi = gp.input(i);
-        for j in 0..=i {
-            let factor = if i == j { 0.5 } else { 1.0 }; // ½·tr with the symmetric pair counted twice
-            let wij = w(i, j) * factor;
-            let xj = gp.input(j);
-            let r2 = super::scaled_sq_dist(xi, xj, inv_l2);
-            let kf = h.signal_var * h.kernel.of_r2(r2);
-            grad[nl] += wij * kf;
-            if i != j {
-                let dk = h.signal_var * h.kernel.d_of_r2(r2);
-                if nl == 1 {
-                    grad[0] += wij * dk * (-2.0 * r2);
-                } else {
-                    for d in 0..dim {
-                        let diff = xi[d] - xj[d];
-                        grad[d] += wij * dk * (-2.0 * diff * diff * inv_l2[d]);
-                    }
-                }
+        let m = i + 1;
+        gp.sq_dists_to_earlier(&columns, i, &mut r2[..i]);
+        r2[i] = 0.0;
+        h.kernel
+            .values_and_slopes(&r2[..m], h.signal_var, &mut kf[..m], &mut dk[..m]);
+        // K⁻¹ is symmetric: row i up to the diagonal is column i's head (upper triangle).
+        let kinv_i = &kinv.col_as_slice(i)[..m];
+        for j in 0..m {
+            let w = a[i] * a[j] - kinv_i[j];
+            if i == j {
+                grad[nl] += 0.5 * w * kf[j];
+                trace_w += w;
+                continue;
+            }
+            grad[nl] += w * kf[j];
+            if ard {
+                let cij = w * dk[j];
+                c[(i, j)] = cij;
+                c[(j, i)] = cij;
+            } else {
+                grad[0] += w * dk[j] * (-2.0 * r2[j]);
             }
         }
     }
+    if ard {
+        let means: Vec<f64> = columns
+            .chunks_exact(n)
+            .map(|col| col.iter().sum::<f64>() / n as f64)
+            .collect();
+        let x = Mat::from_fn(n, dim, |j, d| columns[d * n + j] - means[d]);
+        let mut cx = Mat::<f64>::zeros(n, dim);
+        faer::linalg::matmul::matmul(cx.as_mut(), Accum::Replace, &c, &x, 1.0, Par::Seq);
+        let row_sums: Vec<f64> = (0..n).map(|i| c.col_as_slice(i).iter().sum()).collect();
+        for (d, g) in grad[..dim].iter_mut().enumerate() {
+            let (xd, cxd) = (x.col_as_slice(d), cx.col_as_slice(d));
+            let t: f64 = (0..n).map(|i| xd[i] * (xd[i] * row_sums[i] - cxd[i])).sum();
+            *g = -2.0 * inv_l2[d] * t;
+        }
+    }
     if with_noise {
-        grad[nl + 1] = 0.5 * (0..n).map(|i| w(i, i)).sum::<f64>() * h.noise_var;
+        grad[nl + 1] = 0.5 * trace_w * h.noise_var;
     }
     grad
 }

@@ -213,15 +213,58 @@ impl GaussianProcess {
     /// The covariance matrix of the observations, without noise or jitter.
     pub fn gram(&self) -> Mat<f64> {
         let n = self.len();
+        let columns = self.inputs_by_dim();
         let mut k = Mat::zeros(n, n);
+        let mut row = vec![0.0; n];
         for i in 0..n {
-            for j in 0..=i {
-                let v = self.k(self.input(i), self.input(j));
-                k[(i, j)] = v;
-                k[(j, i)] = v;
+            let row = &mut row[..=i];
+            self.sq_dists_to_earlier(&columns, i, &mut row[..i]);
+            row[i] = 0.0;
+            self.hyper.kernel.apply_in_place(row, self.hyper.signal_var);
+            for (j, v) in row.iter().enumerate() {
+                k[(i, j)] = *v;
+                k[(j, i)] = *v;
             }
         }
         k
+    }
+
+    /// The inputs by dimension: entry d·n + j is coordinate d of observation j.
+    pub fn inputs_by_dim(&self) -> Vec<f64> {
+        let n = self.len();
+        (0..self.dim)
+            .flat_map(|d| (0..n).map(move |j| self.x[j * self.dim + d]))
+            .collect()
+    }
+
+    /// The scaled squared distances of observation i to observations 0..i, into `out`
+    /// (length i): each summed over the dimensions in order, as [`scaled_sq_dist`] does, and
+    /// vectorised across the observations (`columns` from [`Self::inputs_by_dim`]).
+    pub fn sq_dists_to_earlier(&self, columns: &[f64], i: usize, out: &mut [f64]) {
+        let n = self.len();
+        let xi = self.input(i);
+        out.fill(0.0);
+        crate::simd::wide(
+            #[inline(always)]
+            || {
+                for (d, (&xid, col)) in xi.iter().zip(columns.chunks_exact(n)).enumerate() {
+                    let col = &col[..out.len()];
+                    if self.inv_l2.len() == 1 {
+                        for (o, x) in out.iter_mut().zip(col) {
+                            *o += (xid - x) * (xid - x);
+                        }
+                    } else {
+                        let s = self.inv_l2[d];
+                        for (o, x) in out.iter_mut().zip(col) {
+                            *o += (xid - x) * (xid - x) * s;
+                        }
+                    }
+                }
+                if let [s] = self.inv_l2[..] {
+                    out.iter_mut().for_each(|o| *o *= s);
+                }
+            },
+        )
     }
 
     /// Factors K from scratch, raising the jitter until it succeeds.
