@@ -109,3 +109,59 @@ fn turbo_and_linebo_beat_random_search_on_ackley20() {
         );
     }
 }
+
+/// Evaluations until the best reward is within `tolerance` of `optimum` (None: not within
+/// `budget`).
+fn evaluations_to_reach(
+    next: &mut dyn FnMut() -> f64,
+    optimum: f64,
+    tolerance: f64,
+    budget: usize,
+) -> Option<usize> {
+    (1..=budget).find(|_| next() >= optimum - tolerance)
+}
+
+/// REMBO (Wang et al. 2016, Fig. 3) finds the optimum of Branin embedded in 100 dimensions
+/// far faster than uniform random search over the box, the baseline of that paper.
+#[test]
+fn rembo_finds_branin_in_100d_far_faster_than_random_search() {
+    use rand::{Rng, SeedableRng};
+    let problem = Problem::by_name("branin", 100).unwrap();
+    let (optimum, tolerance, budget, seeds) = (-0.397_887, 0.5, 150, 10);
+    let mut rembo_counts = Vec::new();
+    let mut random_counts = Vec::new();
+    for seed in 0..seeds {
+        let mut opt = optimiser("rembo-5d", &problem, seed);
+        let mut next = || {
+            let w = opt.ask().unwrap();
+            let r = problem.reward(&w);
+            opt.tell(&w, r).unwrap();
+            opt.best().unwrap().1
+        };
+        rembo_counts.push(evaluations_to_reach(&mut next, optimum, tolerance, budget));
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let mut best = f64::NEG_INFINITY;
+        let mut next = || {
+            let w: Vec<f64> = (0..100).map(|_| rng.random::<f64>()).collect();
+            best = best.max(problem.reward(&w));
+            best
+        };
+        random_counts.push(evaluations_to_reach(&mut next, optimum, tolerance, budget));
+    }
+    eprintln!(
+        "branin-100d, evaluations to come within {tolerance} of the optimum: \
+         rembo-5d {rembo_counts:?}, uniform random {random_counts:?}"
+    );
+    // Medians, counting a run that never came close as budget + 1.
+    let median = |counts: &[Option<usize>]| {
+        let mut c: Vec<usize> = counts.iter().map(|c| c.unwrap_or(budget + 1)).collect();
+        c.sort();
+        (c[c.len() / 2 - 1] + c[c.len() / 2]) as f64 / 2.0
+    };
+    let (rembo, random) = (median(&rembo_counts), median(&random_counts));
+    assert!(
+        4.0 * rembo <= random,
+        "REMBO needed {rembo} evaluations (median), random search {random}"
+    );
+    assert!(rembo_counts.iter().filter(|c| c.is_some()).count() >= 7);
+}

@@ -264,6 +264,44 @@ impl Bo {
         Ok(())
     }
 
+    /// The best, by the acquisition, of `start` and `count` uniform points of the box.
+    fn best_random_start(
+        &self,
+        start: Vec<f64>,
+        count: usize,
+        rng: &mut impl rand::Rng,
+    ) -> Vec<f64> {
+        if count == 0 {
+            return start;
+        }
+        let mut points = start.clone();
+        for _ in 0..count {
+            points.extend(
+                self.bounds
+                    .lower
+                    .iter()
+                    .zip(&self.bounds.upper)
+                    .map(|(lo, hi)| lo + (hi - lo) * rng.random::<f64>()),
+            );
+        }
+        let acquisition = self.state.config.acquisition;
+        let incumbent = self
+            .gp
+            .values()
+            .iter()
+            .copied()
+            .fold(f64::NEG_INFINITY, f64::max);
+        let scores: Vec<f64> = self
+            .gp
+            .predict_batch(&points)
+            .into_iter()
+            .map(|(m, v)| acquisition.value(m, v, incumbent))
+            .collect();
+        let d = start.len();
+        let i = crate::acquisition::argmax(&scores);
+        points[i * d..(i + 1) * d].to_vec()
+    }
+
     /// The next point and the length-scale bound in force when it was chosen.
     fn suggest(&mut self) -> Result<(Vec<f64>, f64)> {
         let bound = self.state.lengthscale_max;
@@ -294,6 +332,7 @@ impl Bo {
         let acquisition = self.state.config.acquisition;
         let ascent = match &self.state.config.maximiser {
             Maximiser::CoordinateAscent(search) => {
+                let start = self.best_random_start(start, search.random_starts, &mut rng);
                 let mut objective = GpAcquisition::new(&self.gp, acquisition, &start);
                 super::coordinate_ascent::maximise(
                     &mut objective,

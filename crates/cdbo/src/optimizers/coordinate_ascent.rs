@@ -26,6 +26,11 @@ pub struct AxisSearch {
     pub polish: usize,
     /// Acquisition evaluations per suggestion, at most (the paper's 50,000).
     pub budget: usize,
+    /// Uniform random points of the box scored (one batch) before the ascent, which starts
+    /// from the best of them and the best observation: a global first look for acquisitions
+    /// whose maxima lie far from the best point (REMBO's expected improvement). 0 in CDBO.
+    #[serde(default)]
+    pub random_starts: usize,
 }
 
 impl Default for AxisSearch {
@@ -35,6 +40,7 @@ impl Default for AxisSearch {
             scan: 12,
             polish: 8,
             budget: 50_000,
+            random_starts: 0,
         }
     }
 }

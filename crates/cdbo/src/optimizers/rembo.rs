@@ -6,7 +6,9 @@
 //! [w₀ − r, w₀ + r]) and y = 0 giving the demonstration. After y = 0 and S initial samples
 //! that move w by σ₀ as CDBO's do, a GP (Matérn-5/2 ARD as in REMBO, CDBO's hyperparameter scheme)
 //! models the reward over y; the next y maximises expected improvement (REMBO's
-//! acquisition) by coordinate ascent with three sweeps, cheap in d dimensions.
+//! acquisition) by coordinate ascent with three sweeps, cheap in d dimensions, started from
+//! the best of the best observation and 1,000 uniform points of Y (REMBO maximises EI
+//! globally).
 
 use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
@@ -57,6 +59,11 @@ pub struct Rembo {
     best: super::Best,
 }
 
+/// Uniform points of Y scored before each ascent of the expected improvement: REMBO
+/// maximises it globally (with DIRECT in the paper), and its maxima often lie far from the
+/// best point in a space of only d dimensions.
+const RANDOM_STARTS: usize = 1000;
+
 /// The stream of the embedding's draws (the inner BO run uses streams 0, 1, 2, …).
 const EMBEDDING_STREAM: u64 = u64::MAX;
 
@@ -77,6 +84,7 @@ impl Rembo {
             box_radius: (d as f64).sqrt(),
             maximiser: Maximiser::CoordinateAscent(AxisSearch {
                 sweeps: 3,
+                random_starts: RANDOM_STARTS,
                 ..AxisSearch::default()
             }),
             ..BoConfig::default()
