@@ -38,28 +38,34 @@ pub fn exp_nonpositive(x: f64) -> f64 {
     let t = x * LOG2_E + ROUNDER;
     let k = t - ROUNDER;
     let r = (x - k * LN2_HI) - k * LN2_LO;
-    // Horner on the Taylor coefficients 1/12!, …, 1/1!, 1/0!.
-    let p = EXP_TAYLOR.iter().fold(0.0, |acc, c| acc * r + c);
+    // Estrin's scheme on the Taylor coefficients cᵢ = 1/i!: pairs cᵢ + cᵢ₊₁r, joined by r²,
+    // r⁴ and r⁸, a dependency chain of four steps instead of Horner's twelve.
+    let c = &EXP_TAYLOR;
+    let (r2, pair) = (r * r, |i: usize| c[i] + c[i + 1] * r);
+    let r4 = r2 * r2;
+    let low = (pair(0) + pair(2) * r2) + (pair(4) + pair(6) * r2) * r4;
+    let high = (pair(8) + pair(10) * r2) + c[12] * r4;
+    let p = low + high * (r4 * r4);
     // 2^k from the integer k held in t's low mantissa bits: (bits + 1023) << 52 keeps
     // (k + 1023) mod 2¹² as the exponent field, without a float-to-integer conversion.
     p * f64::from_bits(t.to_bits().wrapping_add(1023) << 52)
 }
 
-/// 1/i! for i = 12, 11, …, 0.
+/// 1/i! for i = 0, 1, …, 12.
 const EXP_TAYLOR: [f64; 13] = [
-    1.0 / 479_001_600.0,
-    1.0 / 39_916_800.0,
-    1.0 / 3_628_800.0,
-    1.0 / 362_880.0,
-    1.0 / 40_320.0,
-    1.0 / 5040.0,
-    1.0 / 720.0,
-    1.0 / 120.0,
-    1.0 / 24.0,
-    1.0 / 6.0,
+    1.0,
+    1.0,
     1.0 / 2.0,
-    1.0,
-    1.0,
+    1.0 / 6.0,
+    1.0 / 24.0,
+    1.0 / 120.0,
+    1.0 / 720.0,
+    1.0 / 5040.0,
+    1.0 / 40_320.0,
+    1.0 / 362_880.0,
+    1.0 / 3_628_800.0,
+    1.0 / 39_916_800.0,
+    1.0 / 479_001_600.0,
 ];
 
 const SQRT3: f64 = 1.732_050_807_568_877_2;

@@ -16,6 +16,7 @@ use serde::{Deserialize, Serialize};
 pub use kernel::{Kernel, scaled_sq_dist};
 
 use crate::error::{Error, Result};
+use crate::simd::TriangularRows;
 
 /// The prior mean.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -64,12 +65,8 @@ pub struct GaussianProcess {
     mean: f64,
     /// Lower Cholesky factor of K.
     chol: Mat<f64>,
-    /// The same factor's rows, packed: row i (its i + 1 entries up to the diagonal) starts
-    /// at i(i + 1)/2. A new observation appends a row; one-point solves read it in memory
-    /// order.
-    rows: Vec<f64>,
-    /// 1/Lᵢᵢ.
-    inv_diag: Vec<f64>,
+    /// The same factor by rows, for one-point solves; a new observation appends a row.
+    rows: TriangularRows,
     alpha: Vec<f64>,
     jitter: f64,
 }
@@ -86,8 +83,7 @@ impl GaussianProcess {
             y: Vec::new(),
             mean: 0.0,
             chol: Mat::zeros(0, 0),
-            rows: Vec::new(),
-            inv_diag: Vec::new(),
+            rows: TriangularRows::default(),
             alpha: Vec::new(),
             jitter: 0.0,
         })
@@ -185,9 +181,8 @@ impl GaussianProcess {
             }
             chol[(n, n)] = d;
             self.chol = chol;
-            self.rows.extend_from_slice(&l);
-            self.rows.push(d);
-            self.inv_diag.push(1.0 / d);
+            l.push(d);
+            self.rows.push_row(&l);
             self.update_alpha();
             Ok(())
         } else {
@@ -281,11 +276,7 @@ impl GaussianProcess {
             if let Ok(llt) = k.llt(Side::Lower) {
                 let l = llt.L().to_owned();
                 if (0..n).all(|i| l[(i, i)].is_finite() && l[(i, i)] > 0.0) {
-                    self.rows = (0..n)
-                        .flat_map(|i| (0..=i).map(move |j| (i, j)))
-                        .map(|(i, j)| l[(i, j)])
-                        .collect();
-                    self.inv_diag = (0..n).map(|i| 1.0 / l[(i, i)]).collect();
+                    self.rows = TriangularRows::from_fn(n, |i, j| l[(i, j)]);
                     self.chol = l;
                     self.jitter = jitter * self.hyper.signal_var;
                     self.update_alpha();
@@ -412,9 +403,9 @@ impl GaussianProcess {
     }
 
     /// Overwrites k (len() values) by x = L⁻¹k and returns ‖x‖² (see
-    /// [`crate::simd::forward_substitute`]).
+    /// [`TriangularRows::forward_substitute`]).
     fn forward_substitute_norm2(&self, k: &mut [f64]) -> f64 {
-        crate::simd::forward_substitute(&self.rows, &self.inv_diag, k)
+        self.rows.forward_substitute(k)
     }
 
     fn check_point(&self, w: &[f64]) -> Result<()> {

@@ -22,7 +22,7 @@ pub struct AxisSearch {
     pub sweeps: usize,
     /// Evenly spaced values scanned per axis before the polish.
     pub scan: usize,
-    /// COBYLA evaluations per axis.
+    /// COBYLA evaluations per axis, its first (the start, already scanned) included.
     pub polish: usize,
     /// Acquisition evaluations per suggestion, at most (the paper's 50,000).
     pub budget: usize,
@@ -38,7 +38,7 @@ impl Default for AxisSearch {
         AxisSearch {
             sweeps: 1,
             scan: 12,
-            polish: 8,
+            polish: 6,
             budget: 50_000,
             random_starts: 0,
         }
@@ -90,15 +90,12 @@ impl<'a> GpAcquisition<'a> {
         let r2 = (0..gp.len())
             .map(|j| crate::gp::scaled_sq_dist(point, gp.input(j), gp.inv_l2()))
             .collect();
-        let columns = (0..gp.dim())
-            .flat_map(|d| (0..gp.len()).map(move |j| gp.input(j)[d]))
-            .collect();
         GpAcquisition {
             gp,
             acq,
             best,
             r2,
-            columns,
+            columns: gp.inputs_by_dim(),
         }
     }
 
@@ -120,12 +117,18 @@ impl AxisObjective for GpAcquisition<'_> {
         let h = gp.hyper();
         let (current, scale) = (point[axis], self.scale(axis));
         // Column-major n × B buffer of r², turned into kernel values in one vectorised pass.
-        let mut buf = vec![0.0; n * values.len()];
+        // rest_j = r²ⱼ − sᵢ(wᵢ − Xⱼᵢ)², the part of r²ⱼ that the candidates share.
         let xs = self.column(axis);
-        for (c, v) in values.iter().enumerate() {
-            let col = &mut buf[c * n..(c + 1) * n];
-            for ((out, r2), xj) in col.iter_mut().zip(&self.r2).zip(xs) {
-                *out = r2 + scale * ((v - xj) * (v - xj) - (current - xj) * (current - xj));
+        let rest: Vec<f64> = self
+            .r2
+            .iter()
+            .zip(xs)
+            .map(|(r2, xj)| r2 - scale * (current - xj) * (current - xj))
+            .collect();
+        let mut buf = vec![0.0; n * values.len()];
+        for (col, v) in buf.chunks_exact_mut(n).zip(values) {
+            for ((out, rest), xj) in col.iter_mut().zip(&rest).zip(xs) {
+                *out = rest + scale * (v - xj) * (v - xj);
             }
         }
         h.kernel.apply_in_place(&mut buf, h.signal_var);
@@ -188,12 +191,17 @@ pub fn maximise(
                 .polish
                 .min(settings.budget.saturating_sub(evaluations));
             if polish >= 3 {
-                // Every point COBYLA tries is scored once; the best of them is kept.
+                // Every new point COBYLA tries is scored once; the best of them is kept. Its
+                // first point is the start, whose score the scan already has.
                 let tried = std::cell::Cell::new((0usize, best_v, best_h, best_var));
                 let obj = &*objective;
                 let p = &point;
+                let start = (best_v, best_h);
                 let f = |x: &[f64], _: &mut ()| {
                     let v = x[0].clamp(lo, hi);
+                    if v == start.0 {
+                        return -start.1;
+                    }
                     let (hv, vv) = obj.along(p, i, &[v])[0];
                     let (count, bv, bh, bvar) = tried.get();
                     tried.set(if hv > bh {
