@@ -242,3 +242,30 @@ mod cmaes {
         }
     }
 }
+
+/// A repeated lap of the deterministic simulator teaches the GP nothing (noise 0), and the
+/// next ascent would end on the same weights again: CDBO must never re-drive a lap. Forza with
+/// 10 kernels, seed 1 reached that state at lap 12 (every lap after it re-drove π(w₀)) before
+/// ascents that end on an observation were rerun with the observations excluded.
+#[test]
+fn cdbo_never_re_drives_a_lap() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/torcs/tracks/road/forza/forza.xml");
+    let track = cdbo::track::torcs::read(&path).unwrap_or_else(|e| panic!("{e}"));
+    let config = cdbo::experiment::race::RaceConfig {
+        kernels: 10,
+        laps: 20,
+        seed: 1,
+        ..Default::default()
+    };
+    let car = cdbo::car::Car::spirit_300();
+    let outcome = cdbo::experiment::race::race(track, &car, &config, |_| {}).unwrap();
+    let times: Vec<f64> = outcome.laps.iter().filter_map(|l| l.lap_time_s).collect();
+    for (k, t) in times.iter().enumerate() {
+        assert!(
+            !times[..k].contains(t),
+            "lap time {t} s driven twice: {times:?}"
+        );
+    }
+    assert!(outcome.best_reward_mps > outcome.laps[0].reward_mps);
+}

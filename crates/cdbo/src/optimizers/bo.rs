@@ -13,12 +13,16 @@
 //! [`LOW_UNCERTAINTY`]·σ_f, the upper bound is halved (never below twice the lower bound), so
 //! that the next fit must explain the data with shorter length-scales and the acquisition
 //! finds uncertainty again.
+//!
+//! A coordinate ascent that ends on an observation (posterior variance at most
+//! [`REPEAT_VARIANCE`]·σ_f² plus twice the jitter) is run again with the observations scoring
+//! −∞: with noise 0 a repeated lap teaches nothing, and every later ascent would end there.
 
 use rand_distr::{Distribution, Normal};
 use serde::{Deserialize, Serialize};
 
 use super::cmaes_ascent::CmaesSearch;
-use super::coordinate_ascent::{AxisSearch, GpAcquisition};
+use super::coordinate_ascent::{Ascent, AxisSearch, GpAcquisition};
 use super::{Best, Optimizer, SearchBox, check_tell, rng_for};
 use crate::acquisition::Acquisition;
 use crate::acquisition::ucb::DEFAULT_BETA;
@@ -28,6 +32,10 @@ use crate::gp::{GaussianProcess, Hyper, Kernel, Mean};
 
 /// σ(w_next) below this fraction of σ_f shrinks the length-scale upper bound.
 pub const LOW_UNCERTAINTY: f64 = 0.05;
+
+/// A posterior variance at most this fraction of σ_f² (plus twice the jitter) marks a point
+/// already observed.
+pub const REPEAT_VARIANCE: f64 = 1e-8;
 
 /// How the acquisition is maximised.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -333,14 +341,31 @@ impl Bo {
         let ascent = match &self.state.config.maximiser {
             Maximiser::CoordinateAscent(search) => {
                 let start = self.best_random_start(start, search.random_starts, &mut rng);
-                let mut objective = GpAcquisition::new(&self.gp, acquisition, &start);
-                super::coordinate_ascent::maximise(
-                    &mut objective,
-                    &self.bounds,
-                    &start,
-                    search,
-                    &mut rng,
-                )
+                let objective = GpAcquisition::new(&self.gp, acquisition, &start);
+                let mut ascend = |mut objective: GpAcquisition<'_>| {
+                    super::coordinate_ascent::maximise(
+                        &mut objective,
+                        &self.bounds,
+                        &start,
+                        search,
+                        &mut rng,
+                    )
+                };
+                let ascent = ascend(objective);
+                // An ascent that ends on an observation would re-drive a known lap and teach
+                // the GP nothing (noise 0: every later ascent would end there too); it is run
+                // again with the observations excluded.
+                let floor = REPEAT_VARIANCE * self.gp.hyper().signal_var + 2.0 * self.gp.jitter();
+                if ascent.var <= floor {
+                    let objective = GpAcquisition::new(&self.gp, acquisition, &start);
+                    let again = ascend(objective.excluding_observed(floor));
+                    Ascent {
+                        evaluations: ascent.evaluations + again.evaluations,
+                        ..again
+                    }
+                } else {
+                    ascent
+                }
             }
             Maximiser::Cmaes(search) => super::cmaes_ascent::maximise(
                 &self.gp,

@@ -77,6 +77,7 @@ pub struct GpAcquisition<'a> {
     best: f64,
     r2: Vec<f64>,
     columns: Vec<f64>,
+    variance_floor: f64,
 }
 
 impl<'a> GpAcquisition<'a> {
@@ -96,6 +97,16 @@ impl<'a> GpAcquisition<'a> {
             best,
             r2,
             columns: gp.inputs_by_dim(),
+            variance_floor: f64::NEG_INFINITY,
+        }
+    }
+
+    /// Scores −∞ wherever the posterior variance is at most `floor`: at an observation of a
+    /// noise-free GP, where a lap would only repeat a known one.
+    pub fn excluding_observed(self, floor: f64) -> GpAcquisition<'a> {
+        GpAcquisition {
+            variance_floor: floor,
+            ..self
         }
     }
 
@@ -134,7 +145,14 @@ impl AxisObjective for GpAcquisition<'_> {
         h.kernel.apply_in_place(&mut buf, h.signal_var);
         gp.predict_from_k(&mut buf)
             .into_iter()
-            .map(|(m, v)| (self.acq.value(m, v, self.best), v))
+            .map(|(m, v)| {
+                let h = if v > self.variance_floor {
+                    self.acq.value(m, v, self.best)
+                } else {
+                    f64::NEG_INFINITY
+                };
+                (h, v)
+            })
             .collect()
     }
 
@@ -200,7 +218,7 @@ pub fn maximise(
                 let f = |x: &[f64], _: &mut ()| {
                     let v = x[0].clamp(lo, hi);
                     if v == start.0 {
-                        return -start.1;
+                        return (-start.1).min(f64::MAX);
                     }
                     let (hv, vv) = obj.along(p, i, &[v])[0];
                     let (count, bv, bh, bvar) = tried.get();
@@ -209,7 +227,7 @@ pub fn maximise(
                     } else {
                         (count + 1, bv, bh, bvar)
                     });
-                    -hv
+                    (-hv).min(f64::MAX)
                 };
                 let step = (hi - lo) / (2.0 * (scan - 1).max(1) as f64);
                 let cons: Vec<&dyn cobyla::Func<()>> = vec![];
