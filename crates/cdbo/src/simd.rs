@@ -403,7 +403,7 @@ mod tests {
                 factor.forward_substitute_with(&mut packed, dot4, ungrouped),
                 norm2
             );
-            assert_eq!(portable, x);
+            assert_eq!(packed, x);
         }
     }
 }

@@ -139,6 +139,11 @@ impl GaussianProcess {
         &self.y
     }
 
+    /// The largest observed value (−∞ with no observations): the incumbent of EI.
+    pub fn best_value(&self) -> f64 {
+        self.y.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+    }
+
     /// α = K⁻¹(z − m).
     pub fn alpha(&self) -> &[f64] {
         &self.alpha

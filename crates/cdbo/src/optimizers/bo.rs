@@ -293,12 +293,7 @@ impl Bo {
             );
         }
         let acquisition = self.state.config.acquisition;
-        let incumbent = self
-            .gp
-            .values()
-            .iter()
-            .copied()
-            .fold(f64::NEG_INFINITY, f64::max);
+        let incumbent = self.gp.best_value();
         let scores: Vec<f64> = self
             .gp
             .predict_batch(&points)

@@ -48,11 +48,7 @@ pub fn maximise(
 ) -> Result<Ascent> {
     let dim = start.len();
     let radius = 0.5 * (bounds.upper[0] - bounds.lower[0]);
-    let best_y = gp
-        .values()
-        .iter()
-        .copied()
-        .fold(f64::NEG_INFINITY, f64::max);
+    let best_y = gp.best_value();
     let mut es = Cmaes::new(
         start.to_vec(),
         CmaesConfig {

@@ -83,11 +83,7 @@ pub struct GpAcquisition<'a> {
 impl<'a> GpAcquisition<'a> {
     /// The acquisition at `point` (its distances are computed once here).
     pub fn new(gp: &'a GaussianProcess, acq: Acquisition, point: &[f64]) -> GpAcquisition<'a> {
-        let best = gp
-            .values()
-            .iter()
-            .copied()
-            .fold(f64::NEG_INFINITY, f64::max);
+        let best = gp.best_value();
         let r2 = (0..gp.len())
             .map(|j| crate::gp::scaled_sq_dist(point, gp.input(j), gp.inv_l2()))
             .collect();
