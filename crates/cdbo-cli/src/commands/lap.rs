@@ -62,7 +62,7 @@ pub fn run(args: &LapArgs, data: &DataPath) -> CliResult {
             Box::new(ConstantPedal(a))
         }
         (_, _, Some(path)) if path.extension().is_some_and(|e| e == "json") => {
-            Box::new(super::policy::read_policy(path)?)
+            Box::new(super::policy::read_policy(path)?.pedal())
         }
         (_, _, Some(path)) => Box::new(PolicyTable::read_csv(path)?),
         (speed, _, _) => {

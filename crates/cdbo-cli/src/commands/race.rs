@@ -225,8 +225,8 @@ fn write_plots(
     use plotters::style::{BLACK, BLUE, GREEN, RED};
     let mut sim = cdbo::sim::Simulator::new(track, car);
     sim.config.trace = true;
-    let initial_lap = sim.lap(&mut o.initial.clone());
-    let best_lap = sim.lap(&mut o.best.clone());
+    let initial_lap = sim.lap(&mut o.initial.pedal());
+    let best_lap = sim.lap(&mut o.best.pedal());
     let n = o.laps.len() as f64;
     let flat = |v: f64| vec![(1.0, v), (n, v)];
     let curve = LineChart {

@@ -197,8 +197,8 @@ fn best_policy_figures(
     let initial = RkhsPolicy::fit(demo, best.spec.kernels, best.lengthscale, DEFAULT_RIDGE)?;
     let best_policy = RkhsPolicy::new(best.best_weights.clone(), best.lengthscale)?;
     sim.config.trace = true;
-    let initial_lap = sim.lap(&mut initial.clone());
-    let best_lap = sim.lap(&mut best_policy.clone());
+    let initial_lap = sim.lap(&mut initial.pedal());
+    let best_lap = sim.lap(&mut best_policy.pedal());
     let xs = || (0..=500).map(|i| i as f64 / 500.0);
     let policies = LineChart {
         title: format!("{track_name}: policies ({} kernels)", best.spec.kernels),

@@ -86,8 +86,8 @@ fn answer(
     if weights.len() != dim {
         return Err(format!("expected {dim} weights, got {}", weights.len()));
     }
-    let mut policy = RkhsPolicy::new(weights, lengthscale).map_err(|e| e.to_string())?;
-    let lap = sim.lap(&mut policy);
+    let policy = RkhsPolicy::new(weights, lengthscale).map_err(|e| e.to_string())?;
+    let lap = sim.lap(&mut policy.pedal());
     Ok(json!({
         "reward_mps": lap.reward_mps,
         "lap_time_s": lap.lap_time_s,

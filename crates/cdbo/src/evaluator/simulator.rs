@@ -16,8 +16,8 @@ pub struct SimEvaluator {
 
 impl Evaluator for SimEvaluator {
     fn evaluate(&mut self, weights: &[f64]) -> Result<Outcome> {
-        let mut policy = RkhsPolicy::new(weights.to_vec(), self.lengthscale)?;
-        let lap = self.sim.lap(&mut policy);
+        let policy = RkhsPolicy::new(weights.to_vec(), self.lengthscale)?;
+        let lap = self.sim.lap(&mut policy.pedal());
         Ok(match (lap.lap_time_s, lap.failure) {
             (Some(t), None) => Outcome::Lap {
                 time_s: t,
@@ -49,7 +49,7 @@ mod tests {
             sim: sim.clone(),
             lengthscale: policy.lengthscale,
         };
-        let lap = sim.lap(&mut policy.clone());
+        let lap = sim.lap(&mut policy.pedal());
         let outcome = e.evaluate(&policy.weights).unwrap();
         assert_eq!(outcome.reward().unwrap(), lap.reward_mps);
         assert!(lap.reward_mps > 10.0);

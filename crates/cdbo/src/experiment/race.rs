@@ -121,9 +121,9 @@ pub fn race(
         let t0 = std::time::Instant::now();
         let weights = optimizer.ask()?;
         let optimizer_s = t0.elapsed().as_secs_f64();
-        let mut policy = RkhsPolicy::new(weights.clone(), lengthscale)?;
+        let policy = RkhsPolicy::new(weights.clone(), lengthscale)?;
         let t1 = std::time::Instant::now();
-        let result = sim.lap(&mut policy);
+        let result = sim.lap(&mut policy.pedal());
         let simulator_s = t1.elapsed().as_secs_f64();
         let t2 = std::time::Instant::now();
         optimizer.tell(&weights, result.reward_mps)?;

@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::drive::{Observation, Pedal};
 use crate::error::{Error, Result};
+use crate::gp::kernel::exp_nonpositive;
 
 /// Default ridge factor λ.
 pub const DEFAULT_RIDGE: f64 = 1e-3;
@@ -98,23 +99,24 @@ impl RkhsPolicy {
         self.weights.len()
     }
 
-    /// wᵀφ(x), before clamping.
+    /// wᵀφ(x), before clamping: the sum over all M kernels.
     pub fn raw(&self, x: f64) -> f64 {
-        let m = self.weights.len();
-        let h = 1.0 / (m - 1) as f64;
-        // Only kernels within ~12 length-scales matter (φ < 1e-7 beyond).
-        let reach = (12.0 * self.lengthscale / h).ceil() as isize + 1;
-        let centre = (x / h).round() as isize;
-        let lo = (centre - reach).max(0) as usize;
-        let hi = ((centre + reach).max(0) as usize).min(m - 1);
-        (lo..=hi)
-            .map(|i| self.weights[i] * matern32((x - i as f64 * h).abs() / self.lengthscale))
+        let h = 1.0 / (self.weights.len() - 1) as f64;
+        self.weights
+            .iter()
+            .enumerate()
+            .map(|(i, w)| w * matern32((x - i as f64 * h).abs() / self.lengthscale))
             .sum()
     }
 
     /// π(x) = clamp(wᵀφ(x), −1, 1).
     pub fn action(&self, x: f64) -> f64 {
         self.raw(x).clamp(-1.0, 1.0)
+    }
+
+    /// The policy prepared for driving: π(x) in O(1) per driver step ([`RkhsPedal`]).
+    pub fn pedal(&self) -> RkhsPedal {
+        RkhsPedal::new(self)
     }
 
     /// The (x, a) table at `points` evenly spaced x in [0, 1].
@@ -127,15 +129,89 @@ impl RkhsPolicy {
     }
 }
 
-impl Pedal for RkhsPolicy {
+/// An [`RkhsPolicy`] prepared for driving: wᵀφ(x) exactly, whatever M, from two
+/// exponentials.
+///
+/// With a = √3/l, h = 1/(M − 1) and x in the segment [x̂ₖ, x̂ₖ₊₁], t = x − x̂ₖ, s = x̂ₖ₊₁ − x,
+/// the kernels left of x sum to e^(−at)·(Pₖ + at·Qₖ) and those right of it to
+/// e^(−as)·(Uₖ₊₁ + as·Vₖ₊₁), where, with ρ = e^(−ah),
+///
+/// - Qₖ = wₖ + ρ·Qₖ₋₁,  Pₖ = wₖ + ρ·(Pₖ₋₁ + ah·Qₖ₋₁)  (from the left, P₀ = Q₀ = w₀),
+/// - Vₖ = wₖ + ρ·Vₖ₊₁,  Uₖ = wₖ + ρ·(Uₖ₊₁ + ah·Vₖ₊₁)  (from the right),
+///
+/// since (1 + a(d + t))·e^(−a(d + t)) = e^(−at)·[(1 + ad)·e^(−ad) + at·e^(−ad)] for a kernel
+/// at distance d from x̂ₖ. Both recursions shrink by ρ < 1, so they are stable; outside [0, 1]
+/// the direct sum is used.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RkhsPedal {
+    /// a = √3/l.
+    a: f64,
+    /// Spacing h of the inducing points.
+    h: f64,
+    /// (Pₖ, Qₖ, Uₖ, Vₖ) per inducing point.
+    sums: Vec<[f64; 4]>,
+    policy: RkhsPolicy,
+}
+
+impl RkhsPedal {
+    fn new(policy: &RkhsPolicy) -> RkhsPedal {
+        let w = &policy.weights;
+        let m = w.len();
+        let h = 1.0 / (m - 1) as f64;
+        let a = SQRT_3 / policy.lengthscale;
+        let (rho, ah) = ((-a * h).exp(), a * h);
+        let mut sums = vec![[0.0; 4]; m];
+        let (mut p, mut q) = (0.0, 0.0);
+        for (k, wk) in w.iter().enumerate() {
+            (p, q) = (wk + rho * (p + ah * q), wk + rho * q);
+            sums[k][0] = p;
+            sums[k][1] = q;
+        }
+        let (mut u, mut v) = (0.0, 0.0);
+        for (k, wk) in w.iter().enumerate().rev() {
+            (u, v) = (wk + rho * (u + ah * v), wk + rho * v);
+            sums[k][2] = u;
+            sums[k][3] = v;
+        }
+        RkhsPedal {
+            a,
+            h,
+            sums,
+            policy: policy.clone(),
+        }
+    }
+
+    /// wᵀφ(x), before clamping.
+    pub fn raw(&self, x: f64) -> f64 {
+        if !(0.0..=1.0).contains(&x) {
+            return self.policy.raw(x);
+        }
+        let k = ((x / self.h) as usize).min(self.sums.len() - 2);
+        let at = self.a * (x - k as f64 * self.h);
+        let as_ = self.a * ((k + 1) as f64 * self.h - x);
+        let [p, q, ..] = self.sums[k];
+        let [.., u, v] = self.sums[k + 1];
+        exp_nonpositive(-at) * (p + at * q) + exp_nonpositive(-as_) * (u + as_ * v)
+    }
+
+    /// π(x) = clamp(wᵀφ(x), −1, 1).
+    pub fn action(&self, x: f64) -> f64 {
+        self.raw(x).clamp(-1.0, 1.0)
+    }
+}
+
+impl Pedal for RkhsPedal {
     fn pedal(&mut self, obs: &Observation) -> f64 {
         self.action(obs.x)
     }
 }
 
+/// √3.
+const SQRT_3: f64 = 1.732_050_807_568_877_2;
+
 /// The Matérn-3/2 shape (1 + √3 u)·e^(−√3 u) of u = |x − x′|/l.
 fn matern32(u: f64) -> f64 {
-    let a = 1.732_050_807_568_877_2 * u;
+    let a = SQRT_3 * u;
     (1.0 + a) * (-a).exp()
 }
 
@@ -164,6 +240,7 @@ fn check_shape(kernels: usize, lengthscale: f64) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rand::{Rng, SeedableRng};
 
     #[test]
     fn features_peak_at_their_inducing_points() {
@@ -202,13 +279,42 @@ mod tests {
                 p.action(x)
             );
         }
-        // The truncated sum equals the full one.
-        let mut full = |x: f64| {
-            features_into(x, l, &mut phi);
-            phi.iter().zip(&p.weights).map(|(f, w)| f * w).sum::<f64>()
-        };
+        // wᵀφ(x) is the sum of the features.
         for x in [0.0, 0.123, 0.5, 0.999, 1.0] {
-            assert!((p.raw(x) - full(x)).abs() < 1e-6);
+            features_into(x, l, &mut phi);
+            let full: f64 = phi.iter().zip(&p.weights).map(|(f, w)| f * w).sum();
+            assert!((p.raw(x) - full).abs() < 1e-14);
+        }
+    }
+
+    /// The pedal's two-exponential form equals the direct sum over all kernels, for short
+    /// and long length-scales, at the inducing points, between them and at the ends.
+    #[test]
+    fn pedal_equals_the_direct_sum() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        for (m, l) in [
+            (2, 0.5),
+            (10, 1.0 / 9.0),
+            (100, 1.0 / 99.0),
+            (50, 0.3),
+            (30, 0.002),
+        ] {
+            let weights = (0..m).map(|_| rng.random_range(-2.0..2.0)).collect();
+            let policy = RkhsPolicy::new(weights, l).unwrap();
+            let pedal = policy.pedal();
+            let h = 1.0 / (m - 1) as f64;
+            let xs = (0..=4000)
+                .map(|i| i as f64 / 4000.0)
+                .chain((0..m).map(|i| i as f64 * h))
+                .chain([-0.05, 1.05]);
+            for x in xs {
+                let (fast, direct) = (pedal.raw(x), policy.raw(x));
+                assert!(
+                    (fast - direct).abs() < 1e-13,
+                    "M {m}, l {l}, x {x}: {fast} vs {direct}"
+                );
+                assert_eq!(pedal.action(x), fast.clamp(-1.0, 1.0));
+            }
         }
     }
 
