@@ -98,6 +98,37 @@ fn same_inputs_give_bit_identical_laps() {
     assert_eq!(a.trace, b.trace);
 }
 
+/// Lap times converge as the physics step shrinks: against a 0.5 ms reference the error falls
+/// by a factor of 1.5 to 6 with each halving of the step, and is small at the default 4 ms
+/// (the driver stays at 50 Hz).
+#[test]
+fn the_lap_time_converges_as_the_step_shrinks() {
+    let car = Car::spirit_300();
+    for (track, speed) in [(builtin("ridgeway"), 22.0), (shared_track("forza"), 20.0)] {
+        let lap_time = |dt: f64| {
+            let mut sim = Simulator::new(track.clone(), &car);
+            sim.config.dt = dt;
+            sim.config.driver_every = (0.02 / dt).round() as usize;
+            let r = sim.lap(&mut SpeedHold::new(speed));
+            r.lap_time_s
+                .unwrap_or_else(|| panic!("{} at {dt} s: {:?}", track.name, r.failure))
+        };
+        assert_eq!(Simulator::new(track.clone(), &car).config.dt, 0.004);
+        let reference = lap_time(0.0005);
+        let error = |dt| (lap_time(dt) - reference).abs() / reference;
+        let (e1, e2, e4) = (error(0.001), error(0.002), error(0.004));
+        assert!(e4 < 1e-3, "{}: {e4}", track.name);
+        for (fine, coarse) in [(e1, e2), (e2, e4)] {
+            let ratio = coarse / fine;
+            assert!(
+                (1.5..6.0).contains(&ratio),
+                "{}: errors {e1:e} {e2:e} {e4:e}",
+                track.name
+            );
+        }
+    }
+}
+
 fn straight(length: f64) -> Track {
     Track::from_pieces("straight", "test", &[Piece::flat(length, 0.0)], vec![])
 }

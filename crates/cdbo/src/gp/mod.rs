@@ -6,6 +6,7 @@
 //! jitter is the smallest of 0, 1e-10, 1e-9, … that keeps L finite, raised only when needed
 //! and reported by [`GaussianProcess::jitter`].
 
+pub mod fit_in_flight;
 pub mod kernel;
 pub mod likelihood;
 

@@ -14,6 +14,12 @@
 //! that the next fit must explain the data with shorter length-scales and the acquisition
 //! finds uncertainty again.
 //!
+//! Hyperparameter fits are due at the first BO step and then every `refit_every` laps. The
+//! first is fitted at once; each later one starts from the data at its lap on a thread of its
+//! own ([`FitInFlight`]) and is installed when the next is due, `refit_every` laps later, so
+//! that the laps between hide its O(n³) cost. The schedule depends on the lap count alone:
+//! the result is the same whether the thread finished early or is waited for.
+//!
 //! A coordinate ascent that ends on an observation (posterior variance at most
 //! [`REPEAT_VARIANCE`]·σ_f² plus twice the jitter) is run again with the observations scoring
 //! −∞: with noise 0 a repeated lap teaches nothing, and every later ascent would end there.
@@ -27,6 +33,7 @@ use super::{Best, Optimizer, SearchBox, check_tell, rng_for};
 use crate::acquisition::Acquisition;
 use crate::acquisition::ucb::DEFAULT_BETA;
 use crate::error::{Error, Result};
+use crate::gp::fit_in_flight::FitInFlight;
 use crate::gp::likelihood::{Bounds, fit};
 use crate::gp::{GaussianProcess, Hyper, Kernel, Mean};
 
@@ -128,9 +135,11 @@ pub struct Bo {
     /// The pending suggestion and the length-scale bound it was made under.
     pending: Option<(Vec<f64>, f64)>,
     last_fit_at: usize,
+    /// The fit started at `last_fit_at`, installed when the next is due.
+    fit_in_flight: Option<FitInFlight>,
     /// Acquisition evaluations of the last suggestion.
     pub last_af_evaluations: usize,
-    /// Seconds spent fitting hyperparameters, in total.
+    /// Seconds this run's thread spent fitting hyperparameters or waiting for a fit, in total.
     pub fit_seconds: f64,
 }
 
@@ -207,6 +216,7 @@ impl Bo {
             best: Best::default(),
             pending: None,
             last_fit_at: 0,
+            fit_in_flight: None,
             last_af_evaluations: 0,
             fit_seconds: 0.0,
         };
@@ -250,7 +260,8 @@ impl Bo {
         }
     }
 
-    /// Re-fits the hyperparameters when due (the first BO step, then every `refit_every`).
+    /// When a fit is due (the first BO step, then every `refit_every`): fits at once the first
+    /// time; later, installs the fit started when the last was due and starts the next.
     fn maybe_refit(&mut self) -> Result<()> {
         let n = self.gp.len();
         let every = self.state.config.refit_every;
@@ -258,7 +269,23 @@ impl Bo {
         if n < 2 || !(first || (every > 0 && n >= self.last_fit_at + every)) {
             return Ok(());
         }
-        self.fit_hyperparameters()
+        if first {
+            return self.fit_hyperparameters();
+        }
+        let start = std::time::Instant::now();
+        if let Some(fit) = self.fit_in_flight.take() {
+            self.gp.set_hyper(fit.finish()?)?;
+            self.state.hyper = self.gp.hyper().clone();
+        }
+        let iterations = self.state.config.fit_iterations;
+        self.fit_in_flight = Some(FitInFlight::start(
+            &self.gp,
+            self.hyper_bounds(),
+            iterations,
+        ));
+        self.last_fit_at = n;
+        self.fit_seconds += start.elapsed().as_secs_f64();
+        Ok(())
     }
 
     /// Fits the GP's hyperparameters by maximum likelihood within the current bounds now.

@@ -1,7 +1,7 @@
 //! One lap: the expensive evaluation of the paper, reward R = L/T, or 0 if the lap fails.
 //!
 //! The car starts standing on the start line, on the centre line, facing along it. Every
-//! physics step (2 ms) the car is projected on the centre line; every driver step (20 ms) the
+//! physics step (4 ms) the car is projected on the centre line; every driver step (20 ms) the
 //! pedal and the steering controller update their commands, which are held in between. The lap
 //! ends when the car has covered the track's length, or fails when:
 //! - **off track**: the car's centre is more than width/2 + 1 m from the centre line;
@@ -115,9 +115,12 @@ pub struct LapResult {
 /// Settings of a lap.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LapConfig {
-    /// Physics step (s): TORCS's 2 ms.
+    /// Physics step (s): 4 ms. The integration is first-order: lap times at 4 ms differ
+    /// from those at 0.5 ms by 0.07–0.2 % on average, twice TORCS's 2 ms (0.03–0.1 %), at
+    /// 1.8 times its speed; whether a lap completes agreed in 178 of 180 perturbed policies
+    /// at both steps (the test `the_lap_time_converges_as_the_step_shrinks`).
     pub dt: f64,
-    /// Physics steps per driver step: 10, i.e. the driver at 50 Hz.
+    /// Physics steps per driver step: 5, i.e. the driver at 50 Hz.
     pub driver_every: usize,
     /// Extra distance beyond half the width before the car is off track (m).
     pub off_track_margin: f64,
@@ -132,8 +135,8 @@ pub struct LapConfig {
 impl Default for LapConfig {
     fn default() -> Self {
         LapConfig {
-            dt: 0.002,
-            driver_every: 10,
+            dt: 0.004,
+            driver_every: 5,
             off_track_margin: 1.0,
             time_limit: None,
             trace: false,

@@ -1,5 +1,6 @@
 //! The race simulator: the vehicle model ([`vehicle`]) driven round a track for one lap
-//! ([`lap`]), at TORCS's fixed 500 Hz physics step with the driver at 50 Hz.
+//! ([`lap`]), at a fixed 250 Hz physics step (TORCS: 500 Hz; see [`LapConfig::dt`]) with the driver at
+//! 50 Hz.
 
 pub mod lap;
 pub mod powertrain;
