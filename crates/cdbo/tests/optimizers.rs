@@ -64,6 +64,34 @@ fn every_method_is_deterministic_and_resumes_exactly() {
     }
 }
 
+/// Past `BACKGROUND_FITS_FROM` observations CDBO's fits run on their own thread: a run saved
+/// while one is in flight resumes (its replay redoes the fits) and continues bit for bit, and
+/// a clone taken mid-flight (which redoes the fit on its own thread) agrees too.
+#[test]
+fn cdbo_with_fits_in_flight_is_deterministic_and_resumes_exactly() {
+    use cdbo::optimizers::bo::{BACKGROUND_FITS_FROM, Bo, BoConfig};
+    let problem = Problem::by_name("ackley", 3).unwrap();
+    let config = BoConfig {
+        seed: 5,
+        box_radius: problem.radius,
+        ..BoConfig::default()
+    };
+    let mut a = Bo::new(problem.start.clone(), config.clone()).unwrap();
+    let mut b = Bo::new(problem.start.clone(), config).unwrap();
+    let n = BACKGROUND_FITS_FROM + 7;
+    assert_eq!(drive(&mut a, &problem, n), drive(&mut b, &problem, n));
+    let mut clone = a.clone();
+    let saved: Saved = serde_json::from_str(&serde_json::to_string(&a.save()).unwrap()).unwrap();
+    let mut resumed = saved.resume().unwrap();
+    let rest = drive(&mut a, &problem, 12);
+    assert_eq!(
+        rest,
+        drive(resumed.as_mut(), &problem, 12),
+        "resumed run diverged"
+    );
+    assert_eq!(rest, drive(&mut clone, &problem, 12), "clone diverged");
+}
+
 #[test]
 fn every_method_refuses_bad_tells_and_keeps_its_state() {
     let problem = Problem::by_name("ackley", 4).unwrap();

@@ -58,17 +58,11 @@ impl Steering {
         dt: f64,
     ) -> f64 {
         let d = (self.lookahead_time * state.speed()).max(self.lookahead_min);
-        let target_s = proj.s + d;
-        let c = track.sample(track.index_at(target_s));
-        let along = (target_s - c.s).rem_euclid(track.length);
-        let along = if along > track.length / 2.0 {
-            along - track.length
-        } else {
-            along
-        };
-        let (tx, ty, _) = crate::track::advance(c.x, c.y, c.heading, c.curvature, along);
-        let bearing = (ty - state.y).atan2(tx - state.x);
-        let e = wrap_angle(bearing - state.yaw);
+        let (tx, ty) = track.point_at(proj.s + d);
+        // The angle from the car's heading (cos ψ, sin ψ) to the target, in (−π, π].
+        let (dx, dy) = (tx - state.x, ty - state.y);
+        let (sy, cy) = state.yaw_sin_cos;
+        let e = (cy * dy - sy * dx).atan2(cy * dx + sy * dy);
         let kp = 2.0 * wheelbase / d;
         let raw = kp * e + self.ki * (self.integral + e * dt);
         if raw.abs() < steer_lock {

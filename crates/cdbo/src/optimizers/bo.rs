@@ -37,6 +37,10 @@ use crate::gp::fit_in_flight::FitInFlight;
 use crate::gp::likelihood::{Bounds, fit};
 use crate::gp::{GaussianProcess, Hyper, Kernel, Mean};
 
+/// Hyperparameter fits are fitted at once below this many observations, where they are
+/// cheap, and on their own thread from it on.
+pub const BACKGROUND_FITS_FROM: usize = 100;
+
 /// σ(w_next) below this fraction of σ_f shrinks the length-scale upper bound.
 pub const LOW_UNCERTAINTY: f64 = 0.05;
 
@@ -223,7 +227,7 @@ impl Bo {
         for ((w, r), bound) in saved.observations.iter().zip(&saved.bounds_used) {
             run.state.lengthscale_max = *bound;
             if run.gp.len() > run.state.config.initial_samples {
-                run.maybe_refit()?;
+                run.prepare_gp()?;
             }
             run.pending = Some((w.clone(), *bound));
             run.tell(w, *r)?;
@@ -260,30 +264,38 @@ impl Bo {
         }
     }
 
-    /// When a fit is due (the first BO step, then every `refit_every`): fits at once the first
-    /// time; later, installs the fit started when the last was due and starts the next.
-    fn maybe_refit(&mut self) -> Result<()> {
+    /// Readies the GP for a suggestion. When a fit is due (the first BO step, then every
+    /// `refit_every`): fits at once the first time; later, installs the fit started when the
+    /// last was due and starts the next. Length-scales above the current upper bound (halved
+    /// since, or fitted under an older bound) are brought down to it at once.
+    fn prepare_gp(&mut self) -> Result<()> {
         let n = self.gp.len();
         let every = self.state.config.refit_every;
         let first = n == self.state.config.initial_samples + 1;
-        if n < 2 || !(first || (every > 0 && n >= self.last_fit_at + every)) {
-            return Ok(());
-        }
-        if first {
+        let due = n >= 2 && (first || (every > 0 && n >= self.last_fit_at + every));
+        if due && (first || n < BACKGROUND_FITS_FROM) {
             return self.fit_hyperparameters();
         }
         let start = std::time::Instant::now();
-        if let Some(fit) = self.fit_in_flight.take() {
+        if let Some(fit) = self.fit_in_flight.take_if(|_| due) {
             self.gp.set_hyper(fit.finish()?)?;
-            self.state.hyper = self.gp.hyper().clone();
         }
-        let iterations = self.state.config.fit_iterations;
-        self.fit_in_flight = Some(FitInFlight::start(
-            &self.gp,
-            self.hyper_bounds(),
-            iterations,
-        ));
-        self.last_fit_at = n;
+        let max = self.state.lengthscale_max;
+        if self.gp.hyper().lengthscales.iter().any(|l| *l > max) {
+            let mut hyper = self.gp.hyper().clone();
+            hyper.lengthscales.iter_mut().for_each(|l| *l = l.min(max));
+            self.gp.set_hyper(hyper)?;
+        }
+        self.state.hyper = self.gp.hyper().clone();
+        if due {
+            let iterations = self.state.config.fit_iterations;
+            self.fit_in_flight = Some(FitInFlight::start(
+                &self.gp,
+                self.hyper_bounds(),
+                iterations,
+            ));
+            self.last_fit_at = n;
+        }
         self.fit_seconds += start.elapsed().as_secs_f64();
         Ok(())
     }
@@ -357,7 +369,7 @@ impl Bo {
             self.bounds.clamp(&mut w);
             return Ok(w);
         }
-        self.maybe_refit()?;
+        self.prepare_gp()?;
         let start = self.best.get().map_or(&self.state.w0[..], |b| b.0).to_vec();
         let acquisition = self.state.config.acquisition;
         let ascent = match &self.state.config.maximiser {

@@ -205,6 +205,27 @@ impl Track {
         ((s / self.ds) as usize).min(self.samples.len() - 1)
     }
 
+    /// The centre-line point at station `s` (wrapping around the lap): the arc of curvature
+    /// κ from the sample before it, reached along its chord, of length a·sin(κa/2)/(κa/2)
+    /// at the angle κa/2 from the sample's heading (a the distance from the sample).
+    #[inline]
+    pub fn point_at(&self, s: f64) -> (f64, f64) {
+        let s = self.wrap(s);
+        let f = &self.frames[self.index_at(s)];
+        let a = s - f.s;
+        let half_turn = 0.5 * f.curvature * a;
+        let (sin, cos) = half_turn.sin_cos();
+        let chord = if half_turn == 0.0 {
+            a
+        } else {
+            a * sin / half_turn
+        };
+        (
+            f.x + chord * (f.cos_heading * cos - f.sin_heading * sin),
+            f.y + chord * (f.sin_heading * cos + f.cos_heading * sin),
+        )
+    }
+
     /// Projects (x, y) on the centre line, searching from `hint` (the last known index).
     ///
     /// Walks sample to sample while the point's tangential offset d = (p − cᵢ)·tᵢ lies outside
@@ -417,6 +438,24 @@ mod tests {
             assert!((c.x.hypot(c.y - 100.0) - 100.0).abs() < 1e-9);
         }
         assert!((t.min_radius() - 100.0).abs() < 1e-9);
+    }
+
+    /// On a circle of radius R from (0, 0) heading +x, the station s lies at angle s/R:
+    /// (R·sin(s/R), R − R·cos(s/R)), between samples and across the start line.
+    #[test]
+    fn points_between_samples_lie_on_the_arc() {
+        let t = circle(100.0);
+        for s in [0.0, 0.37, 123.456, t.length - 0.01, t.length + 5.0, -2.5] {
+            let (x, y) = t.point_at(s);
+            let a = s / 100.0;
+            let (ex, ey) = (100.0 * a.sin(), 100.0 - 100.0 * a.cos());
+            assert!(
+                (x - ex).abs() < 1e-9 && (y - ey).abs() < 1e-9,
+                "s {s}: ({x}, {y})"
+            );
+        }
+        let straight = Track::from_pieces("line", "test", &[Piece::flat(50.0, 0.0)], vec![]);
+        assert_eq!(straight.point_at(12.25), (12.25, 0.0));
     }
 
     #[test]
