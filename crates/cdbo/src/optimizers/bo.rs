@@ -2,7 +2,8 @@
 //! Optimisation when the acquisition is maximised by coordinate ascent, standard BO-CMA-ES
 //! when it is maximised by CMA-ES.
 //!
-//! 1. Drive w₀, then S laps with w ~ N(w₀, σ₀²I) clamped to the search box.
+//! 1. Drive w₀, then S laps with w ~ N(w₀, σ₀²I) clamped to the search box; while every lap
+//!    has scored the same (every one failed, say), go on drawing them.
 //! 2. Then, each lap: fit the GP's hyperparameters by maximum likelihood when due, choose
 //!    w = argmax h from the best weights so far, by stochastic coordinate ascent
 //!    ([`super::coordinate_ascent`], paper Alg. 1) or by CMA-ES ([`super::cmaes_ascent`]),
@@ -357,9 +358,13 @@ impl Bo {
         if n == 0 {
             return Ok(self.state.w0.clone());
         }
-        if n <= self.state.config.initial_samples {
-            let normal = Normal::new(0.0, self.state.config.initial_sigma)
-                .map_err(|e| Error::Domain(e.to_string()))?;
+        let initial = self.state.config.initial_samples;
+        let flat = self.gp.values().iter().all(|y| *y == self.gp.values()[0]);
+        if n <= initial || flat {
+            // While every lap has scored the same (all failed, say), the GP carries no
+            // direction: the initial design goes on.
+            let sigma = self.state.config.initial_sigma;
+            let normal = Normal::new(0.0, sigma).map_err(|e| Error::Domain(e.to_string()))?;
             let mut w: Vec<f64> = self
                 .state
                 .w0
