@@ -92,6 +92,40 @@ fn cdbo_with_fits_in_flight_is_deterministic_and_resumes_exactly() {
     assert_eq!(rest, drive(&mut clone, &problem, 12), "clone diverged");
 }
 
+/// While every lap has scored the same, CDBO keeps drawing from N(w₀, σ₀²I) (a flat GP would
+/// send it to the box's corners); the first different score ends the initial design.
+#[test]
+fn cdbo_keeps_its_initial_design_while_every_lap_fails() {
+    use cdbo::optimizers::bo::{Bo, BoConfig};
+    let config = BoConfig::default();
+    let (sigma, radius) = (config.initial_sigma, config.box_radius);
+    let w0 = vec![0.2; 12];
+    let mut bo = Bo::new(w0.clone(), config).unwrap();
+    let distance = |w: &[f64]| {
+        w.iter()
+            .zip(&w0)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max)
+    };
+    for _ in 0..40 {
+        let w = bo.ask().unwrap();
+        assert!(
+            distance(&w) < 6.0 * sigma,
+            "lap {}: {w:?}",
+            bo.evaluations() + 1
+        );
+        bo.tell(&w, 0.0).unwrap();
+    }
+    let w = bo.ask().unwrap();
+    bo.tell(&w, 1.0).unwrap();
+    let far = (0..10).any(|_| {
+        let w = bo.ask().unwrap();
+        bo.tell(&w, 0.0).unwrap();
+        distance(&w) > 0.5 * radius
+    });
+    assert!(far, "the search never left the initial design");
+}
+
 #[test]
 fn every_method_refuses_bad_tells_and_keeps_its_state() {
     let problem = Problem::by_name("ackley", 4).unwrap();
