@@ -6,6 +6,7 @@
 //! so the result is the same bit for bit whether the thread has finished, is still running,
 //! or (in a clone) is redone on the caller's thread.
 
+use std::sync::Arc;
 use std::thread::JoinHandle;
 
 use super::likelihood::{Bounds, fit};
@@ -15,8 +16,9 @@ use crate::error::{Error, Result};
 /// A fit started on its own thread.
 #[derive(Debug)]
 pub struct FitInFlight {
-    /// The GP the fit started from, kept to redo the fit where the thread is not ours.
-    start: GaussianProcess,
+    /// The GP the fit started from, shared with the thread and kept to redo the fit where
+    /// the thread is not ours.
+    start: Arc<GaussianProcess>,
     bounds: Bounds,
     iterations: usize,
     thread: Option<JoinHandle<Result<Hyper>>>,
@@ -25,14 +27,14 @@ pub struct FitInFlight {
 impl FitInFlight {
     /// Starts fitting a copy of `gp` within `bounds` for `iterations` steps.
     pub fn start(gp: &GaussianProcess, bounds: Bounds, iterations: usize) -> FitInFlight {
-        let mut copy = gp.clone();
-        let b = bounds.clone();
+        let start = Arc::new(gp.clone());
+        let (shared, b) = (Arc::clone(&start), bounds.clone());
         let thread = std::thread::Builder::new()
             .name("cdbo-fit".into())
-            .spawn(move || fit_copy(&mut copy, &b, iterations))
+            .spawn(move || fit_copy(&shared, &b, iterations))
             .ok();
         FitInFlight {
-            start: gp.clone(),
+            start,
             bounds,
             iterations,
             thread,
@@ -46,7 +48,7 @@ impl FitInFlight {
             Some(thread) => thread
                 .join()
                 .map_err(|_| Error::Domain("the hyperparameter fit's thread panicked".into()))?,
-            None => fit_copy(&mut self.start.clone(), &self.bounds, self.iterations),
+            None => fit_copy(&self.start, &self.bounds, self.iterations),
         }
     }
 }
@@ -55,7 +57,7 @@ impl FitInFlight {
 impl Clone for FitInFlight {
     fn clone(&self) -> FitInFlight {
         FitInFlight {
-            start: self.start.clone(),
+            start: Arc::clone(&self.start),
             bounds: self.bounds.clone(),
             iterations: self.iterations,
             thread: None,
@@ -63,8 +65,10 @@ impl Clone for FitInFlight {
     }
 }
 
-fn fit_copy(gp: &mut GaussianProcess, bounds: &Bounds, iterations: usize) -> Result<Hyper> {
-    fit(gp, bounds, iterations)?;
+/// Fits a copy of `start`, which stays as it is.
+fn fit_copy(start: &GaussianProcess, bounds: &Bounds, iterations: usize) -> Result<Hyper> {
+    let mut gp = start.clone();
+    fit(&mut gp, bounds, iterations)?;
     Ok(gp.hyper().clone())
 }
 

@@ -140,8 +140,9 @@ impl RkhsPolicy {
 /// - Vₖ = wₖ + ρ·Vₖ₊₁,  Uₖ = wₖ + ρ·(Uₖ₊₁ + ah·Vₖ₊₁)  (from the right),
 ///
 /// since (1 + a(d + t))·e^(−a(d + t)) = e^(−at)·[(1 + ad)·e^(−ad) + at·e^(−ad)] for a kernel
-/// at distance d from x̂ₖ. Both recursions shrink by ρ < 1, so they are stable; outside [0, 1]
-/// the direct sum is used.
+/// at distance d from x̂ₖ. Both recursions shrink by ρ < 1, so they are stable. Outside
+/// [0, 1] every kernel lies on one side: e^(−as)·(U₀ + as·V₀) with s = −x below 0, and
+/// e^(−at)·(P_{M−1} + at·Q_{M−1}) with t = x − 1 above 1.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RkhsPedal {
     /// a = √3/l.
@@ -150,7 +151,6 @@ pub struct RkhsPedal {
     h: f64,
     /// (Pₖ, Qₖ, Uₖ, Vₖ) per inducing point.
     sums: Vec<[f64; 4]>,
-    policy: RkhsPolicy,
 }
 
 impl RkhsPedal {
@@ -173,25 +173,24 @@ impl RkhsPedal {
             sums[k][2] = u;
             sums[k][3] = v;
         }
-        RkhsPedal {
-            a,
-            h,
-            sums,
-            policy: policy.clone(),
-        }
+        RkhsPedal { a, h, sums }
     }
 
     /// wᵀφ(x), before clamping.
     pub fn raw(&self, x: f64) -> f64 {
-        if !(0.0..=1.0).contains(&x) {
-            return self.policy.raw(x);
+        let left = |t: f64, [p, q, ..]: [f64; 4]| exp_nonpositive(-t) * (p + t * q);
+        let right = |s: f64, [.., u, v]: [f64; 4]| exp_nonpositive(-s) * (u + s * v);
+        let last = self.sums.len() - 1;
+        if x < 0.0 {
+            return right(-self.a * x, self.sums[0]);
         }
-        let k = ((x / self.h) as usize).min(self.sums.len() - 2);
-        let at = self.a * (x - k as f64 * self.h);
-        let as_ = self.a * ((k + 1) as f64 * self.h - x);
-        let [p, q, ..] = self.sums[k];
-        let [.., u, v] = self.sums[k + 1];
-        exp_nonpositive(-at) * (p + at * q) + exp_nonpositive(-as_) * (u + as_ * v)
+        if x > 1.0 {
+            return left(self.a * (x - 1.0), self.sums[last]);
+        }
+        let k = ((x / self.h) as usize).min(last - 1);
+        let t = self.a * (x - k as f64 * self.h);
+        let s = self.a * ((k + 1) as f64 * self.h - x);
+        left(t, self.sums[k]) + right(s, self.sums[k + 1])
     }
 
     /// π(x) = clamp(wᵀφ(x), −1, 1).
@@ -306,7 +305,7 @@ mod tests {
             let xs = (0..=4000)
                 .map(|i| i as f64 / 4000.0)
                 .chain((0..m).map(|i| i as f64 * h))
-                .chain([-0.05, 1.05]);
+                .chain([-0.05, -0.001, 1.001, 1.05]);
             for x in xs {
                 let (fast, direct) = (pedal.raw(x), policy.raw(x));
                 assert!(
