@@ -15,6 +15,9 @@ struct Cli {
     /// TORCS / Speed Dreams install folders).
     #[arg(long = "data-dir", global = true, value_name = "DIR")]
     data_dirs: Vec<PathBuf>,
+    /// Where laps are driven: cdbo's simulator, or the game TORCS (`cdbo torcs setup` first).
+    #[arg(long, global = true, value_enum, default_value_t = commands::Simulator::Cdbo)]
+    simulator: commands::Simulator,
     #[command(subcommand)]
     command: Command,
 }
@@ -49,6 +52,9 @@ enum Command {
     /// Fit and print RKHS policies.
     #[command(subcommand)]
     Policy(commands::policy::PolicyCommand),
+    /// The game TORCS: set it up, check it with a lap.
+    #[command(subcommand)]
+    Torcs(commands::torcs::TorcsCommand),
     /// Measure speed.
     #[command(subcommand)]
     Bench(commands::bench::BenchCommand),
@@ -70,12 +76,13 @@ fn main() -> ExitCode {
         Command::Study(cmd) => commands::study::run(&cmd),
         Command::Optimize(args) => commands::optimize::run(&args),
         Command::ServeSim(args) => commands::serve_sim::run(&args, &data),
-        Command::Lap(args) => commands::lap::run(&args, &data),
+        Command::Lap(args) => commands::lap::run(&args, &data, cli.simulator),
         Command::Limit(args) => commands::limit::run(&args, &data),
         Command::Track(cmd) => commands::track::run(&cmd, &data),
         Command::Plot(cmd) => commands::plot::run(&cmd, &data),
         Command::Policy(cmd) => commands::policy::run(&cmd),
         Command::Bench(cmd) => commands::bench::run(&cmd, &data),
+        Command::Torcs(cmd) => commands::torcs::run(&cmd),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -13,6 +13,7 @@
 //!   optimisers, CDBO first.
 //! - [`experiment`]: learning to race a track end to end, and the paper's experiment grid.
 //! - [`study`]: persistent ask/tell studies for a real car; [`evaluator`]: sources of laps.
+//! - [`torcs`]: the racing game TORCS as a source of laps (its robot, setup and lap runner).
 //! - [`benchmarks`]: standard test functions; [`simd`]: AVX2 for the hottest loops.
 
 pub mod acquisition;
@@ -32,6 +33,7 @@ pub mod policy;
 pub mod sim;
 pub mod simd;
 pub mod study;
+pub mod torcs;
 pub mod track;
 
 pub use error::{Error, Result};

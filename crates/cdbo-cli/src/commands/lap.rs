@@ -5,13 +5,14 @@ use std::path::PathBuf;
 use clap::Args;
 use serde::Serialize;
 
-use super::{CliResult, Setup, print_json};
+use super::{CliResult, Setup, Simulator, print_json};
 use cdbo::data_path::DataPath;
 use cdbo::drive::demo::{DEFAULT_TARGET_SPEED, SpeedHold};
 use cdbo::drive::{ConstantPedal, Pedal};
 use cdbo::limit::limit_lap;
 use cdbo::policy::PolicyTable;
-use cdbo::sim::{Failure, Simulator};
+use cdbo::sim::{Failure, LapResult};
+use cdbo::torcs::{Game, GamePedal};
 
 #[derive(Debug, Args)]
 #[command(group(clap::ArgGroup::new("driver").args(["demo", "throttle", "policy"])))]
@@ -50,9 +51,14 @@ struct LapReport {
     limit_lap_time_s: f64,
     limit_reward_mps: f64,
     fraction_of_limit: f64,
+    /// Where the lap was driven: `cdbo` or `torcs`.
+    simulator: &'static str,
 }
 
-pub fn run(args: &LapArgs, data: &DataPath) -> CliResult {
+pub fn run(args: &LapArgs, data: &DataPath, simulator: Simulator) -> CliResult {
+    if simulator == Simulator::Torcs {
+        return run_torcs(args, data);
+    }
     let (track, car) = args.setup.load(data)?;
     let mut pedal: Box<dyn Pedal> = match (args.demo, args.throttle, &args.policy) {
         (_, Some(a), _) => {
@@ -76,7 +82,7 @@ pub fn run(args: &LapArgs, data: &DataPath) -> CliResult {
         }
     };
     let limit = limit_lap(&track, &car);
-    let mut sim = Simulator::new(track, &car);
+    let mut sim = cdbo::sim::Simulator::new(track, &car);
     sim.config.trace = args.trace.is_some() || args.plot.is_some();
     let lap = sim.lap(pedal.as_mut());
     if let Some(path) = &args.trace {
@@ -85,18 +91,101 @@ pub fn run(args: &LapArgs, data: &DataPath) -> CliResult {
     if let Some(path) = &args.plot {
         super::plot::lap_speed(path, &sim.track, &lap, &limit)?;
     }
-    let report = LapReport {
-        track: sim.track.name.clone(),
-        car: car.name.clone(),
-        completed: lap.completed,
-        lap_time_s: lap.lap_time_s,
-        reward_mps: lap.reward_mps,
-        failure: lap.failure,
-        limit_lap_time_s: limit.lap_time_s,
-        limit_reward_mps: limit.reward_mps,
-        fraction_of_limit: lap.reward_mps / limit.reward_mps,
+    print_report(
+        LapReport {
+            track: sim.track.name.clone(),
+            car: car.name.clone(),
+            completed: lap.completed,
+            lap_time_s: lap.lap_time_s,
+            reward_mps: lap.reward_mps,
+            failure: lap.failure,
+            limit_lap_time_s: limit.lap_time_s,
+            limit_reward_mps: limit.reward_mps,
+            fraction_of_limit: lap.reward_mps / limit.reward_mps,
+            simulator: "cdbo",
+        },
+        args.json,
+    )
+}
+
+/// A lap in the game TORCS, driven by cdbo's robot; the limit is cdbo's, on the game's track
+/// and car files.
+fn run_torcs(args: &LapArgs, data: &DataPath) -> CliResult {
+    if args.plot.is_some() {
+        return Err(
+            "--plot needs cdbo's simulator; with --simulator torcs write --trace and plot it"
+                .into(),
+        );
+    }
+    let pedal = match (args.demo, args.throttle, &args.policy) {
+        (_, Some(a), _) => {
+            if !(-1.0..=1.0).contains(&a) {
+                return Err(format!("--throttle {a}: must be in [-1, 1]").into());
+            }
+            GamePedal::Constant(a)
+        }
+        (_, _, Some(path)) if path.extension().is_some_and(|e| e == "json") => {
+            GamePedal::Rkhs(super::policy::read_policy(path)?)
+        }
+        (_, _, Some(path)) => GamePedal::Table(PolicyTable::read_csv(path)?.points().to_vec()),
+        (speed, _, _) => {
+            let speed = speed.unwrap_or(DEFAULT_TARGET_SPEED);
+            if !(speed > 0.0 && speed.is_finite()) {
+                return Err(
+                    format!("--demo {speed}: the target speed must be positive (m/s)").into(),
+                );
+            }
+            GamePedal::Demo(speed)
+        }
     };
-    if args.json {
+    let game = Game::ready()?;
+    let car_name = Simulator::Torcs.car(&args.setup.car);
+    let mut req = game.request(&args.setup.track, car_name, pedal)?;
+    if let Some(path) = &args.trace {
+        req.trace =
+            Some(std::path::absolute(path).map_err(|e| format!("{}: {e}", path.display()))?);
+    }
+    let lap = game
+        .lap(&req)?
+        .map_err(|reason| format!("TORCS drove no lap: {reason}"))?;
+    let game_data = DataPath::new(std::slice::from_ref(&game.install.data_dir));
+    let track = super::load_track(&args.setup.track, &game_data)
+        .or_else(|_| super::load_track(&args.setup.track, data))?;
+    let limit = limit_lap(&track, &req.car);
+    print_report(
+        LapReport {
+            track: track.name.clone(),
+            car: car_name.to_owned(),
+            completed: lap.completed,
+            lap_time_s: lap.lap_time_s,
+            reward_mps: lap.reward_mps,
+            failure: lap.failure,
+            limit_lap_time_s: limit.lap_time_s,
+            limit_reward_mps: limit.reward_mps,
+            fraction_of_limit: lap.reward_mps / limit.reward_mps,
+            simulator: "torcs",
+        },
+        args.json,
+    )
+}
+
+/// One line: the lap time and reward, or where and why the lap failed.
+pub fn describe(lap: &LapResult) -> String {
+    match (lap.lap_time_s, lap.failure) {
+        (Some(t), _) => format!("lap {t:.2} s, reward {:.2} m/s", lap.reward_mps),
+        (None, Some(f)) => format!(
+            "failed ({}) at x = {:.4} ({:.1} m, {:.2} s); reward 0",
+            f.reason.name(),
+            f.x,
+            f.distance_m,
+            f.time_s
+        ),
+        (None, None) => "no lap".into(),
+    }
+}
+
+fn print_report(report: LapReport, json: bool) -> CliResult {
+    if json {
         return print_json(&report);
     }
     match (report.lap_time_s, report.failure) {

@@ -11,6 +11,7 @@ pub mod race;
 pub mod report;
 pub mod serve_sim;
 pub mod study;
+pub mod torcs;
 pub mod track;
 
 use clap::Args;
@@ -21,6 +22,27 @@ use cdbo::track::{Track, builtin, catalog as tracks};
 
 /// The boxed error every command returns; printed as one line by `main`.
 pub type CliResult = Result<(), Box<dyn std::error::Error>>;
+
+/// Where laps are driven (`--simulator`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum Simulator {
+    /// cdbo's own simulator.
+    #[default]
+    Cdbo,
+    /// The game TORCS, driven by cdbo's robot (`cdbo torcs setup` first); tracks and cars by
+    /// their TORCS names, car1-trb1 by default.
+    Torcs,
+}
+
+impl Simulator {
+    /// The car to use: on TORCS the built-in default car becomes car1-trb1.
+    pub fn car(self, spec: &str) -> &str {
+        match self {
+            Simulator::Torcs if spec == cars::DEFAULT => cdbo::torcs::DEFAULT_CAR,
+            _ => spec,
+        }
+    }
+}
 
 /// `--track` and `--car`.
 #[derive(Debug, Args, Clone)]

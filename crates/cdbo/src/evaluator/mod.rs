@@ -4,6 +4,7 @@
 
 pub mod command;
 pub mod simulator;
+pub mod torcs;
 
 use serde::{Deserialize, Serialize};
 

@@ -70,6 +70,11 @@ impl PolicyTable {
         PolicyTable::new(points).map_err(|e| Error::invalid(file, "rows", e.to_string()))
     }
 
+    /// The points (xᵢ, aᵢ).
+    pub fn points(&self) -> &[(f64, f64)] {
+        &self.points
+    }
+
     /// π(x).
     pub fn action(&self, x: f64) -> f64 {
         crate::interp::linear(&self.points, x)

@@ -51,7 +51,7 @@ impl FailureReason {
 }
 
 /// Where and when a lap failed.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, serde::Deserialize)]
 pub struct Failure {
     /// Why.
     pub reason: FailureReason,

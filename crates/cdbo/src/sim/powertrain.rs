@@ -10,7 +10,7 @@
 use crate::car::Car;
 
 /// Hysteresis between the up-shift speed of gear i−1 and the down-shift into it.
-const DOWNSHIFT_MARGIN: f64 = 0.85;
+pub const DOWNSHIFT_MARGIN: f64 = 0.85;
 
 /// Gearbox state.
 #[derive(Debug, Clone, Copy, PartialEq)]

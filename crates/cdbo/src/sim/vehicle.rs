@@ -184,6 +184,21 @@ impl Vehicle {
         &self.tyres
     }
 
+    /// The weights of the front and rear axles' spin in the drive speed the gearbox reads.
+    pub fn driven(&self) -> [f64; 2] {
+        self.driven
+    }
+
+    /// The slip at which ABS and traction control start easing, per axle.
+    pub fn aid_threshold(&self) -> [f64; 2] {
+        self.aid_threshold
+    }
+
+    /// The gearbox's shift points.
+    pub fn shift_map(&self) -> &ShiftMap {
+        &self.shift_map
+    }
+
     /// Standing still at (x, y) facing `yaw`, in first gear.
     pub fn at_rest(&self, x: f64, y: f64, yaw: f64) -> State {
         State {

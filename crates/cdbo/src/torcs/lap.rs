@@ -1,0 +1,393 @@
+//! One lap in the game: a fresh `torcs-bin -r RACE.xml` in its own process group, in a lap
+//! folder of its own under the tree's `laps/` (so parallel laps never share a file), killed
+//! with its group when it outlives its time-out, and the folder removed afterwards.
+//!
+//! The lap folder is the game's local directory (`-l`): it holds the race (one car, our robot,
+//! standing on the start line), the robot's `drivers/cdbo/cdbo.xml` naming the car and the
+//! settings file, the settings themselves (pedal, steering gains, shift points, driver aids,
+//! failure margins; see `torcs-robot/cdbo.cpp`) and the JSON line the robot writes.
+
+use std::fmt::Write as _;
+use std::io::Read;
+use std::os::unix::process::CommandExt;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::{Duration, Instant};
+
+use serde::Deserialize;
+
+use super::{Game, ROBOT};
+use crate::car::Car;
+use crate::error::{Error, Result};
+use crate::policy::RkhsPolicy;
+use crate::sim::lap::{Failure, LapConfig, LapResult};
+use crate::sim::powertrain::DOWNSHIFT_MARGIN;
+use crate::sim::vehicle::Vehicle;
+
+/// What the robot's pedal follows.
+#[derive(Debug, Clone, PartialEq)]
+pub enum GamePedal {
+    /// The demonstrator holding this speed (m/s).
+    Demo(f64),
+    /// The same command everywhere.
+    Constant(f64),
+    /// The paper's RKHS policy π(x).
+    Rkhs(RkhsPolicy),
+    /// An (x, a) table, linear in between.
+    Table(Vec<(f64, f64)>),
+}
+
+/// One lap to drive.
+#[derive(Debug, Clone)]
+pub struct LapRequest {
+    /// TORCS track name (`forza`).
+    pub track: String,
+    /// TORCS car name (`car1-trb1`); its parameters must be `car`'s.
+    pub car_name: String,
+    /// The car as cdbo reads it: wheelbase, gears and shift points, tyres (driver aids).
+    pub car: Car,
+    /// The pedal.
+    pub pedal: GamePedal,
+    /// Lap settings: the steering gains, the off-track margin and the time limit.
+    pub config: LapConfig,
+    /// Write the robot's 50 Hz trace here (CSV, the columns of `cdbo lap --trace`).
+    pub trace: Option<PathBuf>,
+    /// Wall-clock time after which the game is killed and the lap fails.
+    pub timeout: Duration,
+}
+
+/// The default wall-clock time-out of one lap: the game runs some 300-500x real time, so a
+/// lap within its time limit (about 25 game minutes on Forza) takes a few seconds.
+pub const DEFAULT_TIMEOUT: Duration = Duration::from_secs(120);
+
+/// Lap folders made by this process.
+static LAPS: AtomicU64 = AtomicU64::new(0);
+
+/// The line the robot writes.
+#[derive(Debug, Deserialize)]
+struct RobotLine {
+    completed: bool,
+    #[serde(default)]
+    lap_time_s: Option<f64>,
+    #[serde(default)]
+    reward_mps: f64,
+    #[serde(default)]
+    failure: Option<Failure>,
+    #[serde(default)]
+    simulated_s: f64,
+    #[serde(default)]
+    error: Option<String>,
+}
+
+/// A lap folder, removed when dropped.
+struct LapDir(PathBuf);
+
+impl Drop for LapDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// The robot's `drivers/cdbo/cdbo.xml`: one driver of `car`, whose settings are `settings`.
+pub fn robot_xml(car: &str, settings: &str) -> String {
+    format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?>
+<!DOCTYPE params SYSTEM "params.dtd">
+<params name="{ROBOT}" type="robotdef">
+  <section name="Robots">
+    <section name="index">
+      <section name="0">
+        <attstr name="name" val="{ROBOT}"/>
+        <attstr name="desc" val="cdbo's policy, steering and gearbox"/>
+        <attstr name="team" val="cdbo"/>
+        <attstr name="author" val="cdbo"/>
+        <attstr name="car name" val="{car}"/>
+        <attnum name="race number" val="1"/>
+      </section>
+    </section>
+  </section>
+  <section name="{ROBOT}">
+    <attstr name="settings" val="{settings}"/>
+  </section>
+</params>
+"#
+    )
+}
+
+/// A one-car quick race on `track` (in `category`): our robot on the start line.
+fn race_xml(track: &str, category: &str) -> String {
+    format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?>
+<!DOCTYPE params SYSTEM "params.dtd">
+<params name="Quick Race" type="param" mode="mw">
+  <section name="Header">
+    <attstr name="name" val="Quick Race"/>
+    <attnum name="priority" val="10"/>
+  </section>
+  <section name="Tracks">
+    <attnum name="maximum number" val="1"/>
+    <section name="1">
+      <attstr name="name" val="{track}"/>
+      <attstr name="category" val="{category}"/>
+    </section>
+  </section>
+  <section name="Races">
+    <section name="1"><attstr name="name" val="Quick Race"/></section>
+  </section>
+  <section name="Quick Race">
+    <attnum name="distance" val="0"/>
+    <attstr name="type" val="race"/>
+    <attstr name="starting order" val="drivers list"/>
+    <attstr name="restart" val="yes"/>
+    <section name="Starting Grid">
+      <attnum name="rows" val="1"/>
+      <attnum name="distance to start" val="0"/>
+      <attnum name="distance between columns" val="0"/>
+      <attnum name="offset within a column" val="0"/>
+      <attnum name="initial speed" val="0"/>
+      <attnum name="initial height" val="0.2"/>
+    </section>
+    <attnum name="laps" val="2"/>
+  </section>
+  <section name="Drivers">
+    <attnum name="maximum number" val="1"/>
+    <section name="1">
+      <attnum name="idx" val="0"/>
+      <attstr name="module" val="{ROBOT}"/>
+    </section>
+  </section>
+</params>
+"#
+    )
+}
+
+/// The robot's settings file (format in `torcs-robot/cdbo.cpp`).
+fn settings(req: &LapRequest, output: &Path, time_limit: f64) -> String {
+    let car = &req.car;
+    let vehicle = Vehicle::new(car);
+    let list = |v: &mut dyn Iterator<Item = f64>| {
+        v.map(|x| format!("{x:e}")).collect::<Vec<_>>().join(" ")
+    };
+    let mut s = String::from("# cdbo lap settings (torcs-robot/cdbo.cpp)\n");
+    let _ = writeln!(s, "output {}", output.display());
+    if let Some(trace) = &req.trace {
+        let _ = writeln!(s, "trace {}", trace.display());
+    }
+    let pedal = match &req.pedal {
+        GamePedal::Demo(v) => format!("demo {v:e}"),
+        GamePedal::Constant(a) => format!("constant {a:e}"),
+        GamePedal::Rkhs(p) => format!(
+            "rkhs {:e} {}",
+            p.lengthscale,
+            list(&mut p.weights.iter().copied())
+        ),
+        GamePedal::Table(points) => format!(
+            "table {}",
+            list(&mut points.iter().flat_map(|&(x, a)| [x, a]))
+        ),
+    };
+    let _ = writeln!(s, "pedal {pedal}");
+    let _ = writeln!(s, "wheelbase {:e}", car.wheelbase);
+    let st = &req.config.steering;
+    let _ = writeln!(
+        s,
+        "steering {:e} {:e} {:e}",
+        st.lookahead_time, st.lookahead_min, st.ki
+    );
+    let fd = car.final_drive;
+    let _ = writeln!(s, "ratios {}", list(&mut car.gears.iter().map(|g| g * fd)));
+    let _ = writeln!(
+        s,
+        "upshift {}",
+        list(&mut vehicle.shift_map().upshift.iter().copied())
+    );
+    let _ = writeln!(s, "downshift_margin {DOWNSHIFT_MARGIN:e}");
+    let _ = writeln!(s, "shift_time {:e}", car.shift_time);
+    let [f, r] = vehicle.driven();
+    let _ = writeln!(s, "driven {f:e} {r:e}");
+    let [f, r] = vehicle.aid_threshold();
+    let _ = writeln!(s, "aid_slip {f:e} {r:e}");
+    let _ = writeln!(s, "off_track_margin {:e}", req.config.off_track_margin);
+    let _ = writeln!(s, "time_limit {time_limit:e}");
+    s
+}
+
+impl Game {
+    /// A lap of `pedal` with the game's `car` on its `track` (TORCS names), with cdbo's
+    /// default lap settings; the car's parameters are read from the game's own car file.
+    pub fn request(&self, track: &str, car: &str, pedal: GamePedal) -> Result<LapRequest> {
+        self.install.track_category(track)?;
+        self.install.check_car(car)?;
+        let file = self
+            .install
+            .data_dir
+            .join("cars")
+            .join(car)
+            .join(format!("{car}.xml"));
+        Ok(LapRequest {
+            track: track.to_owned(),
+            car_name: car.to_owned(),
+            car: crate::car::torcs::read(&file, None)?,
+            pedal,
+            config: LapConfig::default(),
+            trace: None,
+            timeout: DEFAULT_TIMEOUT,
+        })
+    }
+
+    /// Drives one lap. `Err` when no lap could be attempted (the setup is broken, the track or
+    /// car unknown); `Ok(Err(reason))` when the game produced no lap (it hung and was killed,
+    /// or crashed); otherwise the robot's lap, judged by cdbo's rules.
+    pub fn lap(&self, req: &LapRequest) -> Result<std::result::Result<LapResult, String>> {
+        let category = self.install.track_category(&req.track)?;
+        self.install.check_car(&req.car_name)?;
+        let io = |path: &Path| {
+            let path = path.to_owned();
+            move |source| Error::Io { path, source }
+        };
+        let n = LAPS.fetch_add(1, Ordering::Relaxed);
+        let dir = LapDir(
+            self.root
+                .join("laps")
+                .join(format!("{}-{n}", std::process::id())),
+        );
+        let _ = std::fs::remove_dir_all(&dir.0);
+        let robot_dir = dir.0.join("drivers").join(ROBOT);
+        for d in [&robot_dir, &dir.0.join("config"), &dir.0.join("results")] {
+            std::fs::create_dir_all(d).map_err(io(d))?;
+        }
+        let engine = self.root.join("conf/config/raceengine.xml");
+        std::fs::copy(&engine, dir.0.join("config/raceengine.xml")).map_err(io(&engine))?;
+        let time_limit = req
+            .config
+            .time_limit
+            .unwrap_or_else(|| default_time_limit(&self.install, &req.track, &category));
+        let output = dir.0.join("lap.jsonl");
+        let files = [
+            (
+                robot_dir.join(format!("{ROBOT}.xml")),
+                robot_xml(&req.car_name, "lap.txt"),
+            ),
+            (dir.0.join("lap.txt"), settings(req, &output, time_limit)),
+            (dir.0.join("race.xml"), race_xml(&req.track, &category)),
+        ];
+        for (path, text) in &files {
+            std::fs::write(path, text).map_err(io(path))?;
+        }
+        let stderr_path = dir.0.join("stderr.txt");
+        let stderr = std::fs::File::create(&stderr_path).map_err(io(&stderr_path))?;
+        let mut local = dir.0.clone().into_os_string();
+        local.push("/");
+        let mut lib = self.lib_dir().into_os_string();
+        lib.push("/");
+        let mut data = self.data_dir().into_os_string();
+        data.push("/");
+        let mut child = Command::new(self.lib_dir().join("torcs-bin"))
+            .arg("-l")
+            .arg(&local)
+            .arg("-L")
+            .arg(&lib)
+            .arg("-D")
+            .arg(&data)
+            .arg("-r")
+            .arg(dir.0.join("race.xml"))
+            .current_dir(self.data_dir())
+            .env("LD_LIBRARY_PATH", self.install.lib_dir.join("lib"))
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(stderr)
+            .process_group(0)
+            .spawn()
+            .map_err(|e| {
+                Error::Domain(format!(
+                    "cannot start TORCS ({}): {e}",
+                    self.lib_dir().join("torcs-bin").display()
+                ))
+            })?;
+        let group = child.id() as i32;
+        let start = Instant::now();
+        let status = loop {
+            match child.try_wait() {
+                Ok(Some(status)) => break Some(status),
+                Ok(None) if start.elapsed() > req.timeout => break None,
+                Ok(None) => std::thread::sleep(Duration::from_millis(2)),
+                Err(e) => {
+                    kill_group(group);
+                    let _ = child.wait();
+                    return Err(Error::Domain(format!("waiting for TORCS: {e}")));
+                }
+            }
+        };
+        let Some(status) = status else {
+            // Its leader not yet reaped, the group cannot have been reused: kill all of it.
+            kill_group(group);
+            let _ = child.wait();
+            return Ok(Err(format!(
+                "the game hung: killed after {:.0} s of wall clock",
+                req.timeout.as_secs_f64()
+            )));
+        };
+        let line = std::fs::read_to_string(&output).unwrap_or_default();
+        let Some(line) = line.lines().rfind(|l| !l.trim().is_empty()) else {
+            return Ok(Err(format!(
+                "the game ended ({status}) without a lap: {}",
+                tail(&stderr_path)
+            )));
+        };
+        let robot: RobotLine = serde_json::from_str(line).map_err(|e| {
+            Error::Domain(format!(
+                "the TORCS robot wrote an unreadable line ({e}): {line}"
+            ))
+        })?;
+        if let Some(error) = robot.error {
+            return Err(Error::Domain(format!("the TORCS robot: {error}")));
+        }
+        Ok(Ok(LapResult {
+            completed: robot.completed,
+            lap_time_s: robot.lap_time_s,
+            reward_mps: robot.reward_mps,
+            failure: robot.failure,
+            simulated_s: robot.simulated_s,
+            trace: Vec::new(),
+        }))
+    }
+}
+
+/// cdbo's time limit, 30 s + L / (4 m/s), with L the game's track length; 30 min if the track
+/// cannot be read.
+fn default_time_limit(install: &crate::torcs::Install, track: &str, category: &str) -> f64 {
+    let file = install
+        .data_dir
+        .join("tracks")
+        .join(category)
+        .join(track)
+        .join(format!("{track}.xml"));
+    crate::track::torcs::read(&file)
+        .map(|t| 30.0 + t.length / 4.0)
+        .unwrap_or(1800.0)
+}
+
+/// Kills a process group (nothing happens if it is gone).
+fn kill_group(group: i32) {
+    // SAFETY: kill(2) with a negative pid signals that process group; no memory is involved.
+    unsafe {
+        libc::kill(-group, libc::SIGKILL);
+    }
+}
+
+/// The last line of a file, at most 300 bytes of it.
+fn tail(path: &Path) -> String {
+    let mut text = String::new();
+    if let Ok(mut f) = std::fs::File::open(path) {
+        let mut buf = Vec::new();
+        let _ = f.read_to_end(&mut buf);
+        let start = buf.len().saturating_sub(300);
+        text = String::from_utf8_lossy(&buf[start..]).into_owned();
+    }
+    text.lines()
+        .rfind(|l| !l.trim().is_empty())
+        .unwrap_or("no output")
+        .trim()
+        .to_owned()
+}

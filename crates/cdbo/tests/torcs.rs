@@ -1,0 +1,108 @@
+//! TORCS, the real game, driven by cdbo's robot: a demonstration lap agrees with cdbo's
+//! simulator, a bad policy fails with its reason, bad names are one clear error. Skipped (with
+//! a message) where TORCS or the robot headers (../shared/torcs-sdk) are missing.
+
+mod common;
+
+use std::path::PathBuf;
+use std::sync::{Mutex, MutexGuard, OnceLock};
+
+use cdbo::drive::demo::SpeedHold;
+use cdbo::sim::{FailureReason, Simulator};
+use cdbo::torcs::{self, Game, GamePedal, Install};
+
+/// One lap at a time in this file, so that a test can see the lap folders emptied.
+fn one_at_a_time() -> MutexGuard<'static, ()> {
+    static LOCK: Mutex<()> = Mutex::new(());
+    LOCK.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// The game, set up once for this file in a cache under target/, or why not.
+fn game() -> Option<&'static Game> {
+    static GAME: OnceLock<Result<Game, String>> = OnceLock::new();
+    let game = GAME.get_or_init(|| {
+        let install = Install::find().map_err(|e| e.to_string())?;
+        let sdk = common::shared("torcs-sdk");
+        if !sdk.join("include/robot.h").is_file() {
+            return Err(format!("no robot headers at {}", sdk.display()));
+        }
+        let cache = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("torcs-cache");
+        torcs::setup(&install, &sdk, &cache).map_err(|e| format!("setup failed: {e}"))
+    });
+    match game {
+        Ok(g) => Some(g),
+        Err(why) => {
+            eprintln!("skipped: TORCS is not available ({why})");
+            None
+        }
+    }
+}
+
+/// The demonstrator holding 15 m/s round Forza in car1-trb1: the game's lap time within 1 %
+/// of cdbo's simulator on the same track and car files (measured: 0.02 %).
+#[test]
+fn a_demonstration_lap_in_the_game_agrees_with_the_simulator() {
+    let _one = one_at_a_time();
+    let Some(game) = game() else { return };
+    let req = game
+        .request("forza", "car1-trb1", GamePedal::Demo(15.0))
+        .unwrap();
+    let lap = game.lap(&req).unwrap().unwrap();
+    assert!(lap.completed, "{lap:?}");
+    let data = cdbo::data_path::DataPath::new(std::slice::from_ref(&game.install.data_dir));
+    let track = cdbo::track::catalog::find("forza", &data).unwrap();
+    let ours = Simulator::new(track, &req.car).lap(&mut SpeedHold::new(15.0));
+    let (t_game, t_ours) = (lap.lap_time_s.unwrap(), ours.lap_time_s.unwrap());
+    let diff = (t_game - t_ours).abs() / t_ours;
+    assert!(
+        diff < 0.01,
+        "game {t_game:.2} s, cdbo {t_ours:.2} s: {:.2} %",
+        100.0 * diff
+    );
+    // Each lap's folder is gone once the lap is over.
+    assert_eq!(
+        std::fs::read_dir(game.root.join("laps")).unwrap().count(),
+        0
+    );
+}
+
+/// Full brake from the start: the car never moves, and the game says so as cdbo does.
+#[test]
+fn a_bad_policy_fails_with_its_reason() {
+    let _one = one_at_a_time();
+    let Some(game) = game() else { return };
+    let req = game
+        .request("forza", "car1-trb1", GamePedal::Constant(-1.0))
+        .unwrap();
+    let lap = game.lap(&req).unwrap().unwrap();
+    let failure = lap.failure.expect("full brake completed a lap");
+    assert_eq!(failure.reason, FailureReason::Stalled);
+    assert!(
+        failure.x < 0.01 && (5.0..6.0).contains(&failure.time_s),
+        "{failure:?}"
+    );
+    assert_eq!(lap.reward_mps, 0.0);
+}
+
+/// Unknown tracks and cars are one clear error naming what exists.
+#[test]
+fn unknown_names_are_clear_errors() {
+    let _one = one_at_a_time();
+    let Some(game) = game() else { return };
+    let e = game
+        .request("nowhere", "car1-trb1", GamePedal::Demo(15.0))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("unknown TORCS track \"nowhere\"") && e.contains("forza"),
+        "{e}"
+    );
+    let e = game
+        .request("forza", "no-car", GamePedal::Demo(15.0))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("unknown TORCS car \"no-car\"") && e.contains("car1-trb1"),
+        "{e}"
+    );
+}

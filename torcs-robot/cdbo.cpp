@@ -1,0 +1,481 @@
+/*
+ * cdbo: a TORCS robot that drives one lap the way cdbo's simulator does.
+ *
+ * Copyright (C) 2026 the cdbo authors.
+ *
+ * This program is free software; you can redistribute it and/or modify it under the terms of
+ * the GNU General Public License as published by the Free Software Foundation; either version
+ * 2 of the License, or (at your option) any later version. See COPYING.
+ *
+ * Throttle and brake follow a pedal a in [-1, 1] (a policy pi(x) of the lap fraction x, the
+ * demonstrator's PI speed hold, or a constant); steering is cdbo's look-ahead PI law
+ * (crates/cdbo/src/drive/steering.rs); the gear is chosen by cdbo's automatic gearbox
+ * (crates/cdbo/src/sim/powertrain.rs) from shift points it is given; ABS and traction control
+ * ease the pedals as cdbo's vehicle does; the lap fails by cdbo's rules (sim/lap.rs), judged
+ * from the game's car state. On completion or failure it writes one JSON line and ends the
+ * game process at once.
+ *
+ * Settings: the file named by the attribute "settings" of section "cdbo" in
+ * drivers/cdbo/cdbo.xml, relative to the game's local directory (-l) unless absolute. One
+ * "key values..." per line, '#' starts a comment:
+ *   output PATH                  the JSON line goes here (appended)
+ *   trace PATH                   optional: every driver step (50 Hz) as CSV
+ *   pedal demo V | pedal constant A | pedal rkhs L W1 ... WM | pedal table X1 A1 X2 A2 ...
+ *   wheelbase L                  (m), the steering gain's L
+ *   steering T_LA D_MIN K_I      look-ahead time (s), shortest look-ahead (m), integral gain
+ *   ratios G1 ... GN             total ratio engine -> wheel of each forward gear
+ *   upshift W1 ... WN            engine speed (rad/s) at which to leave each gear
+ *   downshift_margin F           hysteresis of the down-shift
+ *   shift_time S                 (s) no new shift decision during a shift
+ *   driven F R                   weights of the front and rear axle's spin in the drive speed
+ *   aid_slip F R                 slip at which ABS / traction control start easing, per axle
+ *   off_track_margin M           (m) beyond half the width
+ *   time_limit S                 (s)
+ */
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+#include <unistd.h>
+
+#include <car.h>
+#include <raceman.h>
+#include <robot.h>
+#include <robottools.h>
+#include <tgf.h>
+#include <track.h>
+
+namespace {
+
+const double kDemoKp = 0.5;  // drive/demo.rs KP
+const double kDemoKi = 0.1;  // drive/demo.rs KI
+const double kSpinSlipTan = 0.5773502691896258;  // 1 / tan 60 deg (sim/lap.rs)
+const double kSpinMinSpeed = 3.0;
+const double kBackwardsDistance = 10.0;
+const double kStallSpeed = 0.5;
+const double kStallTime = 5.0;
+const double kSlipSpeedFloor = 2.0;  // sim/vehicle.rs SLIP_SPEED_FLOOR
+
+struct Settings {
+    std::string output = "lap.jsonl";
+    std::string trace;
+    std::string pedal = "demo";
+    std::vector<double> pedal_args = {15.0};
+    double wheelbase = 2.6;
+    double lookahead_time = 0.8, lookahead_min = 12.0, ki = 0.1;
+    std::vector<double> ratios, upshift;
+    double downshift_margin = 0.85, shift_time = 0.2;
+    double driven[2] = {0.0, 1.0};
+    double aid_slip[2] = {0.0, 0.0};
+    double off_track_margin = 1.0;
+    double time_limit = 0.0;
+};
+
+struct Lap {
+    Settings cfg;
+    std::string error;
+    tTrack *track = nullptr;
+    FILE *trace = nullptr;
+    double start_time = -1.0, last_time = 0.0;
+    double distance = 0.0, farthest = 0.0, last_station = 0.0, slow_for = 0.0;
+    double steer_integral = 0.0, demo_integral = 0.0;
+    int gear = 0;             // 0-based, as in cdbo
+    double shifting = 0.0;    // time left in a shift (s)
+    bool done = false;
+};
+
+Lap lap;
+
+std::string resolve(const std::string &path) {
+    if (path.empty() || path[0] == '/') return path;
+    return std::string(GetLocalDir()) + path;
+}
+
+bool read_settings(const std::string &path, Settings *s, std::string *error) {
+    FILE *f = fopen(path.c_str(), "r");
+    if (!f) {
+        *error = "cannot read the settings file " + path;
+        return false;
+    }
+    char line[1 << 16];
+    int number = 0;
+    while (fgets(line, sizeof line, f)) {
+        number++;
+        if (char *hash = strchr(line, '#')) *hash = 0;
+        char *save = nullptr;
+        char *key = strtok_r(line, " \t\r\n", &save);
+        if (!key) continue;
+        std::vector<double> nums;
+        std::string word;
+        for (char *tok; (tok = strtok_r(nullptr, " \t\r\n", &save));) {
+            char *end = nullptr;
+            double v = strtod(tok, &end);
+            if (*end == 0 && std::isfinite(v)) {
+                nums.push_back(v);
+            } else if (word.empty() && nums.empty()) {
+                word = tok;
+            } else {
+                *error = path + ":" + std::to_string(number) + ": " + key + ": '" + tok +
+                         "' is not a finite number";
+                fclose(f);
+                return false;
+            }
+        }
+        std::string k = key;
+        auto need = [&](size_t n) {
+            if (nums.size() < n) {
+                *error = path + ":" + std::to_string(number) + ": " + k + " needs " +
+                         std::to_string(n) + " number(s)";
+                return false;
+            }
+            return true;
+        };
+        bool ok = true;
+        if (k == "output") s->output = word;
+        else if (k == "trace") s->trace = word;
+        else if (k == "pedal") { s->pedal = word; s->pedal_args = nums; }
+        else if (k == "wheelbase") { if ((ok = need(1))) s->wheelbase = nums[0]; }
+        else if (k == "steering") {
+            if ((ok = need(3))) { s->lookahead_time = nums[0]; s->lookahead_min = nums[1]; s->ki = nums[2]; }
+        }
+        else if (k == "ratios") s->ratios = nums;
+        else if (k == "upshift") s->upshift = nums;
+        else if (k == "downshift_margin") { if ((ok = need(1))) s->downshift_margin = nums[0]; }
+        else if (k == "shift_time") { if ((ok = need(1))) s->shift_time = nums[0]; }
+        else if (k == "driven") { if ((ok = need(2))) { s->driven[0] = nums[0]; s->driven[1] = nums[1]; } }
+        else if (k == "aid_slip") { if ((ok = need(2))) { s->aid_slip[0] = nums[0]; s->aid_slip[1] = nums[1]; } }
+        else if (k == "off_track_margin") { if ((ok = need(1))) s->off_track_margin = nums[0]; }
+        else if (k == "time_limit") { if ((ok = need(1))) s->time_limit = nums[0]; }
+        else {
+            *error = path + ":" + std::to_string(number) + ": unknown setting '" + k + "'";
+            ok = false;
+        }
+        if (!ok) {
+            fclose(f);
+            return false;
+        }
+    }
+    fclose(f);
+    if (s->ratios.empty() || s->ratios.size() != s->upshift.size()) {
+        *error = path + ": 'ratios' and 'upshift' must give one number per gear";
+        return false;
+    }
+    const std::string &p = s->pedal;
+    bool pedal_ok = (p == "demo" && s->pedal_args.size() == 1 && s->pedal_args[0] > 0) ||
+                    (p == "constant" && s->pedal_args.size() == 1) ||
+                    (p == "rkhs" && s->pedal_args.size() >= 3 && s->pedal_args[0] > 0) ||
+                    (p == "table" && s->pedal_args.size() >= 2 && s->pedal_args.size() % 2 == 0);
+    if (!pedal_ok) {
+        *error = path + ": pedal must be 'demo V', 'constant A', 'rkhs L W1 W2 ...' or 'table X1 A1 ...'";
+        return false;
+    }
+    return true;
+}
+
+double clamp(double v, double lo, double hi) { return v < lo ? lo : (v > hi ? hi : v); }
+
+/// pi(x) = clamp(sum_i w_i k(x, i/(M-1)), -1, 1), k the Matern-3/2 kernel (policy/rkhs.rs).
+double rkhs(const std::vector<double> &args, double x) {
+    double l = args[0];
+    size_t m = args.size() - 1;
+    double sum = 0.0;
+    for (size_t i = 0; i < m; i++) {
+        double r = std::sqrt(3.0) * std::fabs(x - double(i) / double(m - 1)) / l;
+        sum += args[i + 1] * (1.0 + r) * std::exp(-r);
+    }
+    return sum;
+}
+
+/// Linear interpolation in an (x, a) table, held flat beyond its ends (policy/table.rs).
+double table(const std::vector<double> &args, double x) {
+    size_t n = args.size() / 2;
+    if (x <= args[0]) return args[1];
+    for (size_t i = 1; i < n; i++) {
+        double x1 = args[2 * i];
+        if (x <= x1) {
+            double x0 = args[2 * i - 2], a0 = args[2 * i - 1], a1 = args[2 * i + 1];
+            return x1 > x0 ? a0 + (a1 - a0) * (x - x0) / (x1 - x0) : a1;
+        }
+    }
+    return args[2 * n - 1];
+}
+
+double pedal(double x, double speed, double dt) {
+    const std::vector<double> &a = lap.cfg.pedal_args;
+    double v;
+    if (lap.cfg.pedal == "demo") {
+        double e = a[0] - speed;
+        double raw = kDemoKp * e + kDemoKi * (lap.demo_integral + e * dt);
+        if (std::fabs(raw) < 1.0) lap.demo_integral += e * dt;
+        v = kDemoKp * e + kDemoKi * lap.demo_integral;
+    } else if (lap.cfg.pedal == "constant") {
+        v = a[0];
+    } else if (lap.cfg.pedal == "rkhs") {
+        v = rkhs(a, x);
+    } else {
+        v = table(a, x);
+    }
+    return std::isnan(v) ? 0.0 : clamp(v, -1.0, 1.0);
+}
+
+/// The centre-line point s metres from the start line (wrapped onto the lap).
+void centre_point(double s, double *px, double *py) {
+    double len = lap.track->length;
+    s = std::fmod(s, len);
+    if (s < 0) s += len;
+    tTrackSeg *seg = lap.track->seg;  // the last segment; its next is the first
+    for (int i = 0; i < lap.track->nseg; i++) {
+        seg = seg->next;
+        if (s < seg->lgfromstart + seg->length || i == lap.track->nseg - 1) break;
+    }
+    double t = s - seg->lgfromstart;
+    double sx = 0.5 * (seg->vertex[TR_SL].x + seg->vertex[TR_SR].x);
+    double sy = 0.5 * (seg->vertex[TR_SL].y + seg->vertex[TR_SR].y);
+    double h = seg->angle[TR_ZS];
+    if (seg->type == TR_STR) {
+        *px = sx + t * std::cos(h);
+        *py = sy + t * std::sin(h);
+        return;
+    }
+    double turn = seg->type == TR_LFT ? 1.0 : -1.0;
+    double phi = t / seg->radius * turn;
+    // Rotate the start point about the arc's centre by phi.
+    double dx = sx - seg->center.x, dy = sy - seg->center.y;
+    *px = seg->center.x + dx * std::cos(phi) - dy * std::sin(phi);
+    *py = seg->center.y + dx * std::sin(phi) + dy * std::cos(phi);
+}
+
+/// The road-wheel angle (rad) of cdbo's look-ahead PI steering (drive/steering.rs).
+double steer(tCarElt *car, double speed, double dt) {
+    double d = std::fmax(lap.cfg.lookahead_time * speed, lap.cfg.lookahead_min);
+    double tx, ty;
+    centre_point(car->_distFromStartLine + d, &tx, &ty);
+    double dx = tx - car->_pos_X, dy = ty - car->_pos_Y;
+    double cy = std::cos(car->_yaw), sy = std::sin(car->_yaw);
+    double e = std::atan2(cy * dy - sy * dx, cy * dx + sy * dy);
+    double kp = 2.0 * lap.cfg.wheelbase / d;
+    double lock = car->_steerLock;
+    double raw = kp * e + lap.cfg.ki * (lap.steer_integral + e * dt);
+    if (std::fabs(raw) < lock) lap.steer_integral += e * dt;
+    return clamp(kp * e + lap.cfg.ki * lap.steer_integral, -lock, lock);
+}
+
+/// Spin of an axle (rad/s): the mean of its two wheels (0, 1 front; 2, 3 rear).
+double axle_omega(tCarElt *car, int axle) {
+    return 0.5 * (car->_wheelSpinVel(2 * axle) + car->_wheelSpinVel(2 * axle + 1));
+}
+
+/// cdbo's automatic gearbox (sim/powertrain.rs Gearbox::update).
+void choose_gear(tCarElt *car, double dt) {
+    const Settings &c = lap.cfg;
+    lap.shifting = std::fmax(lap.shifting - dt, 0.0);
+    if (lap.shifting > 0.0) return;
+    double w = c.driven[0] * axle_omega(car, 0) + c.driven[1] * axle_omega(car, 1);
+    size_t g = lap.gear;
+    if (g + 1 < c.ratios.size() && w * c.ratios[g] >= c.upshift[g]) {
+        lap.gear++;
+        lap.shifting = c.shift_time;
+    } else if (g > 0 && w * c.ratios[g - 1] < c.downshift_margin * c.upshift[g - 1]) {
+        lap.gear--;
+        lap.shifting = c.shift_time;
+    }
+}
+
+/// Longitudinal slip of an axle, (omega R - v) / max(|v|, v0).
+double axle_slip(tCarElt *car, int axle) {
+    double v = car->_speed_x;
+    double r = 0.5 * (car->_wheelRadius(2 * axle) + car->_wheelRadius(2 * axle + 1));
+    return (axle_omega(car, axle) * r - v) / std::fmax(std::fabs(v), kSlipSpeedFloor);
+}
+
+void json_string(FILE *f, const std::string &s) {
+    fputc('"', f);
+    for (char ch : s) {
+        if (ch == '"' || ch == '\\') fputc('\\', f);
+        if ((unsigned char)ch < 0x20) fprintf(f, "\\u%04x", ch);
+        else fputc(ch, f);
+    }
+    fputc('"', f);
+}
+
+/// Writes the lap's JSON line and ends the game process: nothing else is left to drive.
+[[noreturn]] void finish(double t, double game_time, const char *reason, double lap_time) {
+    std::string out = resolve(lap.cfg.output);
+    FILE *f = fopen(out.c_str(), "a");
+    if (!f) f = stdout;
+    double len = lap.track ? lap.track->length : 0.0;
+    fprintf(f, "{\"robot\":\"cdbo\",\"track\":");
+    json_string(f, lap.track ? lap.track->internalname : "");
+    fprintf(f, ",\"length_m\":%.4f", len);
+    if (!lap.error.empty()) {
+        fprintf(f, ",\"completed\":false,\"error\":");
+        json_string(f, lap.error);
+    } else if (reason) {
+        double d = std::fmax(lap.distance, 0.0);
+        fprintf(f,
+                ",\"completed\":false,\"lap_time_s\":null,\"reward_mps\":0,\"failure\":{\"reason\":\"%s\","
+                "\"x\":%.6f,\"distance_m\":%.3f,\"time_s\":%.4f}",
+                reason, clamp(d / len, 0.0, 1.0), d, t);
+    } else {
+        fprintf(f, ",\"completed\":true,\"lap_time_s\":%.4f,\"reward_mps\":%.6f,\"failure\":null",
+                lap_time, len / lap_time);
+    }
+    fprintf(f, ",\"simulated_s\":%.4f,\"game_time_s\":%.4f}\n", t, game_time);
+    fflush(f);
+    if (lap.trace) fflush(lap.trace);
+    _exit(0);
+}
+
+void new_track(int, tTrack *track, void *, void **settings, tSituation *) {
+    lap.track = track;
+    *settings = nullptr;
+    // The local directory's copy first (one per lap), then the game's data directory.
+    void *h = GfParmReadFile(resolve("drivers/cdbo/cdbo.xml").c_str(), GFPARM_RMODE_STD);
+    if (!h) h = GfParmReadFile("drivers/cdbo/cdbo.xml", GFPARM_RMODE_STD);
+    std::string path = "cdbo-lap.txt";
+    if (h) {
+        path = GfParmGetStr(h, "cdbo", "settings", path.c_str());
+    }
+    std::string resolved = resolve(path);
+    if (read_settings(resolved, &lap.cfg, &lap.error) && !lap.cfg.trace.empty()) {
+        lap.trace = fopen(resolve(lap.cfg.trace).c_str(), "w");
+        if (!lap.trace) {
+            lap.error = "cannot write the trace " + resolve(lap.cfg.trace);
+        } else {
+            fprintf(lap.trace,
+                    "t_s,distance_m,x,speed_mps,pedal,steer_rad,lateral_m,heading_error_rad,"
+                    "slip_angle_rad,gear,rpm,pos_x_m,pos_y_m\n");
+        }
+    }
+    if (h) GfParmReleaseHandle(h);
+    if (lap.cfg.time_limit <= 0.0) lap.cfg.time_limit = 30.0 + track->length / 4.0;
+}
+
+void new_race(int, tCarElt *car, tSituation *) {
+    lap.last_station = car->_distFromStartLine;
+    // The grid puts the car on the start line: a station just short of the length is -epsilon.
+    if (lap.last_station > 0.5 * lap.track->length) lap.last_station -= lap.track->length;
+    lap.distance = lap.last_station;
+    lap.farthest = lap.distance;
+}
+
+void drive(int, tCarElt *car, tSituation *s) {
+    memset((void *)&car->ctrl, 0, sizeof(tCarCtrl));
+    double now = s->currentTime;
+    if (!lap.error.empty()) finish(0.0, now, nullptr, 0.0);
+    if (now < 0.0) {
+        // The count-down before the start: stand on the brake, as the car does at t < 0 in cdbo.
+        car->_brakeCmd = 1.0;
+        car->_gearCmd = 1;
+        return;
+    }
+    if (lap.start_time < 0.0) {
+        lap.start_time = 0.0;  // the race's start
+        lap.last_time = 0.0;
+    }
+    double t = now - lap.start_time;
+    double dt = now - lap.last_time;
+    lap.last_time = now;
+    double len = lap.track->length;
+
+    // Progress along the centre line, unwrapped across the start line.
+    double station = car->_distFromStartLine;
+    double ds = station - std::fmod(lap.last_station + len, len);
+    if (ds > 0.5 * len) ds -= len;
+    if (ds < -0.5 * len) ds += len;
+    double before = lap.distance;
+    lap.distance += ds;
+    lap.last_station = station;
+    if (lap.distance >= len && ds > 0.0) {
+        // Completed between the last driver step and this one: interpolate the crossing.
+        finish(t, now, nullptr, t - dt + dt * (len - before) / ds);
+    }
+    lap.farthest = std::fmax(lap.farthest, lap.distance);
+
+    double vx = car->_speed_x, vy = car->_speed_y;
+    double speed = std::sqrt(vx * vx + vy * vy);
+    tTrackSeg *seg = car->_trkPos.seg;
+    double half_width = 0.5 * seg->width;
+    double lateral = car->_trkPos.toMiddle;
+    double heading_error = car->_yaw - RtTrackSideTgAngleL(&car->_trkPos);
+    heading_error = std::atan2(std::sin(heading_error), std::cos(heading_error));
+    const char *failure = nullptr;
+    if (std::fabs(lateral) > half_width + lap.cfg.off_track_margin) {
+        failure = "off_track";
+    } else if (std::cos(heading_error) < 0.0 ||
+               (vx < std::fabs(vy) * kSpinSlipTan && speed > kSpinMinSpeed)) {
+        failure = "spun";
+    } else if (lap.distance < lap.farthest - kBackwardsDistance) {
+        failure = "backwards";
+    } else if (t > lap.cfg.time_limit) {
+        failure = "time_limit";
+    } else {
+        lap.slow_for = (std::fabs(vx) < kStallSpeed && speed < kStallSpeed) ? lap.slow_for + dt : 0.0;
+        if (lap.slow_for > kStallTime) failure = "stalled";
+    }
+    if (failure) finish(t, now, failure, 0.0);
+
+    double x = clamp(lap.distance / len, 0.0, 1.0);
+    double a = pedal(x, speed, dt);
+    double delta = steer(car, speed, dt);
+    choose_gear(car, dt);
+
+    // Traction control and ABS, as cdbo's vehicle applies them (sim/vehicle.rs).
+    double throttle = std::fmax(a, 0.0), brake = std::fmax(-a, 0.0);
+    int k = lap.cfg.driven[1] > 0.0 ? 1 : 0;
+    double spin = axle_slip(car, k);
+    double thr = lap.cfg.aid_slip[k];
+    if (thr > 0.0 && spin > thr) throttle *= clamp(2.0 - spin / thr, 0.0, 1.0);
+    for (int axle = 0; axle < 2 && brake > 0.0; axle++) {
+        double slide = -axle_slip(car, axle);
+        double th = lap.cfg.aid_slip[axle];
+        if (th > 0.0 && slide > th) brake *= clamp(2.0 - slide / th, 0.0, 1.0);
+    }
+
+    car->_steerCmd = delta / car->_steerLock;
+    car->_accelCmd = throttle;
+    car->_brakeCmd = brake;
+    car->_gearCmd = lap.gear + 1;
+    car->_clutchCmd = 0.0;
+
+    if (lap.trace) {
+        fprintf(lap.trace, "%.3f,%.3f,%.6f,%.4f,%.4f,%.5f,%.4f,%.5f,%.5f,%d,%.0f,%.3f,%.3f\n", t,
+                lap.distance, x, speed, a, delta, lateral, heading_error,
+                std::atan2(vy, std::fmax(std::fabs(vx), 1e-9)), car->_gear, car->_enginerpm * 30.0 / M_PI,
+                car->_pos_X, car->_pos_Y);
+    }
+}
+
+void end_race(int, tCarElt *, tSituation *) {}
+
+void shutdown(int) {
+    if (lap.trace) fclose(lap.trace);
+    lap.trace = nullptr;
+}
+
+int init_robot(int, void *pt) {
+    tRobotItf *itf = (tRobotItf *)pt;
+    itf->rbNewTrack = new_track;
+    itf->rbNewRace = new_race;
+    itf->rbDrive = drive;
+    itf->rbPitCmd = nullptr;
+    itf->rbEndRace = end_race;
+    itf->rbShutdown = shutdown;
+    itf->index = 0;
+    return 0;
+}
+
+}  // namespace
+
+extern "C" int cdbo(tModInfo *info) {
+    memset(info, 0, 10 * sizeof(tModInfo));
+    info->name = strdup("cdbo");
+    info->desc = strdup("cdbo: one lap as cdbo's simulator drives it");
+    info->fctInit = init_robot;
+    info->gfId = ROB_IDENT;
+    info->index = 0;
+    return 0;
+}
