@@ -55,6 +55,29 @@ struct LapReport {
     simulator: &'static str,
 }
 
+impl LapReport {
+    fn new(
+        track: &str,
+        car: &str,
+        lap: &LapResult,
+        limit: &cdbo::limit::Limit,
+        simulator: &'static str,
+    ) -> LapReport {
+        LapReport {
+            track: track.to_owned(),
+            car: car.to_owned(),
+            completed: lap.completed,
+            lap_time_s: lap.lap_time_s,
+            reward_mps: lap.reward_mps,
+            failure: lap.failure,
+            limit_lap_time_s: limit.lap_time_s,
+            limit_reward_mps: limit.reward_mps,
+            fraction_of_limit: lap.reward_mps / limit.reward_mps,
+            simulator,
+        }
+    }
+}
+
 pub fn run(args: &LapArgs, data: &DataPath, simulator: Simulator) -> CliResult {
     if simulator == Simulator::Torcs {
         return run_torcs(args, data);
@@ -92,18 +115,7 @@ pub fn run(args: &LapArgs, data: &DataPath, simulator: Simulator) -> CliResult {
         super::plot::lap_speed(path, &sim.track, &lap, &limit)?;
     }
     print_report(
-        LapReport {
-            track: sim.track.name.clone(),
-            car: car.name.clone(),
-            completed: lap.completed,
-            lap_time_s: lap.lap_time_s,
-            reward_mps: lap.reward_mps,
-            failure: lap.failure,
-            limit_lap_time_s: limit.lap_time_s,
-            limit_reward_mps: limit.reward_mps,
-            fraction_of_limit: lap.reward_mps / limit.reward_mps,
-            simulator: "cdbo",
-        },
+        LapReport::new(&sim.track.name, &car.name, &lap, &limit, "cdbo"),
         args.json,
     )
 }
@@ -153,18 +165,7 @@ fn run_torcs(args: &LapArgs, data: &DataPath) -> CliResult {
         .or_else(|_| super::load_track(&args.setup.track, data))?;
     let limit = limit_lap(&track, &req.car);
     print_report(
-        LapReport {
-            track: track.name.clone(),
-            car: car_name.to_owned(),
-            completed: lap.completed,
-            lap_time_s: lap.lap_time_s,
-            reward_mps: lap.reward_mps,
-            failure: lap.failure,
-            limit_lap_time_s: limit.lap_time_s,
-            limit_reward_mps: limit.reward_mps,
-            fraction_of_limit: lap.reward_mps / limit.reward_mps,
-            simulator: "torcs",
-        },
+        LapReport::new(&track.name, car_name, &lap, &limit, "torcs"),
         args.json,
     )
 }
