@@ -70,7 +70,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let data = cdbo::data_path::DataPath::new(&cli.data_dirs);
     let result = match cli.command {
-        Command::Race(args) => commands::race::run(&args, &data),
+        Command::Race(args) => commands::race::run(&args, &data, cli.simulator),
         Command::Experiment(args) => commands::experiment::run_grid(&args, &data),
         Command::Report(args) => commands::report::run(&args, &data),
         Command::Study(cmd) => commands::study::run(&cmd),

@@ -7,7 +7,7 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 
-use super::{CliResult, Setup, print_json};
+use super::{CliResult, Setup, Simulator, print_json};
 use cdbo::data_path::DataPath;
 use cdbo::experiment::race::{RaceConfig, RaceOutcome, race};
 use cdbo::policy::RkhsPolicy;
@@ -62,11 +62,33 @@ struct Summary {
     out: String,
 }
 
-pub fn run(args: &RaceArgs, data: &DataPath) -> CliResult {
+pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult {
     if !(args.beta.is_finite() && args.beta >= 0.0) {
         return Err(format!("--beta {}: must be a non-negative number", args.beta).into());
     }
-    let (track, car) = args.setup.load(data)?;
+    // In the game, the track and car are the game's, read by cdbo for the limit and plots.
+    let game = match simulator {
+        Simulator::Torcs => {
+            let game = cdbo::torcs::Game::ready()?;
+            let req = game.request(
+                &args.setup.track,
+                simulator.car(&args.setup.car),
+                cdbo::torcs::GamePedal::Demo(args.demo_speed),
+            )?;
+            Some((game, req))
+        }
+        Simulator::Cdbo => None,
+    };
+    let (track, car) = match &game {
+        Some((g, req)) => {
+            let game_data = DataPath::new(std::slice::from_ref(&g.install.data_dir));
+            (
+                super::load_track(&args.setup.track, &game_data)?,
+                req.car.clone(),
+            )
+        }
+        None => args.setup.load(data)?,
+    };
     let track_name = track.name.clone();
     let out = args.out.clone().unwrap_or_else(|| {
         PathBuf::from("runs").join(format!(
@@ -98,18 +120,35 @@ pub fn run(args: &RaceArgs, data: &DataPath) -> CliResult {
     bar.set_prefix(format!("{} on {}", args.method, track_name));
     let limit_reward = cdbo::limit::limit_lap(&track, &car).reward_mps;
     let start = std::time::Instant::now();
-    let outcome = race(track.clone(), &car, &config, |r| {
+    let progress = |r: &cdbo::experiment::race::LapRecord| {
         bar.set_position(r.lap as u64);
         bar.set_message(format!(
             "best {:.2} m/s ({:.0}% of the limit)",
             r.best_mps,
             100.0 * r.best_mps / limit_reward
         ));
-    })?;
+    };
+    let outcome = match &game {
+        Some((g, req)) => cdbo::torcs::race::race(g, req, &track, &config, progress)?,
+        None => race(track.clone(), &car, &config, progress)?,
+    };
     bar.finish_and_clear();
     let wall_s = start.elapsed().as_secs_f64();
     write_outputs(&out, &outcome)?;
-    write_plots(&out, track, &car, &outcome)?;
+    // The speed plots re-drive the initial and best policies where the race was driven.
+    let mut sim = cdbo::sim::Simulator::new(track.clone(), &car);
+    sim.config.trace = true;
+    let drive = |p: &RkhsPolicy| -> Result<cdbo::sim::LapResult, cdbo::Error> {
+        match &game {
+            Some((g, req)) => {
+                let mut req = req.clone();
+                req.record = true;
+                cdbo::torcs::race::drive(g, &req, cdbo::torcs::GamePedal::Rkhs(p.clone()))
+            }
+            None => Ok(sim.lap(&mut p.pedal())),
+        }
+    };
+    write_plots(&out, &track, &outcome, &drive)?;
     let best_lap = outcome
         .laps
         .iter()
@@ -217,20 +256,18 @@ fn write_outputs(out: &Path, o: &RaceOutcome) -> CliResult {
 /// and SVG.
 fn write_plots(
     out: &Path,
-    track: cdbo::track::Track,
-    car: &cdbo::car::Car,
+    track: &cdbo::track::Track,
     o: &RaceOutcome,
+    drive: &dyn Fn(&RkhsPolicy) -> Result<cdbo::sim::LapResult, cdbo::Error>,
 ) -> CliResult {
     use super::plot::{LineChart, draw, speed_chart, speed_map};
     use plotters::style::{BLACK, BLUE, GREEN, RED};
-    let mut sim = cdbo::sim::Simulator::new(track, car);
-    sim.config.trace = true;
-    let initial_lap = sim.lap(&mut o.initial.pedal());
-    let best_lap = sim.lap(&mut o.best.pedal());
+    let initial_lap = drive(&o.initial)?;
+    let best_lap = drive(&o.best)?;
     let n = o.laps.len() as f64;
     let flat = |v: f64| vec![(1.0, v), (n, v)];
     let curve = LineChart {
-        title: format!("{}: best reward per lap", sim.track.name),
+        title: format!("{}: best reward per lap", track.name),
         x_label: "lap".into(),
         y_label: "reward L/T (m/s)".into(),
         series: vec![
@@ -267,7 +304,7 @@ fn write_plots(
         ],
     };
     let speeds = speed_chart(
-        &sim.track,
+        track,
         &[
             ("initial policy", GREEN, &initial_lap),
             ("best policy", BLUE, &best_lap),
@@ -278,7 +315,7 @@ fn write_plots(
         draw(&out.join(format!("learning_curve.{ext}")), &curve)?;
         draw(&out.join(format!("policy.{ext}")), &policies)?;
         draw(&out.join(format!("speed.{ext}")), &speeds)?;
-        speed_map(&out.join(format!("map.{ext}")), &sim.track, &best_lap)?;
+        speed_map(&out.join(format!("map.{ext}")), track, &best_lap)?;
     }
     Ok(())
 }

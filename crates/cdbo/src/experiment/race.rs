@@ -96,18 +96,39 @@ pub fn race(
     track: Track,
     car: &Car,
     config: &RaceConfig,
+    progress: impl FnMut(&LapRecord),
+) -> Result<RaceOutcome> {
+    let limit = limit_lap(&track, car);
+    let sim = Simulator::new(track, car);
+    let (demo, demo_pairs) = demonstrate(&sim, config.demo_speed);
+    race_with(
+        &sim.track.name,
+        (demo, demo_pairs),
+        limit,
+        config,
+        |policy| Ok(sim.lap(&mut policy.pedal())),
+        progress,
+    )
+}
+
+/// Runs a race whose laps `drive` drives (cdbo's simulator, the game TORCS, ...), from a
+/// demonstration already driven there (its lap and (x, a) pairs); `progress` is called after
+/// every lap.
+pub fn race_with(
+    track_name: &str,
+    (demo, demo_pairs): (LapResult, Vec<(f64, f64)>),
+    limit: Limit,
+    config: &RaceConfig,
+    mut drive: impl FnMut(&RkhsPolicy) -> Result<LapResult>,
     mut progress: impl FnMut(&LapRecord),
 ) -> Result<RaceOutcome> {
     if config.laps == 0 {
         return Err(Error::Domain("a race needs at least one lap".into()));
     }
-    let limit = limit_lap(&track, car);
-    let sim = Simulator::new(track, car);
-    let (demo, demo_pairs) = demonstrate(&sim, config.demo_speed);
     if !demo.completed {
         return Err(Error::Domain(format!(
             "the {} m/s demonstration does not complete {} ({:?}): choose a slower --demo-speed",
-            config.demo_speed, sim.track.name, demo.failure
+            config.demo_speed, track_name, demo.failure
         )));
     }
     let lengthscale = default_lengthscale(config.kernels);
@@ -123,7 +144,7 @@ pub fn race(
         let optimizer_s = t0.elapsed().as_secs_f64();
         let policy = RkhsPolicy::new(weights.clone(), lengthscale)?;
         let t1 = std::time::Instant::now();
-        let result = sim.lap(&mut policy.pedal());
+        let result = drive(&policy)?;
         let simulator_s = t1.elapsed().as_secs_f64();
         let t2 = std::time::Instant::now();
         optimizer.tell(&weights, result.reward_mps)?;

@@ -21,7 +21,7 @@ use super::{Game, ROBOT};
 use crate::car::Car;
 use crate::error::{Error, Result};
 use crate::policy::RkhsPolicy;
-use crate::sim::lap::{Failure, LapConfig, LapResult};
+use crate::sim::lap::{Failure, LapConfig, LapResult, TracePoint};
 use crate::sim::powertrain::DOWNSHIFT_MARGIN;
 use crate::sim::vehicle::Vehicle;
 
@@ -53,6 +53,9 @@ pub struct LapRequest {
     pub config: LapConfig,
     /// Write the robot's 50 Hz trace here (CSV, the columns of `cdbo lap --trace`).
     pub trace: Option<PathBuf>,
+    /// Return the trace in the lap's [`LapResult::trace`] (written to the lap folder unless
+    /// `trace` names a file).
+    pub record: bool,
     /// Wall-clock time after which the game is killed and the lap fails.
     pub timeout: Duration,
 }
@@ -163,7 +166,7 @@ fn race_xml(track: &str, category: &str) -> String {
 }
 
 /// The robot's settings file (format in `torcs-robot/cdbo.cpp`).
-fn settings(req: &LapRequest, output: &Path, time_limit: f64) -> String {
+fn settings(req: &LapRequest, output: &Path, trace: Option<&Path>, time_limit: f64) -> String {
     let car = &req.car;
     let vehicle = Vehicle::new(car);
     let list = |v: &mut dyn Iterator<Item = f64>| {
@@ -171,7 +174,7 @@ fn settings(req: &LapRequest, output: &Path, time_limit: f64) -> String {
     };
     let mut s = String::from("# cdbo lap settings (torcs-robot/cdbo.cpp)\n");
     let _ = writeln!(s, "output {}", output.display());
-    if let Some(trace) = &req.trace {
+    if let Some(trace) = trace {
         let _ = writeln!(s, "trace {}", trace.display());
     }
     let pedal = match &req.pedal {
@@ -232,6 +235,7 @@ impl Game {
             pedal,
             config: LapConfig::default(),
             trace: None,
+            record: false,
             timeout: DEFAULT_TIMEOUT,
         })
     }
@@ -264,12 +268,19 @@ impl Game {
             .time_limit
             .unwrap_or_else(|| default_time_limit(&self.install, &req.track, &category));
         let output = dir.0.join("lap.jsonl");
+        let trace = req
+            .trace
+            .clone()
+            .or_else(|| req.record.then(|| dir.0.join("trace.csv")));
         let files = [
             (
                 robot_dir.join(format!("{ROBOT}.xml")),
                 robot_xml(&req.car_name, "lap.txt"),
             ),
-            (dir.0.join("lap.txt"), settings(req, &output, time_limit)),
+            (
+                dir.0.join("lap.txt"),
+                settings(req, &output, trace.as_deref(), time_limit),
+            ),
             (dir.0.join("race.xml"), race_xml(&req.track, &category)),
         ];
         for (path, text) in &files {
@@ -343,13 +354,17 @@ impl Game {
         if let Some(error) = robot.error {
             return Err(Error::Domain(format!("the TORCS robot: {error}")));
         }
+        let trace = match trace.filter(|_| req.record) {
+            Some(path) => read_trace(&path)?,
+            None => Vec::new(),
+        };
         Ok(Ok(LapResult {
             completed: robot.completed,
             lap_time_s: robot.lap_time_s,
             reward_mps: robot.reward_mps,
             failure: robot.failure,
             simulated_s: robot.simulated_s,
-            trace: Vec::new(),
+            trace,
         }))
     }
 }
@@ -366,6 +381,52 @@ fn default_time_limit(install: &crate::torcs::Install, track: &str, category: &s
     crate::track::torcs::read(&file)
         .map(|t| 30.0 + t.length / 4.0)
         .unwrap_or(1800.0)
+}
+
+/// The robot's trace: a header, then one row per driver step in the columns of
+/// `cdbo lap --trace`.
+pub fn read_trace(path: &Path) -> Result<Vec<TracePoint>> {
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+        path: path.to_owned(),
+        source,
+    })?;
+    let file = path.display().to_string();
+    let mut points = Vec::new();
+    for (i, line) in text.lines().enumerate().skip(1) {
+        let bad = |m: String| Error::Invalid {
+            file: file.clone(),
+            line: Some(i as u32 + 1),
+            element: "row".into(),
+            message: m,
+        };
+        let v = line
+            .split(',')
+            .map(|c| {
+                c.trim()
+                    .parse::<f64>()
+                    .map_err(|_| bad(format!("{c:?} is not a number")))
+            })
+            .collect::<Result<Vec<f64>>>()?;
+        if v.len() != 13 {
+            return Err(bad(format!("expected 13 columns, found {}", v.len())));
+        }
+        points.push(TracePoint {
+            t: v[0],
+            distance_m: v[1],
+            x: v[2],
+            speed: v[3],
+            pedal: v[4],
+            steer: v[5],
+            lateral: v[6],
+            heading_error: v[7],
+            slip_angle: v[8],
+            gear: v[9].max(0.0) as usize,
+            rpm: v[10],
+            pos_x: v[11],
+            pos_y: v[12],
+        });
+    }
+    Ok(points)
 }
 
 /// Kills a process group (nothing happens if it is gone).

@@ -13,6 +13,7 @@
 //! traction control, and the same failure rules, judged from the game's car state.
 
 pub mod lap;
+pub mod race;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
