@@ -43,6 +43,9 @@ enum Command {
     Lap(commands::lap::LapArgs),
     /// The quasi-steady-state minimum lap time of a car on a track.
     Limit(commands::limit::LimitArgs),
+    /// The ceiling: the fastest completed lap tracking k x the limit's speed profile, and the
+    /// best M-kernel policy fitted to its pedal.
+    Ceiling(commands::ceiling::CeilingArgs),
     /// Inspect tracks.
     #[command(subcommand)]
     Track(commands::track::TrackCommand),
@@ -78,6 +81,7 @@ fn main() -> ExitCode {
         Command::ServeSim(args) => commands::serve_sim::run(&args, &data),
         Command::Lap(args) => commands::lap::run(&args, &data, cli.simulator),
         Command::Limit(args) => commands::limit::run(&args, &data),
+        Command::Ceiling(args) => commands::ceiling::run(&args, &data),
         Command::Track(cmd) => commands::track::run(&cmd, &data),
         Command::Plot(cmd) => commands::plot::run(&cmd, &data),
         Command::Policy(cmd) => commands::policy::run(&cmd),

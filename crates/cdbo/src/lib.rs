@@ -19,6 +19,7 @@
 pub mod acquisition;
 pub mod benchmarks;
 pub mod car;
+pub mod ceiling;
 pub mod data_path;
 pub mod drive;
 pub mod error;

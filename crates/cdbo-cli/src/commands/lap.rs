@@ -53,6 +53,8 @@ struct LapReport {
     fraction_of_limit: f64,
     /// Where the lap was driven: `cdbo` or `torcs`.
     simulator: &'static str,
+    ceiling_reward_mps: f64,
+    fraction_of_ceiling: f64,
 }
 
 impl LapReport {
@@ -61,6 +63,7 @@ impl LapReport {
         car: &str,
         lap: &LapResult,
         limit: &cdbo::limit::Limit,
+        ceiling_mps: f64,
         simulator: &'static str,
     ) -> LapReport {
         LapReport {
@@ -74,6 +77,8 @@ impl LapReport {
             limit_reward_mps: limit.reward_mps,
             fraction_of_limit: lap.reward_mps / limit.reward_mps,
             simulator,
+            ceiling_reward_mps: ceiling_mps,
+            fraction_of_ceiling: lap.reward_mps / ceiling_mps,
         }
     }
 }
@@ -114,8 +119,17 @@ pub fn run(args: &LapArgs, data: &DataPath, simulator: Simulator) -> CliResult {
     if let Some(path) = &args.plot {
         super::plot::lap_speed(path, &sim.track, &lap, &limit)?;
     }
+    sim.config.trace = false;
+    let (_, ceiling_mps) = cdbo::ceiling::tracked_profile(&sim, &limit)?;
     print_report(
-        LapReport::new(&sim.track.name, &car.name, &lap, &limit, "cdbo"),
+        LapReport::new(
+            &sim.track.name,
+            &car.name,
+            &lap,
+            &limit,
+            ceiling_mps,
+            "cdbo",
+        ),
         args.json,
     )
 }
@@ -164,8 +178,10 @@ fn run_torcs(args: &LapArgs, data: &DataPath) -> CliResult {
     let track = super::load_track(&args.setup.track, &game_data)
         .or_else(|_| super::load_track(&args.setup.track, data))?;
     let limit = limit_lap(&track, &req.car);
+    let ours = cdbo::sim::Simulator::new(track.clone(), &req.car);
+    let (_, ceiling_mps) = cdbo::ceiling::tracked_profile(&ours, &limit)?;
     print_report(
-        LapReport::new(&track.name, car_name, &lap, &limit, "torcs"),
+        LapReport::new(&track.name, car_name, &lap, &limit, ceiling_mps, "torcs"),
         args.json,
     )
 }
@@ -191,14 +207,16 @@ fn print_report(report: LapReport, json: bool) -> CliResult {
     }
     match (report.lap_time_s, report.failure) {
         (Some(t), _) => println!(
-            "{} on {}: lap {:.2} s, reward {:.2} m/s ({:.1} % of the limit {:.2} s, {:.2} m/s)",
+            "{} on {}: lap {:.2} s, reward {:.2} m/s ({:.1} % of the limit {:.2} s, {:.2} m/s; {:.1} % of the ceiling {:.2} m/s)",
             report.car,
             report.track,
             t,
             report.reward_mps,
             100.0 * report.fraction_of_limit,
             report.limit_lap_time_s,
-            report.limit_reward_mps
+            report.limit_reward_mps,
+            100.0 * report.fraction_of_ceiling,
+            report.ceiling_reward_mps
         ),
         (None, Some(f)) => println!(
             "{} on {}: failed ({:?}) at x = {:.4} ({:.1} m, {:.2} s); reward 0 (limit {:.2} s, {:.2} m/s)",

@@ -1,6 +1,7 @@
 //! One module per sub-command; shared argument groups here.
 
 pub mod bench;
+pub mod ceiling;
 pub mod experiment;
 pub mod lap;
 pub mod limit;

@@ -55,6 +55,8 @@ struct Summary {
     limit_reward_mps: f64,
     limit_lap_time_s: f64,
     best_fraction_of_limit: f64,
+    ceiling_reward_mps: f64,
+    best_fraction_of_ceiling: f64,
     failed_laps: usize,
     wall_s: f64,
     optimizer_s: f64,
@@ -134,6 +136,8 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     };
     bar.finish_and_clear();
     let wall_s = start.elapsed().as_secs_f64();
+    let ceiling_sim = cdbo::sim::Simulator::new(track.clone(), &car);
+    let (_, ceiling_mps) = cdbo::ceiling::tracked_profile(&ceiling_sim, &outcome.limit)?;
     write_outputs(&out, &outcome)?;
     // The speed plots re-drive the initial and best policies where the race was driven.
     let mut sim = cdbo::sim::Simulator::new(track.clone(), &car);
@@ -166,6 +170,8 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         limit_reward_mps: outcome.limit.reward_mps,
         limit_lap_time_s: outcome.limit.lap_time_s,
         best_fraction_of_limit: outcome.best_reward_mps / outcome.limit.reward_mps,
+        ceiling_reward_mps: ceiling_mps,
+        best_fraction_of_ceiling: outcome.best_reward_mps / ceiling_mps,
         failed_laps: outcome.laps.iter().filter(|l| l.failure.is_some()).count(),
         wall_s,
         optimizer_s: outcome.laps.iter().map(|l| l.optimizer_s).sum(),
@@ -180,7 +186,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         return print_json(&summary);
     }
     println!(
-        "{} on {}, {} kernels, {} laps: best lap {} at {:.2} m/s, {:.1} % of the limit ({:.2} m/s), {:.2}x the demonstration ({:.2} m/s); {} laps failed",
+        "{} on {}, {} kernels, {} laps: best lap {} at {:.2} m/s, {:.1} % of the limit ({:.2} m/s), {:.1} % of the ceiling ({:.2} m/s), {:.2}x the demonstration ({:.2} m/s); {} laps failed",
         summary.method,
         summary.track,
         summary.kernels,
@@ -191,6 +197,8 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         summary.best_reward_mps,
         100.0 * summary.best_fraction_of_limit,
         summary.limit_reward_mps,
+        100.0 * summary.best_fraction_of_ceiling,
+        summary.ceiling_reward_mps,
         summary.best_reward_mps / summary.demo_reward_mps,
         summary.demo_reward_mps,
         summary.failed_laps

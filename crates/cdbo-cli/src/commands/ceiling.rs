@@ -1,0 +1,45 @@
+//! `cdbo ceiling`: the best lap this drive stack can do, beside the physical limit.
+
+use clap::Args;
+
+use super::{CliResult, Setup, print_json};
+use cdbo::ceiling::ceiling;
+use cdbo::data_path::DataPath;
+
+#[derive(Debug, Args)]
+pub struct CeilingArgs {
+    #[command(flatten)]
+    setup: Setup,
+    /// Policy kernels M of the fitted policy.
+    #[arg(long, default_value_t = 30)]
+    kernels: usize,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+pub fn run(args: &CeilingArgs, data: &DataPath) -> CliResult {
+    if args.kernels < 2 {
+        return Err(format!("--kernels {}: a policy needs at least 2", args.kernels).into());
+    }
+    let (track, car) = args.setup.load(data)?;
+    let name = track.name.clone();
+    let c = ceiling(track, &car, args.kernels)?;
+    if args.json {
+        return print_json(&c);
+    }
+    let pct = |v: f64| 100.0 * v / c.limit_mps;
+    println!(
+        "{} on {}: limit {:.2} m/s; tracking {:.3} x the limit's speed profile {:.2} m/s ({:.1} % of the limit); best {}-kernel policy fitted to its pedal {:.2} m/s ({:.1} %)",
+        car.name,
+        name,
+        c.limit_mps,
+        c.k,
+        c.tracked_mps,
+        pct(c.tracked_mps),
+        c.kernels,
+        c.policy_mps,
+        pct(c.policy_mps)
+    );
+    Ok(())
+}

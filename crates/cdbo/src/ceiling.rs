@@ -1,0 +1,187 @@
+//! The ceiling: the best lap this drive stack (the PI steering controller and a pedal over
+//! the lap fraction) reaches, as opposed to the physical [limit](crate::limit).
+//!
+//! 1. **Profile tracking**: a speed controller follows k·v_lim(s), the QSS limit's speed
+//!    profile scaled by k, previewed over the next τ seconds:
+//!    a = clamp(K_p·(max(k·min_{s ≤ s′ ≤ s + v·τ} v_lim(s′), v_min) − v), −1, 1), where the
+//!    floor v_min lets the car leave the standing start (the profile begins at 0).
+//!    The largest k whose lap completes is found by bisection (completion is not strictly
+//!    monotone in k; the bisection keeps a completed k as its lower end, so the result is a
+//!    completed lap).
+//! 2. **The policy class**: the pedal of that lap, a(x), fitted by ridge regression with M
+//!    kernels (paper eq. 9), scaled by c ∈ {1, 1.5, 2} before the fit (a clamped policy
+//!    reaches full throttle and brake only by overshooting), for the laps at k·(1 − 0.03j),
+//!    j = 0…[`POLICY_SCAN`]; the best completed lap of these fitted policies is the ceiling of
+//!    M-kernel policies.
+//!
+//! Their rewards beside the limit's show how much of the gap to the limit is the steering's
+//! (limit → tracked profile) and the policy class's (tracked profile → fitted policy), and
+//! what is left to an optimiser.
+
+use serde::Serialize;
+
+use crate::car::Car;
+use crate::drive::{Observation, Pedal};
+use crate::error::{Error, Result};
+use crate::limit::{Limit, limit_lap};
+use crate::policy::RkhsPolicy;
+use crate::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
+use crate::sim::Simulator;
+use crate::track::Track;
+
+/// Proportional gain of the profile tracker (per m/s): full pedal at 1 m/s off the target.
+pub const TRACKER_GAIN: f64 = 1.0;
+/// Preview time τ of the profile tracker (s).
+pub const PREVIEW_S: f64 = 0.3;
+/// The floor v_min of the tracker's target (m/s): below the demonstrator's 15 m/s, which
+/// every track of the paper completes.
+pub const TRACKER_FLOOR_MPS: f64 = 10.0;
+/// Bisection steps on k.
+pub const BISECTION_STEPS: usize = 14;
+/// Laps below the largest k whose pedals are fitted.
+pub const POLICY_SCAN: usize = 15;
+/// The scales c of the pedal before the fit.
+pub const PEDAL_SCALES: [f64; 3] = [1.0, 1.5, 2.0];
+
+/// A speed controller following k times the limit's speed profile.
+#[derive(Debug, Clone)]
+pub struct ProfileTracker<'a> {
+    /// The limit's speed at each track sample (m/s), plus the finish.
+    pub profile: &'a [f64],
+    /// The track's length (m).
+    pub length: f64,
+    /// The scale k.
+    pub k: f64,
+}
+
+impl ProfileTracker<'_> {
+    /// A tracker of k times `limit`'s profile on a track of `length` metres.
+    pub fn new(limit: &Limit, length: f64, k: f64) -> ProfileTracker<'_> {
+        ProfileTracker {
+            profile: &limit.speed,
+            length,
+            k,
+        }
+    }
+
+    /// The previewed target k·min v_lim over [s, s + v·τ] (m/s).
+    pub fn target(&self, x: f64, speed: f64) -> f64 {
+        let n = self.profile.len() - 1;
+        let at = |x: f64| ((x.clamp(0.0, 1.0) * n as f64).round() as usize).min(n);
+        let (i, j) = (at(x), at(x + speed * PREVIEW_S / self.length));
+        let v = self.profile[i..=j]
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min);
+        (self.k * v).max(TRACKER_FLOOR_MPS)
+    }
+}
+
+impl Pedal for ProfileTracker<'_> {
+    fn pedal(&mut self, obs: &Observation) -> f64 {
+        (TRACKER_GAIN * (self.target(obs.x, obs.speed) - obs.speed)).clamp(-1.0, 1.0)
+    }
+}
+
+/// The ceiling of a car on a track. The tracked profile's lap is the ceiling the learners are
+/// measured against; the fitted policy is a lower bound of the M-kernel policies' best (a
+/// least-squares fit of a bang-bang pedal, not an optimum).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Ceiling {
+    /// The physical limit's reward (m/s).
+    pub limit_mps: f64,
+    /// The largest completed profile scale k.
+    pub k: f64,
+    /// The reward of the tracked profile's lap (m/s).
+    pub tracked_mps: f64,
+    /// Policy kernels M.
+    pub kernels: usize,
+    /// The best completed lap of an M-kernel policy fitted to a tracked lap's pedal (m/s);
+    /// 0 if none completed.
+    pub policy_mps: f64,
+    /// That policy.
+    pub policy: Option<RkhsPolicy>,
+}
+
+/// The ceiling of `kernels`-kernel policies for `car` on `track`.
+pub fn ceiling(track: Track, car: &Car, kernels: usize) -> Result<Ceiling> {
+    let limit = limit_lap(&track, car);
+    let sim = Simulator::new(track, car);
+    ceiling_with(&sim, &limit, kernels)
+}
+
+/// The largest scale k of the limit's speed profile whose tracked lap completes, and that
+/// lap's reward (m/s): step 1 of the ceiling.
+pub fn tracked_profile(sim: &Simulator, limit: &Limit) -> Result<(f64, f64)> {
+    let (mut lo, mut hi) = (0.0, 1.0);
+    let mut lo_reward = 0.0;
+    for _ in 0..BISECTION_STEPS {
+        let k = 0.5 * (lo + hi);
+        let lap = sim.lap(&mut ProfileTracker::new(limit, sim.track.length, k));
+        if lap.completed {
+            (lo, lo_reward) = (k, lap.reward_mps);
+        } else {
+            hi = k;
+        }
+    }
+    if lo_reward == 0.0 {
+        return Err(Error::Domain(format!(
+            "no scale of the limit's speed profile completes {}",
+            sim.track.name
+        )));
+    }
+    Ok((lo, lo_reward))
+}
+
+/// [`ceiling`] for a simulator and its limit lap.
+pub fn ceiling_with(sim: &Simulator, limit: &Limit, kernels: usize) -> Result<Ceiling> {
+    let (k, tracked_mps) = tracked_profile(sim, limit)?;
+    let lengthscale = default_lengthscale(kernels);
+    let mut traced = sim.clone();
+    traced.config.trace = true;
+    let mut best: (f64, Option<RkhsPolicy>) = (0.0, None);
+    for j in 0..=POLICY_SCAN {
+        let scaled = k * (1.0 - 0.03 * j as f64);
+        let lap = traced.lap(&mut ProfileTracker::new(limit, sim.track.length, scaled));
+        for scale in PEDAL_SCALES {
+            let pairs: Vec<(f64, f64)> = lap.trace.iter().map(|p| (p.x, scale * p.pedal)).collect();
+            let policy = RkhsPolicy::fit(&pairs, kernels, lengthscale, DEFAULT_RIDGE)?;
+            let reward = sim.lap(&mut policy.pedal()).reward_mps;
+            if reward > best.0 {
+                best = (reward, Some(policy));
+            }
+        }
+    }
+    Ok(Ceiling {
+        limit_mps: limit.reward_mps,
+        k,
+        tracked_mps,
+        kernels,
+        policy_mps: best.0,
+        policy: best.1,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// On Ridgeway the tracked profile completes above the demonstrator (15 m/s) and below
+    /// the limit, and the failed upper end of the bisection, one step above k, does fail.
+    #[test]
+    fn the_tracked_profile_is_the_largest_completing_scale() {
+        let track = crate::track::builtin::load("ridgeway").unwrap().unwrap();
+        let car = Car::spirit_300();
+        let limit = limit_lap(&track, &car);
+        let sim = Simulator::new(track, &car);
+        let (k, reward) = tracked_profile(&sim, &limit).unwrap();
+        assert!(
+            reward > 15.0 && reward < limit.reward_mps,
+            "{reward} {}",
+            limit.reward_mps
+        );
+        let above = k + 0.5f64.powi(BISECTION_STEPS as i32);
+        let lap = sim.lap(&mut ProfileTracker::new(&limit, sim.track.length, above));
+        assert!(!lap.completed, "k = {above} completed");
+    }
+}
