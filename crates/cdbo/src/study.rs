@@ -296,7 +296,7 @@ impl Study {
         let saved = (|| -> Result<()> {
             // Re-establish the optimiser's pending suggestion (the trial's), then tell it.
             optimizer.ask()?;
-            optimizer.tell(&trial.weights, reward)?;
+            optimizer.tell_lap(&trial.weights, reward, x_fail)?;
             let state = serde_json::to_string(&optimizer.save())
                 .map_err(|e| Error::Domain(e.to_string()))?;
             tx.execute(

@@ -147,7 +147,7 @@ pub fn race_with(
         let result = drive(&policy)?;
         let simulator_s = t1.elapsed().as_secs_f64();
         let t2 = std::time::Instant::now();
-        optimizer.tell(&weights, result.reward_mps)?;
+        optimizer.tell_lap(&weights, result.reward_mps, result.failure.map(|f| f.x))?;
         let optimizer_s = optimizer_s + t2.elapsed().as_secs_f64();
         if result.reward_mps > best.1 {
             best = (policy, result.reward_mps);

@@ -9,6 +9,7 @@ pub mod cmaes;
 pub mod cmaes_ascent;
 pub mod coordinate_ascent;
 pub mod linebo;
+pub mod pattern_search;
 pub mod random;
 pub mod rembo;
 pub mod turbo;
@@ -31,6 +32,14 @@ pub trait Optimizer {
     /// The reward of a lap driven with `weights` (0 for a failed lap). Bad input — wrong
     /// dimension, non-finite weights or reward — is refused and changes nothing.
     fn tell(&mut self, weights: &[f64], reward: f64) -> Result<()>;
+
+    /// [`tell`](Optimizer::tell) with where a failed lap failed (`failed_at`, a lap fraction in
+    /// [0, 1], for a failed lap whose place is known): all a car's lap timer gives besides the
+    /// time. Methods that read the place override it; the others are told the reward.
+    fn tell_lap(&mut self, weights: &[f64], reward: f64, failed_at: Option<f64>) -> Result<()> {
+        let _ = failed_at;
+        self.tell(weights, reward)
+    }
 
     /// The best weights told so far and their reward.
     fn best(&self) -> Option<(&[f64], f64)>;
@@ -58,6 +67,8 @@ pub enum Saved {
     Turbo(Box<turbo::TurboState>),
     /// LineBO.
     Linebo(Box<linebo::LineBoState>),
+    /// Pattern search with failure repair.
+    PatternSearch(Box<pattern_search::PatternSearchState>),
 }
 
 impl Saved {
@@ -70,6 +81,7 @@ impl Saved {
             Saved::Rembo(s) => Box::new(rembo::Rembo::resume(*s)?),
             Saved::Turbo(s) => Box::new(turbo::Turbo::resume(*s)?),
             Saved::Linebo(s) => Box::new(linebo::LineBo::resume(*s)?),
+            Saved::PatternSearch(s) => Box::new(pattern_search::PatternSearch::resume(*s)?),
         })
     }
 }
@@ -84,6 +96,7 @@ pub const METHODS: &[&str] = &[
     "turbo",
     "linebo",
     "random",
+    "pattern-search",
 ];
 
 /// What every method is told besides w₀.
@@ -188,6 +201,15 @@ pub fn by_name(name: &str, w0: Vec<f64>, settings: &Settings) -> Result<Box<dyn 
                 seed,
                 sigma: sigma0,
                 box_radius,
+            },
+        )?),
+        "pattern-search" => Box::new(pattern_search::PatternSearch::new(
+            w0,
+            pattern_search::PatternSearchConfig {
+                seed,
+                sigma0,
+                box_radius,
+                repair: true,
             },
         )?),
         other => {
