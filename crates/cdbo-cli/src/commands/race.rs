@@ -19,7 +19,8 @@ pub struct RaceArgs {
     /// Policy kernels M (the paper: 10 to 100).
     #[arg(long, default_value_t = 30)]
     kernels: usize,
-    /// Optimiser: cdbo, cmaes, bo-cmaes, rembo-5d, rembo-10d, turbo, linebo, random.
+    /// Optimiser: cdbo, cmaes, bo-cmaes, rembo-5d, rembo-10d, turbo, linebo, random,
+    /// pattern-search.
     #[arg(long, default_value = "cdbo")]
     method: String,
     /// Laps (the paper: 300).

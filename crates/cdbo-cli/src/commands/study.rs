@@ -51,7 +51,8 @@ pub struct InitialPolicy {
     /// Policy length-scale (default 1/(M − 1)).
     #[arg(long)]
     lengthscale: Option<f64>,
-    /// Optimiser: cdbo, cmaes, bo-cmaes, rembo-5d, rembo-10d, turbo, linebo, random.
+    /// Optimiser: cdbo, cmaes, bo-cmaes, rembo-5d, rembo-10d, turbo, linebo, random,
+    /// pattern-search.
     #[arg(long, default_value = "cdbo")]
     method: String,
     /// Seed of every random choice.

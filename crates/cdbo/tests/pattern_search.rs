@@ -1,0 +1,118 @@
+//! The pattern search with failure repair: its repair move, its save/resume with failure
+//! places, and a lap with a cliff on which it must beat random search.
+
+use cdbo::optimizers::pattern_search::{PatternSearch, PatternSearchConfig};
+use cdbo::optimizers::{Optimizer, Saved, Settings, by_name};
+
+/// A toy lap with a cliff: D segments driven in order at speeds wᵢ; segment i takes at most
+/// cᵢ = 0.5 + 0.4·sin²(i). Too fast (wᵢ > cᵢ) or stopped (wᵢ ≤ 0.05), the car fails there, at
+/// x = i/(D − 1); otherwise the reward is the mean speed D / Σ 1/wᵢ. The optimum, wᵢ = cᵢ,
+/// lies on the cliff's edge.
+fn cliff_lap(w: &[f64]) -> (f64, Option<f64>) {
+    let last = (w.len() - 1) as f64;
+    let mut time = 0.0;
+    for (i, &v) in w.iter().enumerate() {
+        if v > cap(i) || v <= 0.05 {
+            return (0.0, Some(i as f64 / last));
+        }
+        time += 1.0 / v;
+    }
+    (w.len() as f64 / time, None)
+}
+
+fn cap(i: usize) -> f64 {
+    0.5 + 0.4 * (i as f64).sin().powi(2)
+}
+
+/// Asks and tells `evals` laps of the cliff, with the failure places; returns the asked weights.
+fn drive(opt: &mut dyn Optimizer, evals: usize) -> Vec<Vec<f64>> {
+    (0..evals)
+        .map(|_| {
+            let w = opt.ask().unwrap();
+            let (reward, at) = cliff_lap(&w);
+            opt.tell_lap(&w, reward, at).unwrap();
+            w
+        })
+        .collect()
+}
+
+/// The best reward of a method on the 20-segment cliff from wᵢ = 0.2, 200 laps.
+fn best_on_cliff(method: &str, seed: u64) -> f64 {
+    let mut opt = by_name(method, vec![0.2; 20], &Settings::race(seed, 2.0)).unwrap();
+    drive(opt.as_mut(), 200);
+    opt.best().unwrap().1
+}
+
+/// Over 10 seeds, the pattern search beats Gaussian random search around the best point (the
+/// same start, box and σ₀) on the cliff, and comes within 10 % of the optimum.
+#[test]
+fn pattern_search_beats_random_search_next_to_a_cliff() {
+    let optimum = 20.0 / (0..20).map(|i| 1.0 / cap(i)).sum::<f64>();
+    let mean = |method| (0..10).map(|s| best_on_cliff(method, s)).sum::<f64>() / 10.0;
+    let (ps, random) = (mean("pattern-search"), mean("random"));
+    eprintln!("cliff: optimum {optimum:.4}, pattern-search {ps:.4}, random {random:.4}");
+    assert!(ps > random, "pattern search {ps} <= random search {random}");
+    assert!(ps > 0.9 * optimum, "pattern search {ps}, optimum {optimum}");
+}
+
+/// A lap that fails past the moved weight is repaired: the next lap gives the step back at
+/// the kernel just before the failure; a failure at or before the moved weight is not.
+#[test]
+fn a_failed_lap_is_repaired_before_where_it_failed() {
+    let config = PatternSearchConfig {
+        sigma0: 0.1,
+        ..PatternSearchConfig::default()
+    };
+    for seed in 0..8 {
+        let mut ps = PatternSearch::new(
+            vec![0.0; 5],
+            PatternSearchConfig {
+                seed,
+                ..config.clone()
+            },
+        )
+        .unwrap();
+        let start = ps.ask().unwrap();
+        ps.tell_lap(&start, 1.0, None).unwrap();
+        let w = ps.ask().unwrap();
+        let moved = w.iter().position(|&v| v != 0.0).unwrap();
+        assert_eq!(w[moved], 0.1);
+        // A failure at x = 1 lies in kernel 4's span: kernel 3 brakes before it.
+        ps.tell_lap(&w, 0.0, Some(1.0)).unwrap();
+        let next = ps.ask().unwrap();
+        if moved < 3 {
+            let mut repair = w.clone();
+            repair[3] -= 0.1;
+            assert_eq!(next, repair, "seed {seed}");
+        } else {
+            assert_eq!(next.iter().filter(|&&v| v != 0.0).count(), 1, "{next:?}");
+            assert!(next[moved] == 0.0, "seed {seed}: {next:?}");
+        }
+    }
+}
+
+/// Same seed, same laps; a search saved mid-run (failure places told) resumes bit for bit.
+#[test]
+fn pattern_search_is_deterministic_and_resumes_exactly() {
+    let new = || by_name("pattern-search", vec![0.2; 12], &Settings::race(3, 2.0)).unwrap();
+    let (mut a, mut b) = (new(), new());
+    assert_eq!(drive(a.as_mut(), 40), drive(b.as_mut(), 40));
+    let pending = a.ask().unwrap();
+    let saved: Saved = serde_json::from_str(&serde_json::to_string(&a.save()).unwrap()).unwrap();
+    let mut resumed = saved.resume().unwrap();
+    assert_eq!(resumed.ask().unwrap(), pending);
+    assert_eq!(drive(a.as_mut(), 30), drive(resumed.as_mut(), 30));
+    assert_eq!(a.best(), resumed.best());
+}
+
+/// A failure place outside [0, 1] is refused and changes nothing.
+#[test]
+fn a_bad_failure_place_is_refused() {
+    let mut ps = by_name("pattern-search", vec![0.2; 4], &Settings::race(0, 2.0)).unwrap();
+    let w = ps.ask().unwrap();
+    let before = ps.save();
+    for at in [-0.1, 1.5, f64::NAN] {
+        assert!(ps.tell_lap(&w, 0.0, Some(at)).is_err());
+    }
+    assert_eq!(ps.save(), before);
+}
