@@ -1,0 +1,112 @@
+"""A gymnasium-style episodic environment: one step is one lap.
+
+The action is the policy's weights w (M = ``kernels`` of them), the reward the lap's
+L/T in m/s (0 when the lap fails), and every episode ends after its one lap. ``info``
+tells the lap time, whether and where the lap failed. ``env.w0`` is the demonstration's
+fitted policy, the start every method is given (``cdbo race`` starts from the same).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._cdbo import DEFAULT_BOX_RADIUS, Policy, Simulator
+
+try:
+    import gymnasium as _gym
+    from gymnasium import spaces as _spaces
+
+    _Base = _gym.Env
+except ImportError:  # a plain class without gymnasium
+    _gym = None
+    _spaces = None
+    _Base = object
+
+
+class _Box:
+    """The action box [w0 - r, w0 + r] when gymnasium is not installed."""
+
+    def __init__(self, low, high):
+        self.low = np.asarray(low, dtype=np.float64)
+        self.high = np.asarray(high, dtype=np.float64)
+        self.shape = self.low.shape
+        self.dtype = np.dtype(np.float64)
+
+    def contains(self, x):
+        x = np.asarray(x, dtype=np.float64)
+        return x.shape == self.shape and bool(np.all((x >= self.low) & (x <= self.high)))
+
+    def sample(self, rng=None):
+        rng = rng if rng is not None else np.random.default_rng()
+        return rng.uniform(self.low, self.high)
+
+
+def _box(low, high):
+    if _spaces is None:
+        return _Box(low, high)
+    return _spaces.Box(low=np.asarray(low), high=np.asarray(high), dtype=np.float64)
+
+
+class RaceEnv(_Base):
+    """Racing one track: ``RaceEnv(track="ridgeway", car="spirit-300", kernels=30)``.
+
+    ``reset()`` returns ``(obs, info)`` and ``step(w)`` returns ``(obs, reward, terminated,
+    truncated, info)`` with ``terminated=True``: each episode is one lap. The observation is
+    a constant (there is nothing to observe before a lap). ``action_space`` is the box
+    [w0 - bounds, w0 + bounds] the library's optimisers search; the weights are not clipped.
+    """
+
+    metadata = {"render_modes": []}
+
+    def __init__(
+        self,
+        track="ridgeway",
+        car="spirit-300",
+        kernels: int = 30,
+        demo_speed: float = 15.0,
+        bounds: float = DEFAULT_BOX_RADIUS,
+        data_dir=None,
+    ):
+        self.simulator = Simulator(track, car, data_dir=data_dir)
+        demo, x, a = self.simulator.demonstrate(demo_speed)
+        if not demo.completed:
+            raise ValueError(
+                f"the {demo_speed} m/s demonstration does not complete "
+                f"{self.simulator.track.name} ({demo.failure}): choose a slower demo_speed"
+            )
+        self.demo = demo
+        self.initial = Policy.fit(x, a, kernels)
+        self.w0 = self.initial.weights
+        self.lengthscale = self.initial.lengthscale
+        self.action_space = _box(self.w0 - bounds, self.w0 + bounds)
+        self.observation_space = _box(np.zeros(1), np.zeros(1))
+        self.last = None
+
+    def reset(self, *, seed=None, options=None):
+        if _gym is not None:
+            super().reset(seed=seed)
+        return np.zeros(1), {}
+
+    def step(self, action):
+        policy = Policy(np.asarray(action, dtype=np.float64), self.lengthscale)
+        lap = self.simulator.lap(policy)
+        self.last = lap
+        info = {
+            "completed": lap.completed,
+            "lap_time": lap.time,
+            "failure": lap.failure,
+            "x_fail": lap.x_fail,
+        }
+        return np.zeros(1), lap.reward, True, False, info
+
+    def lap(self, w) -> float:
+        """The reward of one lap with weights ``w`` (``step`` without the episode)."""
+        return self.step(w)[1]
+
+
+def register():
+    """Registers ``cdbo/Race-v0`` with gymnasium (raises ImportError without it)."""
+    import gymnasium
+
+    if "cdbo/Race-v0" not in gymnasium.registry:
+        gymnasium.register(id="cdbo/Race-v0", entry_point="cdbo.env:RaceEnv")

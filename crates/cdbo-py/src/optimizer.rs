@@ -1,0 +1,143 @@
+//! `cdbo.Optimizer`: every method of `cdbo race --method` behind one ask/tell object.
+
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
+
+use numpy::PyArray1;
+use pyo3::prelude::*;
+use pyo3::types::{PyBytes, PyType};
+
+use cdbo::optimizers::{DEFAULT_BOX_RADIUS, Optimizer, Saved, Settings, by_name};
+
+use crate::convert::{IntoPy, array, lock, vector};
+
+/// An ask/tell optimiser of rewards over weights, started from w0.
+///
+/// `Optimizer(method, w0, seed=0, beta=1.0, bounds=1.5, sigma0=0.03)`: `method` is one of
+/// `cdbo.METHODS`; the weights are searched in the box [w0 - bounds, w0 + bounds]; `sigma0`
+/// is the exploration scale around w0 (CDBO's initial samples, the evolution strategies'
+/// step). The defaults are `cdbo race`'s, so the same seed asks the same weights.
+#[pyclass(name = "Optimizer", module = "cdbo")]
+pub struct PyOptimizer {
+    inner: Mutex<Box<dyn Optimizer + Send>>,
+    /// Seconds the library spent in the last `ask` (f64 bits), for the binding's overhead.
+    last_ask_s: AtomicU64,
+}
+
+impl PyOptimizer {
+    fn wrap(inner: Box<dyn Optimizer + Send>) -> Self {
+        PyOptimizer {
+            inner: Mutex::new(inner),
+            last_ask_s: AtomicU64::new(0),
+        }
+    }
+}
+
+#[pymethods]
+impl PyOptimizer {
+    #[new]
+    #[pyo3(signature = (method, w0, *, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, bounds = DEFAULT_BOX_RADIUS, sigma0 = None))]
+    fn new(
+        py: Python<'_>,
+        method: &str,
+        w0: &Bound<'_, PyAny>,
+        seed: u64,
+        beta: f64,
+        bounds: f64,
+        sigma0: Option<f64>,
+    ) -> PyResult<Self> {
+        let w0 = vector(w0, "w0")?;
+        let race = Settings::race(seed, beta);
+        let settings = Settings {
+            box_radius: bounds,
+            sigma0: sigma0.unwrap_or(race.sigma0),
+            ..race
+        };
+        let inner = py.detach(|| by_name(method, w0, &settings)).py()?;
+        Ok(PyOptimizer::wrap(inner))
+    }
+
+    /// The weights of the next evaluation (the same until they are told).
+    fn ask<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let w = py.detach(|| {
+            let mut inner = lock(&self.inner)?;
+            let t0 = Instant::now();
+            let w = inner.ask();
+            let seconds = t0.elapsed().as_secs_f64();
+            self.last_ask_s.store(seconds.to_bits(), Ordering::Relaxed);
+            w.py()
+        })?;
+        Ok(array(py, w))
+    }
+
+    /// Seconds the library itself spent choosing the weights in the last `ask` (the rest of
+    /// the call's time is the binding's: `bench/ask_overhead.py` measures it).
+    #[getter]
+    fn last_ask_s(&self) -> f64 {
+        f64::from_bits(self.last_ask_s.load(Ordering::Relaxed))
+    }
+
+    /// Tells the reward of `w` (0 for a failed lap).
+    fn tell(&self, py: Python<'_>, w: &Bound<'_, PyAny>, reward: f64) -> PyResult<()> {
+        let w = vector(w, "w")?;
+        py.detach(|| lock(&self.inner)?.tell(&w, reward).py())
+    }
+
+    /// The best (weights, reward) told so far, or None.
+    #[getter]
+    fn best<'py>(&self, py: Python<'py>) -> PyResult<Option<(Bound<'py, PyArray1<f64>>, f64)>> {
+        let inner = lock(&self.inner)?;
+        Ok(inner.best().map(|(w, r)| (array(py, w.to_vec()), r)))
+    }
+
+    /// The method's name.
+    #[getter]
+    fn method(&self) -> PyResult<&'static str> {
+        Ok(lock(&self.inner)?.name())
+    }
+
+    /// Number of weights.
+    #[getter]
+    fn dim(&self) -> PyResult<usize> {
+        Ok(lock(&self.inner)?.dim())
+    }
+
+    /// Number of rewards told.
+    #[getter]
+    fn evaluations(&self) -> PyResult<usize> {
+        Ok(lock(&self.inner)?.evaluations())
+    }
+
+    /// The whole state as bytes (JSON); `Optimizer.load` continues exactly from it.
+    fn save<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
+        let saved = lock(&self.inner)?.save();
+        let json = py
+            .detach(|| serde_json::to_vec(&saved))
+            .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
+        Ok(PyBytes::new(py, &json))
+    }
+
+    /// The optimiser saved by `save()`.
+    #[classmethod]
+    fn load(_cls: &Bound<'_, PyType>, py: Python<'_>, state: &[u8]) -> PyResult<Self> {
+        let inner = py
+            .detach(|| {
+                let saved: Saved = serde_json::from_slice(state)
+                    .map_err(|e| cdbo::Error::Domain(format!("not a saved cdbo optimiser: {e}")))?;
+                saved.resume()
+            })
+            .py()?;
+        Ok(PyOptimizer::wrap(inner))
+    }
+
+    fn __repr__(&self) -> PyResult<String> {
+        let inner = lock(&self.inner)?;
+        Ok(format!(
+            "Optimizer({:?}, dim={}, evaluations={})",
+            inner.name(),
+            inner.dim(),
+            inner.evaluations()
+        ))
+    }
+}

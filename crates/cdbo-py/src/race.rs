@@ -1,0 +1,144 @@
+//! `cdbo.race`: the library's own race loop (`cdbo race`), from Python.
+
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+
+use cdbo::experiment::race::{LapRecord, RaceConfig, RaceOutcome};
+
+use crate::convert::IntoPy;
+use crate::sim::{PyLapResult, PyLimit, PyPolicy, car_from, track_from};
+
+/// A lap record as a dict: lap, reward, best, lap_time, failure, x_fail, optimizer_s,
+/// simulator_s.
+fn record<'py>(py: Python<'py>, r: &LapRecord) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("lap", r.lap)?;
+    d.set_item("reward", r.reward_mps)?;
+    d.set_item("best", r.best_mps)?;
+    d.set_item("lap_time", r.lap_time_s)?;
+    d.set_item("failure", r.failure.map(|f| f.name()))?;
+    d.set_item("x_fail", r.x_fail)?;
+    d.set_item("optimizer_s", r.optimizer_s)?;
+    d.set_item("simulator_s", r.simulator_s)?;
+    Ok(d)
+}
+
+/// What a race produced: `best_reward` (m/s) and the `best` policy, the `initial` policy
+/// fitted to the `demo` lap, every lap's record in `laps` (a list of dicts), and the `limit`.
+#[pyclass(name = "RaceResult", module = "cdbo", frozen)]
+pub struct PyRaceResult {
+    outcome: RaceOutcome,
+    demo: Py<PyLapResult>,
+    limit: Py<PyLimit>,
+}
+
+#[pymethods]
+impl PyRaceResult {
+    #[getter]
+    fn best_reward(&self) -> f64 {
+        self.outcome.best_reward_mps
+    }
+
+    #[getter]
+    fn best(&self) -> PyPolicy {
+        PyPolicy {
+            policy: self.outcome.best.clone(),
+        }
+    }
+
+    #[getter]
+    fn initial(&self) -> PyPolicy {
+        PyPolicy {
+            policy: self.outcome.initial.clone(),
+        }
+    }
+
+    #[getter]
+    fn demo(&self, py: Python<'_>) -> Py<PyLapResult> {
+        self.demo.clone_ref(py)
+    }
+
+    #[getter]
+    fn limit(&self, py: Python<'_>) -> Py<PyLimit> {
+        self.limit.clone_ref(py)
+    }
+
+    #[getter]
+    fn laps<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        let list = PyList::empty(py);
+        for r in &self.outcome.laps {
+            list.append(record(py, r)?)?;
+        }
+        Ok(list)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "RaceResult(best_reward={:.4} m/s, laps={}, limit={:.4} m/s)",
+            self.outcome.best_reward_mps,
+            self.outcome.laps.len(),
+            self.outcome.limit.reward_mps
+        )
+    }
+}
+
+/// Learns a policy for a track exactly as `cdbo race` does (the same laps, bit for bit, for
+/// the same settings): drive the demonstration, fit w0, then `laps` laps of `method`.
+/// `track` and `car` are objects or names; `progress(record)` is called after every lap with
+/// the lap's record (a dict).
+#[pyfunction]
+#[pyo3(signature = (track = None, car = None, *, method = "cdbo", kernels = 30, laps = 300, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, demo_speed = 15.0, data_dir = None, progress = None))]
+#[allow(clippy::too_many_arguments)]
+pub fn race(
+    py: Python<'_>,
+    track: Option<&Bound<'_, PyAny>>,
+    car: Option<&Bound<'_, PyAny>>,
+    method: &str,
+    kernels: usize,
+    laps: usize,
+    seed: u64,
+    beta: f64,
+    demo_speed: f64,
+    data_dir: Option<&Bound<'_, PyAny>>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<PyRaceResult> {
+    let track = track_from(py, track, data_dir)?;
+    let car = car_from(car, data_dir)?;
+    let config = RaceConfig {
+        method: method.to_owned(),
+        kernels,
+        laps,
+        seed,
+        beta,
+        demo_speed,
+    };
+    let mut callback_error: Option<PyErr> = None;
+    let outcome = py
+        .detach(|| {
+            cdbo::experiment::race::race(track, &car, &config, |r| {
+                if let (Some(cb), None) = (&progress, &callback_error) {
+                    Python::attach(|py| {
+                        if let Err(e) = record(py, r).and_then(|d| cb.call1(py, (d,))) {
+                            callback_error = Some(e);
+                        }
+                    });
+                }
+            })
+        })
+        .py()?;
+    if let Some(e) = callback_error {
+        return Err(e);
+    }
+    let demo = Py::new(py, PyLapResult::new(py, outcome.demo.clone(), false)?)?;
+    let limit = Py::new(
+        py,
+        PyLimit {
+            limit: outcome.limit.clone(),
+        },
+    )?;
+    Ok(PyRaceResult {
+        outcome,
+        demo,
+        limit,
+    })
+}

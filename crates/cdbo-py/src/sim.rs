@@ -1,0 +1,490 @@
+//! Tracks, cars, the simulator, the policy and the limit lap.
+
+use std::path::PathBuf;
+
+use numpy::PyArray1;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyType};
+
+use cdbo::car::Car;
+use cdbo::experiment::race::demonstrate;
+use cdbo::limit::{Limit, limit_lap};
+use cdbo::policy::RkhsPolicy;
+use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
+use cdbo::sim::{LapResult, Simulator};
+use cdbo::track::Track;
+
+use crate::convert::{Array, Column, IntoPy, array, columns, data_path, vector};
+
+/// A name or a path given as `str` or `os.PathLike`.
+fn spec(obj: &Bound<'_, PyAny>) -> PyResult<String> {
+    match obj.extract::<String>() {
+        Ok(s) => Ok(s),
+        Err(_) => Ok(obj.extract::<PathBuf>()?.to_string_lossy().into_owned()),
+    }
+}
+
+/// A track given as a `Track`, a name or path, or None (the built-in default, Ridgeway).
+pub fn track_from(
+    py: Python<'_>,
+    obj: Option<&Bound<'_, PyAny>>,
+    data_dir: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Track> {
+    let spec = match obj {
+        Some(o) if o.is_none() => cdbo::track::builtin::DEFAULT.to_owned(),
+        Some(o) => match o.cast::<PyTrack>() {
+            Ok(t) => return Ok(t.get().track.clone()),
+            Err(_) => spec(o)?,
+        },
+        None => cdbo::track::builtin::DEFAULT.to_owned(),
+    };
+    let data = data_path(data_dir)?;
+    py.detach(|| cdbo::track::catalog::find(&spec, &data)).py()
+}
+
+/// A car given as a `Car`, a name or path, or None (the built-in default, spirit-300).
+pub fn car_from(
+    obj: Option<&Bound<'_, PyAny>>,
+    data_dir: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Car> {
+    let spec = match obj {
+        Some(o) if o.is_none() => cdbo::car::catalog::DEFAULT.to_owned(),
+        Some(o) => match o.cast::<PyCar>() {
+            Ok(c) => return Ok(c.get().car.clone()),
+            Err(_) => spec(o)?,
+        },
+        None => cdbo::car::catalog::DEFAULT.to_owned(),
+    };
+    cdbo::car::catalog::find(&spec, &data_path(data_dir)?).py()
+}
+
+/// A race track.
+///
+/// `Track.load(name_or_path, data_dir=None)`: a built-in name (`ridgeway`), a TORCS `.xml` or
+/// TUMFTM `.csv` file, or a track name in the data folders (`forza`), as `cdbo race --track`.
+#[pyclass(name = "Track", module = "cdbo", frozen)]
+#[derive(Clone)]
+pub struct PyTrack {
+    pub track: Track,
+}
+
+#[pymethods]
+impl PyTrack {
+    #[classmethod]
+    #[pyo3(signature = (name_or_path = None, data_dir = None))]
+    fn load(
+        _cls: &Bound<'_, PyType>,
+        py: Python<'_>,
+        name_or_path: Option<&Bound<'_, PyAny>>,
+        data_dir: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        Ok(PyTrack {
+            track: track_from(py, name_or_path, data_dir)?,
+        })
+    }
+
+    /// The built-in tracks' names.
+    #[staticmethod]
+    fn builtin() -> Vec<&'static str> {
+        cdbo::track::builtin::names().collect()
+    }
+
+    /// The track's name.
+    #[getter]
+    fn name(&self) -> &str {
+        &self.track.name
+    }
+
+    /// Where it was read from.
+    #[getter]
+    fn source(&self) -> &str {
+        &self.track.source
+    }
+
+    /// Centre-line length (m).
+    #[getter]
+    fn length(&self) -> f64 {
+        self.track.length
+    }
+
+    /// What was odd about the file (unclosed loop, unknown elements).
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.track.warnings.clone()
+    }
+
+    /// The centre line at every sample: `s`, `x`, `y`, `z`, `heading`, `curvature`, `width`
+    /// (m, rad, 1/m) as NumPy arrays.
+    fn centre_line<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let cols: [Column<cdbo::track::Sample>; 7] = [
+            ("s", |p| p.s),
+            ("x", |p| p.x),
+            ("y", |p| p.y),
+            ("z", |p| p.z),
+            ("heading", |p| p.heading),
+            ("curvature", |p| p.curvature),
+            ("width", |p| p.width),
+        ];
+        columns(py, &self.track.samples, &cols)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Track({:?}, length={:.1} m, source={:?})",
+            self.track.name, self.track.length, self.track.source
+        )
+    }
+}
+
+/// A car.
+///
+/// `Car.load(name_or_path="spirit-300", data_dir=None)`: the built-in `spirit-300`, a TORCS /
+/// Speed Dreams car `.xml`, or a car name in the data folders, as `cdbo race --car`.
+#[pyclass(name = "Car", module = "cdbo", frozen)]
+#[derive(Clone)]
+pub struct PyCar {
+    pub car: Car,
+}
+
+#[pymethods]
+impl PyCar {
+    #[classmethod]
+    #[pyo3(signature = (name_or_path = None, data_dir = None))]
+    fn load(
+        _cls: &Bound<'_, PyType>,
+        name_or_path: Option<&Bound<'_, PyAny>>,
+        data_dir: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        Ok(PyCar {
+            car: car_from(name_or_path, data_dir)?,
+        })
+    }
+
+    /// The car's name.
+    #[getter]
+    fn name(&self) -> &str {
+        &self.car.name
+    }
+
+    /// Mass with driver and fuel (kg).
+    #[getter]
+    fn mass(&self) -> f64 {
+        self.car.mass
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Car({:?}, mass={:.0} kg)", self.car.name, self.car.mass)
+    }
+}
+
+/// A policy π(x) = clamp(wᵀφ(x), −1, 1) over Matérn-3/2 kernels at M evenly spaced points
+/// of the lap fraction x (the paper's eq. 2–7).
+///
+/// `Policy(weights, lengthscale=None)` (default length-scale 1/(M − 1)), or
+/// `Policy.fit(x, a, kernels)`: the ridge fit of a demonstration's (x, a) pairs (eq. 9).
+#[pyclass(name = "Policy", module = "cdbo", frozen)]
+#[derive(Clone)]
+pub struct PyPolicy {
+    pub policy: RkhsPolicy,
+}
+
+#[pymethods]
+impl PyPolicy {
+    #[new]
+    #[pyo3(signature = (weights, lengthscale = None))]
+    fn new(weights: &Bound<'_, PyAny>, lengthscale: Option<f64>) -> PyResult<Self> {
+        let w = vector(weights, "weights")?;
+        let l = lengthscale.unwrap_or_else(|| default_lengthscale(w.len()));
+        Ok(PyPolicy {
+            policy: RkhsPolicy::new(w, l).py()?,
+        })
+    }
+
+    /// The ridge fit w₀ = (ΦᵀΦ + λI)⁻¹Φᵀa of (x, a) pairs with M = `kernels`.
+    #[classmethod]
+    #[pyo3(signature = (x, a, kernels, *, lengthscale = None, ridge = DEFAULT_RIDGE))]
+    fn fit(
+        _cls: &Bound<'_, PyType>,
+        py: Python<'_>,
+        x: &Bound<'_, PyAny>,
+        a: &Bound<'_, PyAny>,
+        kernels: usize,
+        lengthscale: Option<f64>,
+        ridge: f64,
+    ) -> PyResult<Self> {
+        let (x, a) = (vector(x, "x")?, vector(a, "a")?);
+        if x.len() != a.len() {
+            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "x and a must have the same length, got {} and {}",
+                x.len(),
+                a.len()
+            )));
+        }
+        let pairs: Vec<(f64, f64)> = x.into_iter().zip(a).collect();
+        let l = lengthscale.unwrap_or_else(|| default_lengthscale(kernels));
+        let policy = py
+            .detach(|| RkhsPolicy::fit(&pairs, kernels, l, ridge))
+            .py()?;
+        Ok(PyPolicy { policy })
+    }
+
+    /// The weights w.
+    #[getter]
+    fn weights<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        array(py, self.policy.weights.clone())
+    }
+
+    /// The kernels' length-scale l.
+    #[getter]
+    fn lengthscale(&self) -> f64 {
+        self.policy.lengthscale
+    }
+
+    /// Number of kernels M.
+    #[getter]
+    fn kernels(&self) -> usize {
+        self.policy.kernels()
+    }
+
+    /// π(x) at each lap fraction of `x` (a number or an array).
+    fn action<'py>(&self, py: Python<'py>, x: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        if let Ok(v) = x.extract::<f64>() {
+            return Ok(self.policy.action(v).into_pyobject(py)?.into_any());
+        }
+        let xs = vector(x, "x")?;
+        let a = xs.iter().map(|&v| self.policy.action(v)).collect();
+        Ok(array(py, a).into_any())
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Policy(kernels={}, lengthscale={})",
+            self.policy.kernels(),
+            self.policy.lengthscale
+        )
+    }
+}
+
+/// What a lap produced: `completed`, `time` (s, None if it failed), `reward` = L/T (m/s, 0 on
+/// failure), `failure` (`off_track`, `spun`, `backwards`, `stalled`, `time_limit` or None) and
+/// where (`x_fail`, lap fraction), and the `trace` when asked for: a dict of NumPy arrays, one
+/// entry per driver step (t, distance_m, x, speed, pedal, steer, lateral, heading_error,
+/// slip_angle, gear, rpm, pos_x, pos_y).
+#[pyclass(name = "LapResult", module = "cdbo", frozen)]
+pub struct PyLapResult {
+    lap: LapResult,
+    trace: Option<Py<PyDict>>,
+}
+
+impl PyLapResult {
+    pub fn new(py: Python<'_>, lap: LapResult, with_trace: bool) -> PyResult<Self> {
+        let trace = if with_trace {
+            let cols: [Column<cdbo::sim::TracePoint>; 13] = [
+                ("t", |p| p.t),
+                ("distance_m", |p| p.distance_m),
+                ("x", |p| p.x),
+                ("speed", |p| p.speed),
+                ("pedal", |p| p.pedal),
+                ("steer", |p| p.steer),
+                ("lateral", |p| p.lateral),
+                ("heading_error", |p| p.heading_error),
+                ("slip_angle", |p| p.slip_angle),
+                ("gear", |p| p.gear as f64),
+                ("rpm", |p| p.rpm),
+                ("pos_x", |p| p.pos_x),
+                ("pos_y", |p| p.pos_y),
+            ];
+            Some(columns(py, &lap.trace, &cols)?.unbind())
+        } else {
+            None
+        };
+        Ok(PyLapResult { lap, trace })
+    }
+}
+
+#[pymethods]
+impl PyLapResult {
+    #[getter]
+    fn completed(&self) -> bool {
+        self.lap.completed
+    }
+
+    #[getter]
+    fn time(&self) -> Option<f64> {
+        self.lap.lap_time_s
+    }
+
+    #[getter]
+    fn reward(&self) -> f64 {
+        self.lap.reward_mps
+    }
+
+    #[getter]
+    fn failure(&self) -> Option<&'static str> {
+        self.lap.failure.map(|f| f.reason.name())
+    }
+
+    #[getter]
+    fn x_fail(&self) -> Option<f64> {
+        self.lap.failure.map(|f| f.x)
+    }
+
+    /// Simulated time (s).
+    #[getter]
+    fn simulated_s(&self) -> f64 {
+        self.lap.simulated_s
+    }
+
+    #[getter]
+    fn trace(&self, py: Python<'_>) -> Option<Py<PyDict>> {
+        self.trace.as_ref().map(|t| t.clone_ref(py))
+    }
+
+    fn __repr__(&self) -> String {
+        match (self.lap.lap_time_s, self.lap.failure) {
+            (Some(t), _) => format!(
+                "LapResult(time={t:.3} s, reward={:.3} m/s)",
+                self.lap.reward_mps
+            ),
+            (_, Some(f)) => format!(
+                "LapResult(failure={:?}, x_fail={:.3})",
+                f.reason.name(),
+                f.x
+            ),
+            _ => "LapResult(failed)".into(),
+        }
+    }
+}
+
+/// A track and a car, ready to run laps: `Simulator(track, car)`.
+#[pyclass(name = "Simulator", module = "cdbo", frozen)]
+pub struct PySimulator {
+    pub sim: Simulator,
+}
+
+#[pymethods]
+impl PySimulator {
+    #[new]
+    #[pyo3(signature = (track = None, car = None, *, data_dir = None))]
+    fn new(
+        py: Python<'_>,
+        track: Option<&Bound<'_, PyAny>>,
+        car: Option<&Bound<'_, PyAny>>,
+        data_dir: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let track = track_from(py, track, data_dir)?;
+        let car = car_from(car, data_dir)?;
+        Ok(PySimulator {
+            sim: Simulator::new(track, &car),
+        })
+    }
+
+    /// One lap with `policy`; `trace=True` records every driver step.
+    #[pyo3(signature = (policy, *, trace = false))]
+    fn lap(
+        &self,
+        py: Python<'_>,
+        policy: PyRef<'_, PyPolicy>,
+        trace: bool,
+    ) -> PyResult<PyLapResult> {
+        let policy = policy.policy.clone();
+        let lap = py.detach(|| {
+            if trace {
+                let mut sim = self.sim.clone();
+                sim.config.trace = true;
+                sim.lap(&mut policy.pedal())
+            } else {
+                self.sim.lap(&mut policy.pedal())
+            }
+        });
+        PyLapResult::new(py, lap, trace)
+    }
+
+    /// The demonstrator's lap at `speed` (m/s) and its (x, a) pairs as two arrays: what
+    /// `Policy.fit` turns into w0.
+    #[pyo3(signature = (speed = 15.0))]
+    fn demonstrate<'py>(
+        &self,
+        py: Python<'py>,
+        speed: f64,
+    ) -> PyResult<(PyLapResult, Array<'py>, Array<'py>)> {
+        let (lap, pairs) = py.detach(|| demonstrate(&self.sim, speed));
+        let (x, a) = pairs.into_iter().unzip();
+        Ok((
+            PyLapResult::new(py, lap, false)?,
+            array(py, x),
+            array(py, a),
+        ))
+    }
+
+    /// The track.
+    #[getter]
+    fn track(&self) -> PyTrack {
+        PyTrack {
+            track: self.sim.track.clone(),
+        }
+    }
+
+    /// The car.
+    #[getter]
+    fn car(&self) -> PyCar {
+        PyCar {
+            car: self.sim.vehicle.car.clone(),
+        }
+    }
+
+    /// A lap's time limit (s).
+    #[getter]
+    fn time_limit(&self) -> f64 {
+        self.sim.time_limit()
+    }
+}
+
+/// The quasi-steady-state limit lap: `time` (s), `reward` = L/T (m/s) and the limit `speed`
+/// at every track sample (m/s).
+#[pyclass(name = "Limit", module = "cdbo", frozen)]
+pub struct PyLimit {
+    pub limit: Limit,
+}
+
+#[pymethods]
+impl PyLimit {
+    #[getter]
+    fn time(&self) -> f64 {
+        self.limit.lap_time_s
+    }
+
+    #[getter]
+    fn reward(&self) -> f64 {
+        self.limit.reward_mps
+    }
+
+    #[getter]
+    fn speed<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        array(py, self.limit.speed.clone())
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Limit(time={:.3} s, reward={:.3} m/s)",
+            self.limit.lap_time_s, self.limit.reward_mps
+        )
+    }
+}
+
+/// The physical limit of `car` on `track` (objects or names): no lap of the simulator beats
+/// it.
+#[pyfunction]
+#[pyo3(signature = (track = None, car = None, *, data_dir = None))]
+pub fn limit(
+    py: Python<'_>,
+    track: Option<&Bound<'_, PyAny>>,
+    car: Option<&Bound<'_, PyAny>>,
+    data_dir: Option<&Bound<'_, PyAny>>,
+) -> PyResult<PyLimit> {
+    let track = track_from(py, track, data_dir)?;
+    let car = car_from(car, data_dir)?;
+    Ok(PyLimit {
+        limit: py.detach(|| limit_lap(&track, &car)),
+    })
+}

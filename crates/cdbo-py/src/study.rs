@@ -1,0 +1,229 @@
+//! `cdbo.Study`: a persistent ask/tell study in the same SQLite file as `cdbo study`.
+
+use std::path::PathBuf;
+use std::sync::Mutex;
+
+use numpy::PyArray1;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList, PyType};
+
+use cdbo::policy::rkhs::default_lengthscale;
+use cdbo::study::{Outcome, Study, StudyConfig, Trial};
+
+use crate::convert::{IntoPy, array, lock, vector};
+
+/// One trial of a study: `id`, the `weights` to drive, and once told its `reward`,
+/// `lap_time` (s), `failure` and `x_fail`.
+#[pyclass(name = "Trial", module = "cdbo", frozen)]
+pub struct PyTrial {
+    trial: Trial,
+}
+
+#[pymethods]
+impl PyTrial {
+    #[getter]
+    fn id(&self) -> i64 {
+        self.trial.id
+    }
+
+    #[getter]
+    fn weights<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        array(py, self.trial.weights.clone())
+    }
+
+    #[getter]
+    fn reward(&self) -> Option<f64> {
+        self.trial.reward
+    }
+
+    #[getter]
+    fn lap_time(&self) -> Option<f64> {
+        self.trial.lap_time_s
+    }
+
+    #[getter]
+    fn failure(&self) -> Option<&str> {
+        self.trial.failure.as_deref()
+    }
+
+    #[getter]
+    fn x_fail(&self) -> Option<f64> {
+        self.trial.x_fail
+    }
+
+    fn __repr__(&self) -> String {
+        match self.trial.reward {
+            Some(r) => format!("Trial(id={}, reward={r})", self.trial.id),
+            None => format!("Trial(id={}, pending)", self.trial.id),
+        }
+    }
+}
+
+/// A persistent ask/tell study: one SQLite file, the same as `cdbo study` reads and writes,
+/// so a study created here can be driven by the command line and back.
+///
+/// `Study.create(path, w0, method="cdbo", lengthscale=None, seed=0, beta=1.0)` (M = len(w0)
+/// kernels, length-scale 1/(M − 1) by default), `Study.open(path)`; then `ask()` → `Trial`,
+/// `tell(trial, reward)`, `tell(trial, lap_time=T, length=L)` or `tell(trial, failed=True,
+/// at=x, reason=...)`; every told result is on disk when `tell` returns.
+#[pyclass(name = "Study", module = "cdbo")]
+pub struct PyStudy {
+    study: Mutex<Study>,
+}
+
+#[pymethods]
+impl PyStudy {
+    #[classmethod]
+    #[pyo3(signature = (path, w0, *, method = "cdbo", lengthscale = None, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA))]
+    #[allow(clippy::too_many_arguments)]
+    fn create(
+        _cls: &Bound<'_, PyType>,
+        py: Python<'_>,
+        path: PathBuf,
+        w0: &Bound<'_, PyAny>,
+        method: &str,
+        lengthscale: Option<f64>,
+        seed: u64,
+        beta: f64,
+    ) -> PyResult<Self> {
+        let w0 = vector(w0, "w0")?;
+        let config = StudyConfig {
+            method: method.to_owned(),
+            kernels: w0.len(),
+            lengthscale: lengthscale.unwrap_or_else(|| default_lengthscale(w0.len())),
+            seed,
+            beta,
+            w0,
+        };
+        let study = py.detach(|| Study::create(&path, config)).py()?;
+        Ok(PyStudy {
+            study: Mutex::new(study),
+        })
+    }
+
+    /// Opens an existing study file.
+    #[classmethod]
+    fn open(_cls: &Bound<'_, PyType>, py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        let study = py.detach(|| Study::open(&path)).py()?;
+        Ok(PyStudy {
+            study: Mutex::new(study),
+        })
+    }
+
+    /// The trial to drive next: the pending one if any, else a new suggestion.
+    fn ask(&self, py: Python<'_>) -> PyResult<PyTrial> {
+        let trial = py.detach(|| lock(&self.study)?.ask().py())?;
+        Ok(PyTrial { trial })
+    }
+
+    /// Records trial `trial` (a `Trial` or its id): a `reward`, or a completed lap's
+    /// `lap_time` (s) and `length` (m), or `failed=True` (reward 0) with where (`at`, lap
+    /// fraction) and why (`reason`). Returns the reward; durable on return.
+    #[pyo3(signature = (trial, reward = None, *, lap_time = None, length = None, failed = false, at = None, reason = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn tell(
+        &self,
+        py: Python<'_>,
+        trial: &Bound<'_, PyAny>,
+        reward: Option<f64>,
+        lap_time: Option<f64>,
+        length: Option<f64>,
+        failed: bool,
+        at: Option<f64>,
+        reason: Option<String>,
+    ) -> PyResult<f64> {
+        let id = match trial.cast::<PyTrial>() {
+            Ok(t) => t.get().trial.id,
+            Err(_) => trial
+                .extract::<i64>()
+                .map_err(|_| PyValueError::new_err("trial must be a Trial or a trial id"))?,
+        };
+        if !failed && (at.is_some() || reason.is_some()) {
+            return Err(PyValueError::new_err(
+                "at= and reason= describe a failed lap: give them with failed=True",
+            ));
+        }
+        let outcome = match (reward, lap_time, length, failed) {
+            (Some(r), None, None, false) => Outcome::Reward(r),
+            (None, Some(time_s), Some(length_m), false) => Outcome::Lap { time_s, length_m },
+            (None, None, None, true) => Outcome::Failed { at, reason },
+            _ => {
+                return Err(PyValueError::new_err(
+                    "tell one of: a reward, lap_time= and length=, or failed=True",
+                ));
+            }
+        };
+        py.detach(|| lock(&self.study)?.tell(id, &outcome).py())
+    }
+
+    /// The told trial with the highest reward, or None.
+    #[getter]
+    fn best(&self, py: Python<'_>) -> PyResult<Option<PyTrial>> {
+        let best = py.detach(|| lock(&self.study)?.best().py())?;
+        Ok(best.map(|trial| PyTrial { trial }))
+    }
+
+    /// Number of told trials.
+    #[getter]
+    fn told(&self) -> PyResult<usize> {
+        lock(&self.study)?.told().py()
+    }
+
+    /// The study's settings as a dict (method, kernels, lengthscale, seed, beta, w0).
+    #[getter]
+    fn config<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let c = lock(&self.study)?.config().clone();
+        let d = PyDict::new(py);
+        d.set_item("method", c.method)?;
+        d.set_item("kernels", c.kernels)?;
+        d.set_item("lengthscale", c.lengthscale)?;
+        d.set_item("seed", c.seed)?;
+        d.set_item("beta", c.beta)?;
+        d.set_item("w0", array(py, c.w0))?;
+        Ok(d)
+    }
+
+    /// The study file.
+    #[getter]
+    fn path(&self) -> PyResult<PathBuf> {
+        Ok(lock(&self.study)?.path().to_owned())
+    }
+
+    /// Every trial in asking order: a pandas DataFrame when pandas is installed (and
+    /// `as_frame` is not False), else a list of dicts; columns id, weights, reward,
+    /// lap_time, failure, x_fail.
+    #[pyo3(signature = (*, as_frame = None))]
+    fn history<'py>(&self, py: Python<'py>, as_frame: Option<bool>) -> PyResult<Bound<'py, PyAny>> {
+        let trials = py.detach(|| lock(&self.study)?.history().py())?;
+        let list = PyList::empty(py);
+        for t in trials {
+            let d = PyDict::new(py);
+            d.set_item("id", t.id)?;
+            d.set_item("weights", array(py, t.weights))?;
+            d.set_item("reward", t.reward)?;
+            d.set_item("lap_time", t.lap_time_s)?;
+            d.set_item("failure", t.failure)?;
+            d.set_item("x_fail", t.x_fail)?;
+            list.append(d)?;
+        }
+        if as_frame == Some(false) {
+            return Ok(list.into_any());
+        }
+        match py.import("pandas") {
+            Ok(pandas) => pandas.getattr("DataFrame")?.call1((list,)),
+            Err(e) if as_frame == Some(true) => Err(e),
+            Err(_) => Ok(list.into_any()),
+        }
+    }
+
+    fn __repr__(&self) -> PyResult<String> {
+        let s = lock(&self.study)?;
+        Ok(format!(
+            "Study({:?}, method={:?}, kernels={})",
+            s.path().display().to_string(),
+            s.config().method,
+            s.config().kernels
+        ))
+    }
+}

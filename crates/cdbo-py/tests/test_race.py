@@ -1,0 +1,75 @@
+"""The race loop: cdbo.race and a Python loop over Optimizer + RaceEnv give the command line's
+results bit for bit."""
+
+import json
+
+import numpy as np
+import pytest
+
+import cdbo
+
+
+def test_race_ridgeway_300_laps_is_the_clis_race_bit_for_bit(cli, tmp_path):
+    summary = json.loads(cli("race", "--json", "--laps", 300, "--seed", 0, "--out", tmp_path))
+    result = cdbo.race("ridgeway", laps=300, seed=0)
+    assert result.best_reward == summary["best_reward_mps"]
+    assert result.demo.reward == summary["demo_reward_mps"]
+    assert result.limit.reward == summary["limit_reward_mps"]
+    assert sum(lap["failure"] is not None for lap in result.laps) == summary["failed_laps"]
+
+
+def test_a_python_loop_over_optimizer_and_env_is_the_librarys_race():
+    laps = 40
+    result = cdbo.race("ridgeway", method="cdbo", kernels=20, laps=laps, seed=5)
+    env = cdbo.RaceEnv("ridgeway", kernels=20)
+    assert np.array_equal(env.w0, result.initial.weights)
+    opt = cdbo.Optimizer("cdbo", env.w0, seed=5)
+    rewards = []
+    for _ in range(laps):
+        env.reset()
+        w = opt.ask()
+        _, reward, terminated, truncated, info = env.step(w)
+        assert terminated and not truncated
+        assert (info["failure"] is None) == info["completed"]
+        opt.tell(w, reward)
+        rewards.append(reward)
+    assert rewards == [lap["reward"] for lap in result.laps]
+    assert opt.best[1] == result.best_reward
+    # The best policy drives the best lap again.
+    assert cdbo.Simulator("ridgeway").lap(result.best).reward == result.best_reward
+
+
+def test_progress_is_called_after_every_lap_and_its_errors_propagate():
+    seen = []
+    result = cdbo.race(laps=5, kernels=10, progress=seen.append)
+    assert [r["lap"] for r in seen] == [1, 2, 3, 4, 5]
+    assert seen == result.laps
+    assert seen[-1]["best"] == result.best_reward
+
+    def fail(record):
+        raise RuntimeError(f"stop at lap {record['lap']}")
+
+    with pytest.raises(RuntimeError, match="stop at lap 1"):
+        cdbo.race(laps=3, kernels=10, progress=fail)
+
+
+def test_race_refuses_bad_settings():
+    with pytest.raises(ValueError, match="at least one lap"):
+        cdbo.race(laps=0)
+    with pytest.raises(ValueError, match="unknown method"):
+        cdbo.race(method="nope", laps=2)
+    with pytest.raises(ValueError, match="demonstration does not complete"):
+        cdbo.race(demo_speed=80.0, laps=2)
+
+
+def test_the_environment_works_without_gymnasium_and_registers_with_it():
+    env = cdbo.RaceEnv(kernels=10)
+    assert env.action_space.shape == (10,)
+    assert np.array_equal(env.action_space.low, env.w0 - cdbo.DEFAULT_BOX_RADIUS)
+    obs, info = env.reset(seed=0)
+    _, reward, *_ = env.step(env.w0)
+    assert reward == cdbo.Simulator().lap(cdbo.Policy(env.w0, env.lengthscale)).reward
+    gymnasium = pytest.importorskip("gymnasium")
+    made = gymnasium.make("cdbo/Race-v0", kernels=10)
+    made.reset(seed=0)
+    assert made.step(env.w0)[1] == reward

@@ -1,0 +1,99 @@
+"""cdbo.Study: the same SQLite file as `cdbo study`, driven from Python and the command line."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+import cdbo
+
+
+def test_a_study_written_in_python_is_read_and_driven_by_the_cli_and_back(cli, tmp_path):
+    db = tmp_path / "car.cdbo.db"
+    w0 = np.linspace(0.2, 0.8, 6)
+    study = cdbo.Study.create(db, w0, seed=2)
+    assert study.config["kernels"] == 6 and np.array_equal(study.config["w0"], w0)
+    first = study.ask()
+    assert first.id == 1 and np.array_equal(first.weights, w0)
+    assert study.tell(first, lap_time=50.0, length=1000.0) == 20.0
+    second = study.ask()
+    assert study.tell(second.id, failed=True, at=0.25, reason="spun") == 0.0
+    third = study.ask()
+
+    # The command line sees the same trials and the same pending suggestion.
+    history = json.loads(cli("study", "history", "car", "--db", db, "--json"))
+    assert [t["id"] for t in history] == [1, 2, 3]
+    assert history[0]["reward"] == 20.0 and history[0]["lap_time_s"] == 50.0
+    assert history[1]["failure"] == "spun" and history[1]["x_fail"] == 0.25
+    asked = json.loads(cli("study", "ask", "car", "--db", db))
+    assert asked["trial"] == 3 and asked["weights"] == list(third.weights)
+    cli("study", "tell", "car", "--db", db, "--trial", 3, "--reward", 21.5)
+
+    # And Python sees what the command line told, and continues from it.
+    again = cdbo.Study.open(db)
+    assert again.told == 3
+    assert again.best.id == 3 and again.best.reward == 21.5
+    fourth = again.ask()
+    assert fourth.id == 4
+    status = json.loads(cli("study", "status", "car", "--db", db, "--json"))
+    assert status["pending_trial"] == 4 and status["best_reward"] == 21.5
+
+
+def test_a_study_asks_what_the_optimizer_asks():
+    w0 = np.zeros(5)
+    study = cdbo.Study.create(
+        __import__("tempfile").mkdtemp() + "/s.db", w0, method="cmaes", seed=4
+    )
+    opt = cdbo.Optimizer("cmaes", w0, seed=4)
+    for i in range(8):
+        t = study.ask()
+        w = opt.ask()
+        assert np.array_equal(t.weights, w)
+        study.tell(t, reward=float(-i))
+        opt.tell(w, float(-i))
+
+
+def test_history_is_a_list_of_dicts_or_a_dataframe(tmp_path):
+    study = cdbo.Study.create(tmp_path / "h.db", np.zeros(3))
+    t = study.ask()
+    study.tell(t, 1.5)
+    study.ask()
+    rows = study.history(as_frame=False)
+    assert [r["id"] for r in rows] == [1, 2]
+    assert rows[0]["reward"] == 1.5 and rows[1]["reward"] is None
+    pandas = pytest.importorskip("pandas")
+    frame = study.history()
+    assert isinstance(frame, pandas.DataFrame) and list(frame["id"]) == [1, 2]
+
+
+def test_bad_input_raises_and_loses_nothing(tmp_path):
+    db = tmp_path / "s.db"
+    study = cdbo.Study.create(db, np.zeros(3))
+    with pytest.raises(FileExistsError, match="already exists"):
+        cdbo.Study.create(db, np.zeros(3))
+    assert isinstance(FileExistsError(), OSError)
+    with pytest.raises(OSError, match="no such study"):
+        cdbo.Study.open(tmp_path / "missing.db")
+    (tmp_path / "notes.db").write_text("x,a\n0,1\n")
+    with pytest.raises(OSError, match="not a cdbo study|not an SQLite database"):
+        cdbo.Study.open(tmp_path / "notes.db")
+    with pytest.raises(ValueError, match="unknown method"):
+        cdbo.Study.create(tmp_path / "m.db", np.zeros(3), method="nope")
+    assert not (tmp_path / "m.db").exists()
+    t = study.ask()
+    with pytest.raises(ValueError, match="reward must be a finite number"):
+        study.tell(t, math.inf)
+    with pytest.raises(ValueError, match="lap time must be a positive"):
+        study.tell(t, lap_time=-1.0, length=100.0)
+    with pytest.raises(ValueError, match="tell one of"):
+        study.tell(t, 1.0, failed=True)
+    with pytest.raises(ValueError, match="with failed=True"):
+        study.tell(t, 1.0, at=0.5)
+    with pytest.raises(ValueError, match="no trial 9"):
+        study.tell(9, 1.0)
+    assert study.told == 0
+    study.tell(t, 3.0)
+    with pytest.raises(ValueError, match="already told"):
+        study.tell(t, 4.0)
+    assert study.best.reward == 3.0
