@@ -78,10 +78,19 @@ impl PyOptimizer {
         f64::from_bits(self.last_ask_s.load(Ordering::Relaxed))
     }
 
-    /// Tells the reward of `w` (0 for a failed lap).
-    fn tell(&self, py: Python<'_>, w: &Bound<'_, PyAny>, reward: f64) -> PyResult<()> {
+    /// Tells the reward of `w` (0 for a failed lap) and, for a failed lap whose place is
+    /// known, where it failed (`failed_at`, a lap fraction; methods that use it, such as
+    /// pattern-search, repair the policy there).
+    #[pyo3(signature = (w, reward, failed_at = None))]
+    fn tell(
+        &self,
+        py: Python<'_>,
+        w: &Bound<'_, PyAny>,
+        reward: f64,
+        failed_at: Option<f64>,
+    ) -> PyResult<()> {
         let w = vector(w, "w")?;
-        py.detach(|| lock(&self.inner)?.tell(&w, reward).py())
+        py.detach(|| lock(&self.inner)?.tell_lap(&w, reward, failed_at).py())
     }
 
     /// The best (weights, reward) told so far, or None.

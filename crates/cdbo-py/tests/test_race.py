@@ -18,12 +18,15 @@ def test_race_ridgeway_300_laps_is_the_clis_race_bit_for_bit(cli, tmp_path):
     assert sum(lap["failure"] is not None for lap in result.laps) == summary["failed_laps"]
 
 
-def test_a_python_loop_over_optimizer_and_env_is_the_librarys_race():
+@pytest.mark.parametrize("method", ["cdbo", "pattern-search"])
+def test_a_python_loop_over_optimizer_and_env_is_the_librarys_race(method):
+    if method not in cdbo.METHODS:
+        pytest.skip(f"{method} is not in this build")
     laps = 40
-    result = cdbo.race("ridgeway", method="cdbo", kernels=20, laps=laps, seed=5)
+    result = cdbo.race("ridgeway", method=method, kernels=20, laps=laps, seed=5)
     env = cdbo.RaceEnv("ridgeway", kernels=20)
     assert np.array_equal(env.w0, result.initial.weights)
-    opt = cdbo.Optimizer("cdbo", env.w0, seed=5)
+    opt = cdbo.Optimizer(method, env.w0, seed=5)
     rewards = []
     for _ in range(laps):
         env.reset()
@@ -31,7 +34,7 @@ def test_a_python_loop_over_optimizer_and_env_is_the_librarys_race():
         _, reward, terminated, truncated, info = env.step(w)
         assert terminated and not truncated
         assert (info["failure"] is None) == info["completed"]
-        opt.tell(w, reward)
+        opt.tell(w, reward, failed_at=info["x_fail"])
         rewards.append(reward)
     assert rewards == [lap["reward"] for lap in result.laps]
     assert opt.best[1] == result.best_reward

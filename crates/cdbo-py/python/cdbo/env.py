@@ -79,7 +79,7 @@ class RaceEnv(_Base):
         self.w0 = self.initial.weights
         self.lengthscale = self.initial.lengthscale
         self.action_space = _box(self.w0 - bounds, self.w0 + bounds)
-        self.observation_space = _box(np.zeros(1), np.zeros(1))
+        self.observation_space = _box(np.zeros(1), np.ones(1))
         self.last = None
 
     def reset(self, *, seed=None, options=None):
