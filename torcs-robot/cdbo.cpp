@@ -58,6 +58,8 @@ const double kBackwardsDistance = 10.0;
 const double kStallSpeed = 0.5;
 const double kStallTime = 5.0;
 const double kSlipSpeedFloor = 2.0;  // sim/vehicle.rs SLIP_SPEED_FLOOR
+const double kLaunchTime = 2.0;      // s, the clutch's closing while pulling away
+const double kLaunchSpeed = 5.0;     // m/s, added to the road speed when closing it
 
 struct Settings {
     std::string output = "lap.jsonl";
@@ -84,6 +86,7 @@ struct Lap {
     double steer_integral = 0.0, demo_integral = 0.0;
     int gear = 0;             // 0-based, as in cdbo
     double shifting = 0.0;    // time left in a shift (s)
+    double launch_time = 0.0; // time with throttle in first gear (s)
     bool done = false;
 };
 
@@ -284,6 +287,25 @@ void choose_gear(tCarElt *car, double dt) {
     }
 }
 
+/// The clutch while pulling away in first gear. cdbo's powertrain lets the clutch slip below
+/// idle with the engine giving its idle torque; the game's engine gives no torque below idle
+/// and drives the wheels only while it turns faster, so a standing car with the clutch closed
+/// barely creeps. As the game's own robots do, the clutch starts open and closes over
+/// kLaunchTime of throttle, sooner once the engine passes half its red line with the car
+/// rolling; after first gear it stays closed.
+double launch_clutch(tCarElt *car, double throttle, double dt) {
+    if (lap.gear != 0) return 0.0;
+    if (throttle > 0.0) lap.launch_time += dt;
+    double ramp = clamp(1.0 - lap.launch_time / kLaunchTime, 0.0, 1.0);
+    double red = car->_enginerpmRedLine;
+    double above_half = car->_enginerpm - 0.5 * red;
+    if (above_half <= 0.0 || red <= 0.0) return ramp;
+    double ratio = lap.cfg.ratios[0];
+    double wheel_speed_at_red = std::fabs(car->_wheelRadius(2) * red / ratio);
+    double rolling = (kLaunchSpeed + std::fmax(0.0, car->_speed_x)) / wheel_speed_at_red;
+    return std::fmin(ramp, std::fmax(0.0, 1.0 - rolling * 2.0 * above_half / red));
+}
+
 /// Longitudinal slip of an axle, (omega R - v) / max(|v|, v0).
 double axle_slip(tCarElt *car, int axle) {
     double v = car->_speed_x;
@@ -428,7 +450,8 @@ void drive(int, tCarElt *car, tSituation *s) {
     int k = lap.cfg.driven[1] > 0.0 ? 1 : 0;
     double spin = axle_slip(car, k);
     double thr = lap.cfg.aid_slip[k];
-    if (thr > 0.0 && spin > thr) throttle *= clamp(2.0 - spin / thr, 0.0, 1.0);
+    // Not while pulling away: there the game's clutch slips and its wheels spin up at once.
+    if (thr > 0.0 && spin > thr && speed > kSlipSpeedFloor) throttle *= clamp(2.0 - spin / thr, 0.0, 1.0);
     for (int axle = 0; axle < 2 && brake > 0.0; axle++) {
         double slide = -axle_slip(car, axle);
         double th = lap.cfg.aid_slip[axle];
@@ -439,7 +462,7 @@ void drive(int, tCarElt *car, tSituation *s) {
     car->_accelCmd = throttle;
     car->_brakeCmd = brake;
     car->_gearCmd = lap.gear + 1;
-    car->_clutchCmd = 0.0;
+    car->_clutchCmd = launch_clutch(car, throttle, dt);
 
     if (lap.trace) {
         fprintf(lap.trace, "%.3f,%.3f,%.6f,%.4f,%.4f,%.5f,%.4f,%.5f,%.5f,%d,%.0f,%.3f,%.3f\n", t,

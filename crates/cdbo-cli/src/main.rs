@@ -86,7 +86,7 @@ fn main() -> ExitCode {
         Command::Plot(cmd) => commands::plot::run(&cmd, &data),
         Command::Policy(cmd) => commands::policy::run(&cmd),
         Command::Bench(cmd) => commands::bench::run(&cmd, &data),
-        Command::Torcs(cmd) => commands::torcs::run(&cmd),
+        Command::Torcs(cmd) => commands::torcs::run(&cmd, &data),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -174,9 +174,7 @@ fn run_torcs(args: &LapArgs, data: &DataPath) -> CliResult {
     let lap = game
         .lap(&req)?
         .map_err(|reason| format!("TORCS drove no lap: {reason}"))?;
-    let game_data = DataPath::new(std::slice::from_ref(&game.install.data_dir));
-    let track = super::load_track(&args.setup.track, &game_data)
-        .or_else(|_| super::load_track(&args.setup.track, data))?;
+    let track = super::game_track(&args.setup.track, &game, data)?;
     let limit = limit_lap(&track, &req.car);
     let ours = cdbo::sim::Simulator::new(track.clone(), &req.car);
     let (_, ceiling_mps) = cdbo::ceiling::tracked_profile(&ours, &limit)?;

@@ -13,6 +13,7 @@ pub mod report;
 pub mod serve_sim;
 pub mod study;
 pub mod torcs;
+pub mod torcs_compare;
 pub mod track;
 
 use clap::Args;
@@ -74,6 +75,19 @@ pub fn load_track(spec: &str, data: &DataPath) -> Result<Track, cdbo::Error> {
         eprintln!("warning: {w}");
     }
     Ok(track)
+}
+
+/// cdbo's reading of a TORCS track for a lap in the game: from the data folders (where
+/// `--data-dir` comes first), else from the game's own data.
+pub fn game_track(
+    name: &str,
+    game: &cdbo::torcs::Game,
+    data: &DataPath,
+) -> Result<Track, cdbo::Error> {
+    load_track(name, data).or_else(|e| {
+        let game_data = DataPath::new(std::slice::from_ref(&game.install.data_dir));
+        load_track(name, &game_data).map_err(|_| e)
+    })
 }
 
 /// Prints a value as pretty JSON on stdout.

@@ -83,13 +83,10 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         Simulator::Cdbo => None,
     };
     let (track, car) = match &game {
-        Some((g, req)) => {
-            let game_data = DataPath::new(std::slice::from_ref(&g.install.data_dir));
-            (
-                super::load_track(&args.setup.track, &game_data)?,
-                req.car.clone(),
-            )
-        }
+        Some((g, req)) => (
+            super::game_track(&args.setup.track, g, data)?,
+            req.car.clone(),
+        ),
         None => args.setup.load(data)?,
     };
     let track_name = track.name.clone();

@@ -31,6 +31,9 @@ pub enum TorcsCommand {
         #[arg(long)]
         json: bool,
     },
+    /// cdbo's simulator against the game: demonstrations, full throttle, policies drawn
+    /// around a learned one, speed along the lap, the limit against a built-in robot.
+    Compare(super::torcs_compare::CompareArgs),
 }
 
 #[derive(Debug, Serialize)]
@@ -52,8 +55,9 @@ fn report(game: &Game) -> SetupReport {
     }
 }
 
-pub fn run(cmd: &TorcsCommand) -> CliResult {
+pub fn run(cmd: &TorcsCommand, data: &cdbo::data_path::DataPath) -> CliResult {
     match cmd {
+        TorcsCommand::Compare(args) => super::torcs_compare::run(args, data),
         TorcsCommand::Setup { json } => {
             let install = Install::find()?;
             let game = torcs::setup(&install, &torcs::sdk_dir()?, &torcs::cache_dir()?)?;

@@ -118,8 +118,9 @@ pub fn robot_xml(car: &str, settings: &str) -> String {
     )
 }
 
-/// A one-car quick race on `track` (in `category`): our robot on the start line.
-fn race_xml(track: &str, category: &str) -> String {
+/// A one-car quick race of `laps` laps on `track` (in `category`): driver 0 of `robot` on
+/// the start line.
+fn race_xml(track: &str, category: &str, robot: &str, laps: usize) -> String {
     format!(
         r#"<?xml version="1.0" encoding="UTF-8"?>
 <!DOCTYPE params SYSTEM "params.dtd">
@@ -151,13 +152,13 @@ fn race_xml(track: &str, category: &str) -> String {
       <attnum name="initial speed" val="0"/>
       <attnum name="initial height" val="0.2"/>
     </section>
-    <attnum name="laps" val="2"/>
+    <attnum name="laps" val="{laps}"/>
   </section>
   <section name="Drivers">
     <attnum name="maximum number" val="1"/>
     <section name="1">
       <attnum name="idx" val="0"/>
-      <attstr name="module" val="{ROBOT}"/>
+      <attstr name="module" val="{robot}"/>
     </section>
   </section>
 </params>
@@ -281,63 +282,18 @@ impl Game {
                 dir.0.join("lap.txt"),
                 settings(req, &output, trace.as_deref(), time_limit),
             ),
-            (dir.0.join("race.xml"), race_xml(&req.track, &category)),
+            (
+                dir.0.join("race.xml"),
+                race_xml(&req.track, &category, ROBOT, 2),
+            ),
         ];
         for (path, text) in &files {
             std::fs::write(path, text).map_err(io(path))?;
         }
         let stderr_path = dir.0.join("stderr.txt");
-        let stderr = std::fs::File::create(&stderr_path).map_err(io(&stderr_path))?;
-        let mut local = dir.0.clone().into_os_string();
-        local.push("/");
-        let mut lib = self.lib_dir().into_os_string();
-        lib.push("/");
-        let mut data = self.data_dir().into_os_string();
-        data.push("/");
-        let mut child = Command::new(self.lib_dir().join("torcs-bin"))
-            .arg("-l")
-            .arg(&local)
-            .arg("-L")
-            .arg(&lib)
-            .arg("-D")
-            .arg(&data)
-            .arg("-r")
-            .arg(dir.0.join("race.xml"))
-            .current_dir(self.data_dir())
-            .env("LD_LIBRARY_PATH", self.install.lib_dir.join("lib"))
-            .stdin(Stdio::null())
-            .stdout(Stdio::null())
-            .stderr(stderr)
-            .process_group(0)
-            .spawn()
-            .map_err(|e| {
-                Error::Domain(format!(
-                    "cannot start TORCS ({}): {e}",
-                    self.lib_dir().join("torcs-bin").display()
-                ))
-            })?;
-        let group = child.id() as i32;
-        let start = Instant::now();
-        let status = loop {
-            match child.try_wait() {
-                Ok(Some(status)) => break Some(status),
-                Ok(None) if start.elapsed() > req.timeout => break None,
-                Ok(None) => std::thread::sleep(Duration::from_millis(2)),
-                Err(e) => {
-                    kill_group(group);
-                    let _ = child.wait();
-                    return Err(Error::Domain(format!("waiting for TORCS: {e}")));
-                }
-            }
-        };
-        let Some(status) = status else {
-            // Its leader not yet reaped, the group cannot have been reused: kill all of it.
-            kill_group(group);
-            let _ = child.wait();
-            return Ok(Err(format!(
-                "the game hung: killed after {:.0} s of wall clock",
-                req.timeout.as_secs_f64()
-            )));
+        let status = match self.run_race(&dir.0, req.timeout)? {
+            Ok(status) => status,
+            Err(hung) => return Ok(Err(hung)),
         };
         let line = std::fs::read_to_string(&output).unwrap_or_default();
         let Some(line) = line.lines().rfind(|l| !l.trim().is_empty()) else {
@@ -367,6 +323,175 @@ impl Game {
             trace,
         }))
     }
+}
+
+impl Game {
+    /// Runs the race `dir/race.xml` with `dir` as the game's local directory, its output in
+    /// `dir/stdout.txt` and `dir/stderr.txt`. `Ok(Err(why))` when it outlived `timeout` and
+    /// was killed with its process group.
+    fn run_race(
+        &self,
+        dir: &Path,
+        timeout: Duration,
+    ) -> Result<std::result::Result<std::process::ExitStatus, String>> {
+        let io = |path: &Path| {
+            let path = path.to_owned();
+            move |source| Error::Io { path, source }
+        };
+        let file = |name: &str| {
+            let path = dir.join(name);
+            std::fs::File::create(&path).map_err(io(&path))
+        };
+        let with_slash = |p: &Path| {
+            let mut s = p.as_os_str().to_owned();
+            s.push("/");
+            s
+        };
+        let mut child = Command::new(self.lib_dir().join("torcs-bin"))
+            .arg("-l")
+            .arg(with_slash(dir))
+            .arg("-L")
+            .arg(with_slash(&self.lib_dir()))
+            .arg("-D")
+            .arg(with_slash(&self.data_dir()))
+            .arg("-r")
+            .arg(dir.join("race.xml"))
+            .current_dir(self.data_dir())
+            .env("LD_LIBRARY_PATH", self.install.lib_dir.join("lib"))
+            .stdin(Stdio::null())
+            .stdout(file("stdout.txt")?)
+            .stderr(file("stderr.txt")?)
+            .process_group(0)
+            .spawn()
+            .map_err(|e| {
+                Error::Domain(format!(
+                    "cannot start TORCS ({}): {e}",
+                    self.lib_dir().join("torcs-bin").display()
+                ))
+            })?;
+        let group = child.id() as i32;
+        let start = Instant::now();
+        loop {
+            match child.try_wait() {
+                Ok(Some(status)) => return Ok(Ok(status)),
+                Ok(None) if start.elapsed() > timeout => {
+                    // Its leader not yet reaped, the group cannot have been reused: kill it all.
+                    kill_group(group);
+                    let _ = child.wait();
+                    return Ok(Err(format!(
+                        "the game hung: killed after {:.0} s of wall clock",
+                        timeout.as_secs_f64()
+                    )));
+                }
+                Ok(None) => std::thread::sleep(Duration::from_millis(2)),
+                Err(e) => {
+                    kill_group(group);
+                    let _ = child.wait();
+                    return Err(Error::Domain(format!("waiting for TORCS: {e}")));
+                }
+            }
+        }
+    }
+
+    /// A built-in robot (`bt`, `berniw`, ...) driving `car` on `track` for two laps from the
+    /// same standing start: (the first lap's time, the best lap's time) in seconds.
+    pub fn robot_laps(&self, robot: &str, track: &str, car: &str) -> Result<(f64, f64)> {
+        let category = self.install.track_category(track)?;
+        self.install.check_car(car)?;
+        let xml = self
+            .install
+            .data_dir
+            .join("drivers")
+            .join(robot)
+            .join(format!("{robot}.xml"));
+        let original = std::fs::read_to_string(&xml).map_err(|source| Error::Io {
+            path: xml.clone(),
+            source,
+        })?;
+        let n = LAPS.fetch_add(1, Ordering::Relaxed);
+        let dir = LapDir(
+            self.root
+                .join("laps")
+                .join(format!("{}-{n}", std::process::id())),
+        );
+        let robot_dir = dir.0.join("drivers").join(robot);
+        for d in [&robot_dir, &dir.0.join("config"), &dir.0.join("results")] {
+            std::fs::create_dir_all(d).map_err(|source| Error::Io {
+                path: d.to_path_buf(),
+                source,
+            })?;
+        }
+        // Its driver 0 in our car: the robot's own file with every car name replaced.
+        let key = "name=\"car name\" val=\"";
+        let ours = original
+            .lines()
+            .map(|l| match l.find(key) {
+                Some(i) => {
+                    let (head, rest) = l.split_at(i + key.len());
+                    let tail = rest.find('"').map_or("", |j| &rest[j..]);
+                    format!("{head}{car}{tail}")
+                }
+                None => l.to_owned(),
+            })
+            .collect::<Vec<_>>()
+            .join("\n");
+        let race = race_xml(track, &category, robot, 2);
+        let files = [
+            (robot_dir.join(format!("{robot}.xml")), ours),
+            (dir.0.join("race.xml"), race),
+        ];
+        for (path, text) in &files {
+            std::fs::write(path, text).map_err(|source| Error::Io {
+                path: path.clone(),
+                source,
+            })?;
+        }
+        let engine = self.root.join("conf/config/raceengine.xml");
+        std::fs::copy(&engine, dir.0.join("config/raceengine.xml")).map_err(|source| {
+            Error::Io {
+                path: engine.clone(),
+                source,
+            }
+        })?;
+        self.run_race(&dir.0, DEFAULT_TIMEOUT)?
+            .map_err(|why| Error::Domain(format!("{robot} on {track}: {why}")))?;
+        // "Sim Time: T [s], Leader Laps: 1, ..." is printed as the first lap ends.
+        let stdout = std::fs::read_to_string(dir.0.join("stdout.txt")).unwrap_or_default();
+        let first = stdout
+            .lines()
+            .find(|l| l.contains("Leader Laps:    1") || l.contains("Leader Laps: 1,"))
+            .and_then(|l| l.split_whitespace().nth(2))
+            .and_then(|t| t.parse::<f64>().ok());
+        let best = find_number(&dir.0.join("results"), "best lap time");
+        match (first, best) {
+            (Some(first), Some(best)) => Ok((first, best)),
+            _ => Err(Error::Domain(format!(
+                "{robot} on {track} in {car}: no lap times in the game's output ({})",
+                tail(&dir.0.join("stderr.txt"))
+            ))),
+        }
+    }
+}
+
+/// The value of the first `<attnum name="NAME" val="V"/>` in the XML files under `dir`.
+fn find_number(dir: &Path, name: &str) -> Option<f64> {
+    let key = format!("name=\"{name}\" val=\"");
+    for entry in std::fs::read_dir(dir).ok()?.filter_map(|e| e.ok()) {
+        let path = entry.path();
+        let found = if path.is_dir() {
+            find_number(&path, name)
+        } else {
+            let text = std::fs::read_to_string(&path).unwrap_or_default();
+            text.find(&key).and_then(|i| {
+                let rest = &text[i + key.len()..];
+                rest[..rest.find('"')?].parse().ok()
+            })
+        };
+        if found.is_some() {
+            return found;
+        }
+    }
+    None
 }
 
 /// cdbo's time limit, 30 s + L / (4 m/s), with L the game's track length; 30 min if the track

@@ -1,0 +1,378 @@
+//! `cdbo torcs compare`: cdbo's simulator against the game TORCS, the same car on the same
+//! tracks — demonstration laps, full throttle, policies drawn around a learned one, speed along
+//! the lap, and the quasi-steady-state limit against a built-in robot of the game.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+use clap::Args;
+use plotters::style::{BLUE, GREEN};
+use rand::SeedableRng;
+use rand_distr::{Distribution, StandardNormal};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use super::CliResult;
+use cdbo::data_path::DataPath;
+use cdbo::drive::ConstantPedal;
+use cdbo::drive::demo::SpeedHold;
+use cdbo::experiment::race::{RaceConfig, race};
+use cdbo::policy::RkhsPolicy;
+use cdbo::sim::{LapResult, Simulator};
+use cdbo::torcs::{Game, GamePedal, LapRequest};
+
+#[derive(Debug, Args)]
+pub struct CompareArgs {
+    /// TORCS tracks, comma-separated.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "forza,e-track-2,aalborg,alpine-1"
+    )]
+    tracks: Vec<String>,
+    /// TORCS car.
+    #[arg(long, default_value = cdbo::torcs::DEFAULT_CAR)]
+    car: String,
+    /// Demonstration speeds (m/s), comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "10,15,20")]
+    demo: Vec<f64>,
+    /// Policies drawn around the learned one, per track.
+    #[arg(long, default_value_t = 100)]
+    policies: usize,
+    /// Standard deviation of the weights' perturbation.
+    #[arg(long, default_value_t = 0.03)]
+    sigma: f64,
+    /// Kernels of the policy learned in cdbo's simulator.
+    #[arg(long, default_value_t = 30)]
+    kernels: usize,
+    /// Laps of that race.
+    #[arg(long, default_value_t = 300)]
+    laps: usize,
+    /// Seed of the race and of the drawn policies.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// The game's built-in robot to compare the limit with.
+    #[arg(long, default_value = "bt")]
+    robot: String,
+    /// Games running at once.
+    #[arg(long, default_value_t = 2)]
+    jobs: usize,
+    /// Output folder: compare.json, compare.md, speed_TRACK.png/.svg.
+    #[arg(long, default_value = "runs/torcs-compare")]
+    out: PathBuf,
+}
+
+/// One lap in both simulators.
+#[derive(Debug, Serialize)]
+struct Pair {
+    what: String,
+    cdbo: Lap,
+    torcs: Lap,
+}
+
+/// The gist of a lap.
+#[derive(Debug, Serialize)]
+struct Lap {
+    lap_time_s: Option<f64>,
+    failure: Option<String>,
+    x_fail: Option<f64>,
+    distance_fail_m: Option<f64>,
+}
+
+impl Lap {
+    fn of(l: &LapResult) -> Lap {
+        Lap {
+            lap_time_s: l.lap_time_s,
+            failure: l.failure.map(|f| f.reason.name().to_owned()),
+            x_fail: l.failure.map(|f| f.x),
+            distance_fail_m: l.failure.map(|f| f.distance_m),
+        }
+    }
+
+    fn cell(&self) -> String {
+        match (self.lap_time_s, &self.failure) {
+            (Some(t), _) => format!("{t:.2} s"),
+            (None, Some(f)) => format!(
+                "{f} at {:.0} m (x = {:.3})",
+                self.distance_fail_m.unwrap_or(0.0),
+                self.x_fail.unwrap_or(0.0)
+            ),
+            _ => "-".into(),
+        }
+    }
+}
+
+/// Policies drawn around the learned one, in both simulators.
+#[derive(Debug, Serialize)]
+struct Policies {
+    drawn: usize,
+    sigma: f64,
+    learned_reward_mps: f64,
+    completed_cdbo: usize,
+    completed_torcs: usize,
+    agree: usize,
+    both_completed: usize,
+    lap_time_error_mean: Option<f64>,
+    lap_time_error_max: Option<f64>,
+    lap_time_bias: Option<f64>,
+    torcs_wall_s: f64,
+}
+
+#[derive(Debug, Serialize)]
+struct TrackReport {
+    track: String,
+    length_m: f64,
+    demos: Vec<Pair>,
+    full_throttle: Pair,
+    learned: Pair,
+    policies: Policies,
+    limit_lap_time_s: f64,
+    robot: String,
+    robot_first_lap_s: Option<f64>,
+    robot_best_lap_s: Option<f64>,
+}
+
+pub fn run(args: &CompareArgs, data: &DataPath) -> CliResult {
+    if args.policies == 0 || args.jobs == 0 || !(args.sigma.is_finite() && args.sigma >= 0.0) {
+        return Err("--policies and --jobs must be positive, --sigma non-negative".into());
+    }
+    let game = Game::ready()?;
+    std::fs::create_dir_all(&args.out).map_err(|e| format!("{}: {e}", args.out.display()))?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.jobs)
+        .build()?;
+    let mut reports = Vec::new();
+    for track in &args.tracks {
+        let r = compare_track(&game, track, args, &pool, data)?;
+        eprintln!(
+            "{}: demo {}; policies agree {}/{}, lap-time error {:.2} %",
+            r.track,
+            r.demos
+                .iter()
+                .map(|d| format!("{} {} / {}", d.what, d.cdbo.cell(), d.torcs.cell()))
+                .collect::<Vec<_>>()
+                .join(", "),
+            r.policies.agree,
+            r.policies.drawn,
+            100.0 * r.policies.lap_time_error_mean.unwrap_or(f64::NAN)
+        );
+        reports.push(r);
+    }
+    std::fs::write(
+        args.out.join("compare.json"),
+        serde_json::to_string_pretty(&reports)?,
+    )?;
+    let md = markdown(&reports, args);
+    std::fs::write(args.out.join("compare.md"), &md)?;
+    print!("{md}");
+    Ok(())
+}
+
+fn compare_track(
+    game: &Game,
+    name: &str,
+    args: &CompareArgs,
+    pool: &rayon::ThreadPool,
+    data: &DataPath,
+) -> Result<TrackReport, Box<dyn std::error::Error>> {
+    let base = game.request(name, &args.car, GamePedal::Demo(15.0))?;
+    let track = super::game_track(name, game, data)?;
+    let car = base.car.clone();
+    let mut sim = Simulator::new(track.clone(), &car);
+    let in_game = |pedal: GamePedal, record: bool| -> Result<LapResult, cdbo::Error> {
+        let mut req: LapRequest = base.clone();
+        req.pedal = pedal;
+        req.record = record;
+        cdbo::torcs::race::drive(game, &req, req.pedal.clone())
+    };
+    let mut demos = Vec::new();
+    for &v in &args.demo {
+        demos.push(Pair {
+            what: format!("{v} m/s"),
+            cdbo: Lap::of(&sim.lap(&mut SpeedHold::new(v))),
+            torcs: Lap::of(&in_game(GamePedal::Demo(v), false)?),
+        });
+    }
+    let full_throttle = Pair {
+        what: "full throttle".into(),
+        cdbo: Lap::of(&sim.lap(&mut ConstantPedal(1.0))),
+        torcs: Lap::of(&in_game(GamePedal::Constant(1.0), false)?),
+    };
+
+    // A policy learned in cdbo's simulator, then policies drawn around it.
+    let config = RaceConfig {
+        kernels: args.kernels,
+        laps: args.laps,
+        seed: args.seed,
+        ..RaceConfig::default()
+    };
+    let learned = race(track.clone(), &car, &config, |_| {})?;
+    let best = learned.best.clone();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(args.seed);
+    let drawn: Vec<RkhsPolicy> = (0..args.policies)
+        .map(|_| {
+            let w = best
+                .weights
+                .iter()
+                .map(|w| w + args.sigma * Distribution::<f64>::sample(&StandardNormal, &mut rng))
+                .collect();
+            RkhsPolicy::new(w, best.lengthscale)
+        })
+        .collect::<Result<_, _>>()?;
+    let ours: Vec<LapResult> = drawn.iter().map(|p| sim.lap(&mut p.pedal())).collect();
+    let start = std::time::Instant::now();
+    let theirs: Vec<LapResult> = pool.install(|| {
+        drawn
+            .par_iter()
+            .map(|p| in_game(GamePedal::Rkhs(p.clone()), false))
+            .collect::<Result<_, _>>()
+    })?;
+    let torcs_wall_s = start.elapsed().as_secs_f64();
+    let errors: Vec<f64> = ours
+        .iter()
+        .zip(&theirs)
+        .filter_map(|(o, t)| Some((t.lap_time_s? - o.lap_time_s?) / o.lap_time_s?))
+        .collect();
+    let n = errors.len() as f64;
+    let policies = Policies {
+        drawn: args.policies,
+        sigma: args.sigma,
+        learned_reward_mps: learned.best_reward_mps,
+        completed_cdbo: ours.iter().filter(|l| l.completed).count(),
+        completed_torcs: theirs.iter().filter(|l| l.completed).count(),
+        agree: ours
+            .iter()
+            .zip(&theirs)
+            .filter(|(o, t)| o.completed == t.completed)
+            .count(),
+        both_completed: errors.len(),
+        lap_time_error_mean: (n > 0.0).then(|| errors.iter().map(|e| e.abs()).sum::<f64>() / n),
+        lap_time_error_max: errors.iter().map(|e| e.abs()).reduce(f64::max),
+        lap_time_bias: (n > 0.0).then(|| errors.iter().sum::<f64>() / n),
+        torcs_wall_s,
+    };
+
+    // Speed along the lap of the learned policy, in both.
+    sim.config.trace = true;
+    let ours_best = sim.lap(&mut best.pedal());
+    let theirs_best = in_game(GamePedal::Rkhs(best.clone()), true)?;
+    let chart = super::plot::speed_chart(
+        &track,
+        &[
+            ("cdbo's simulator", BLUE, &ours_best),
+            ("TORCS", GREEN, &theirs_best),
+        ],
+        &learned.limit,
+    );
+    for ext in ["png", "svg"] {
+        super::plot::draw(&args.out.join(format!("speed_{name}.{ext}")), &chart)?;
+    }
+    let robot = game.robot_laps(&args.robot, name, &args.car);
+    if let Err(e) = &robot {
+        eprintln!("warning: {e}");
+    }
+    Ok(TrackReport {
+        track: name.to_owned(),
+        length_m: track.length,
+        demos,
+        full_throttle,
+        learned: Pair {
+            what: "learned".into(),
+            cdbo: Lap::of(&ours_best),
+            torcs: Lap::of(&theirs_best),
+        },
+        policies,
+        limit_lap_time_s: learned.limit.lap_time_s,
+        robot: args.robot.clone(),
+        robot_first_lap_s: robot.as_ref().ok().map(|r| r.0),
+        robot_best_lap_s: robot.as_ref().ok().map(|r| r.1),
+    })
+}
+
+fn pct(a: Option<f64>, b: Option<f64>) -> String {
+    match (a, b) {
+        (Some(a), Some(b)) => format!("{:+.2} %", 100.0 * (a - b) / b),
+        _ => "-".into(),
+    }
+}
+
+fn markdown(reports: &[TrackReport], args: &CompareArgs) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "Car {}; tracks {}.\n\n### Demonstration laps (PI speed hold)\n\n| track | target | cdbo | TORCS | TORCS − cdbo |\n| --- | --- | --- | --- | --- |",
+        args.car,
+        args.tracks.join(", ")
+    );
+    for r in reports {
+        for d in &r.demos {
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {} | {} |",
+                r.track,
+                d.what,
+                d.cdbo.cell(),
+                d.torcs.cell(),
+                pct(d.torcs.lap_time_s, d.cdbo.lap_time_s)
+            );
+        }
+    }
+    let _ = writeln!(
+        s,
+        "\n### Full throttle\n\n| track | cdbo | TORCS |\n| --- | --- | --- |"
+    );
+    for r in reports {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} |",
+            r.track,
+            r.full_throttle.cdbo.cell(),
+            r.full_throttle.torcs.cell()
+        );
+    }
+    let _ = writeln!(
+        s,
+        "\n### Policies around a learned one\n\nLearned in cdbo's simulator ({} kernels, {} laps, seed {}); {} policies w = w* + {}·N(0, I).\n\n| track | learned: cdbo | learned: TORCS | completed cdbo / TORCS | completion agreement | both completed | lap-time error mean / max | bias (TORCS − cdbo) | TORCS wall |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+        args.kernels, args.laps, args.seed, args.policies, args.sigma
+    );
+    for r in reports {
+        let p = &r.policies;
+        let opt = |v: Option<f64>| v.map_or("-".into(), |v| format!("{:.2} %", 100.0 * v));
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} / {} | {} / {} ({:.0} %) | {} | {} / {} | {} | {:.1} s |",
+            r.track,
+            r.learned.cdbo.cell(),
+            r.learned.torcs.cell(),
+            p.completed_cdbo,
+            p.completed_torcs,
+            p.agree,
+            p.drawn,
+            100.0 * p.agree as f64 / p.drawn as f64,
+            p.both_completed,
+            opt(p.lap_time_error_mean),
+            opt(p.lap_time_error_max),
+            p.lap_time_bias
+                .map_or("-".into(), |v| format!("{:+.2} %", 100.0 * v)),
+            p.torcs_wall_s
+        );
+    }
+    let _ = writeln!(
+        s,
+        "\n### cdbo's limit against the game's `{}` robot (same car)\n\n| track | QSS limit (standing start, centre line) | {} first lap (standing start) | {} best lap (flying) | limit vs first lap |\n| --- | --- | --- | --- | --- |",
+        args.robot, args.robot, args.robot
+    );
+    for r in reports {
+        let t = |v: Option<f64>| v.map_or("-".into(), |v| format!("{v:.2} s"));
+        let _ = writeln!(
+            s,
+            "| {} | {:.2} s | {} | {} | {} |",
+            r.track,
+            r.limit_lap_time_s,
+            t(r.robot_first_lap_s),
+            t(r.robot_best_lap_s),
+            pct(Some(r.limit_lap_time_s), r.robot_first_lap_s)
+        );
+    }
+    s
+}
