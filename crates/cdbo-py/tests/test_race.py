@@ -76,3 +76,32 @@ def test_the_environment_works_without_gymnasium_and_registers_with_it():
     made = gymnasium.make("cdbo/Race-v0", kernels=10)
     made.reset(seed=0)
     assert made.step(env.w0)[1] == reward
+
+
+def test_the_gil_is_released_while_laps_run():
+    """With a switch interval of 100 s a thread gives up the GIL only when it blocks or a
+    call releases it: the main thread, woken by the first lap's callback, runs while the race
+    is still in its second lap only if the library runs laps without the GIL."""
+    import sys
+    import threading
+
+    laps, seen, woken = 8, [], threading.Event()
+    ran_after = []
+
+    def progress(record):
+        seen.append(record["lap"])
+        if record["lap"] == 1:
+            woken.set()
+
+    old = sys.getswitchinterval()
+    sys.setswitchinterval(100.0)
+    try:
+        racer = threading.Thread(target=cdbo.race, kwargs=dict(laps=laps, kernels=10, progress=progress))
+        racer.start()
+        woken.wait()
+        ran_after.append(len(seen))
+        racer.join()
+    finally:
+        sys.setswitchinterval(old)
+    assert seen == list(range(1, laps + 1))
+    assert ran_after[0] < laps, f"the main thread ran only after {ran_after[0]} laps"
