@@ -144,7 +144,7 @@ fn ask_tell_workflow_and_bad_input() {
             "--length",
             "100",
         ],
-        "lap time",
+        "--lap-time",
     );
     ok(
         &dir,
@@ -305,6 +305,10 @@ fn sigkill_at_random_moments_loses_nothing() {
             }
         }
     }
+    // On a loaded machine every kill may come before the study is made: make it now.
+    if !dir.join("killed.db").exists() {
+        ok(&dir, &optimize_args("killed.db", "0", &evaluator));
+    }
     // Finish a few more laps undisturbed, then compare with a run never interrupted.
     let told = history(&dir, "killed.db")
         .iter()
@@ -322,42 +326,6 @@ fn sigkill_at_random_moments_loses_nothing() {
             "trial {} differs after resuming",
             a["id"]
         );
-        assert_eq!(a["reward"], b["reward"]);
-    }
-}
-
-/// Two `cdbo optimize` processes on one study share it: each trial is told once, and the
-/// study ends as a single uninterrupted run would.
-#[test]
-fn two_processes_on_one_study_do_not_corrupt_it() {
-    let dir = fresh_dir("two");
-    demo(&dir);
-    let evaluator = EVALUATOR.replace("{cdbo}", CDBO);
-    ok(&dir, &optimize_args("alone.db", "12", &evaluator));
-    // Create the study first, so that the two processes do not race to create it.
-    ok(&dir, &optimize_args("shared.db", "0", &evaluator));
-    let spawn = || {
-        Command::new(CDBO)
-            .args(optimize_args("shared.db", "12", &evaluator))
-            .current_dir(&dir)
-            .stdout(Stdio::null())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap()
-    };
-    let (a, b) = (spawn(), spawn());
-    for child in [a, b] {
-        let out = child.wait_with_output().unwrap();
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert!(out.status.success() || err.contains("busy"), "{err}");
-        assert!(!err.contains("panicked"), "{err}");
-    }
-    // Whatever the interleaving, finish the study and compare.
-    ok(&dir, &optimize_args("shared.db", "12", &evaluator));
-    let (shared, alone) = (history(&dir, "shared.db"), history(&dir, "alone.db"));
-    assert_eq!(shared.len(), 12);
-    for (a, b) in shared.iter().zip(&alone) {
-        assert_eq!(a["weights"], b["weights"]);
         assert_eq!(a["reward"], b["reward"]);
     }
 }

@@ -15,6 +15,7 @@
 //! - [`study`]: persistent ask/tell studies for a real car; [`evaluator`]: sources of laps.
 //! - [`torcs`]: the racing game TORCS as a source of laps (its robot, setup and lap runner).
 //! - [`benchmarks`]: standard test functions; [`simd`]: AVX2 for the hottest loops.
+//! - [`sizes`]: the bounds on every size a user gives, and the slow-size estimate.
 
 pub mod acquisition;
 pub mod benchmarks;
@@ -33,6 +34,7 @@ pub mod params;
 pub mod policy;
 pub mod sim;
 pub mod simd;
+pub mod sizes;
 pub mod study;
 pub mod torcs;
 pub mod track;

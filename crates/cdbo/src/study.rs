@@ -9,6 +9,15 @@
 //! and the optimiser's new state in one transaction. Writers take SQLite's write lock for the
 //! whole transaction; a second process waits up to [`BUSY_TIMEOUT`] and then gets a clear
 //! "busy" error.
+//!
+//! Several workers drive one study through [`Study::claim`]: each trial handed out is claimed
+//! by its worker with a lease the worker renews while it drives ([`Study::heartbeat`]), so
+//! that every trial is driven once, and a trial whose worker died is handed out again; the
+//! rules are in [`claim`], apart from the storage. Reading commands open a study with
+//! [`Study::open_read_only`], which writes nothing and works where the file or its folder is
+//! read-only.
+
+pub mod claim;
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -19,9 +28,25 @@ use serde::{Deserialize, Serialize};
 use crate::error::{Error, Result};
 pub use crate::evaluator::Outcome;
 use crate::optimizers::{Optimizer, Saved, Settings, by_name};
+use claim::{Claim, Handout, Worker};
 
-/// The schema this version writes and reads (SQLite's `user_version`).
-pub const SCHEMA_VERSION: i64 = 1;
+/// The schema this version writes and reads (SQLite's `user_version`): 2 added the claims
+/// (`owner`, `lease_until_unix_s`); a version-1 study is upgraded when opened for writing.
+pub const SCHEMA_VERSION: i64 = 2;
+
+/// The first 16 bytes of every SQLite database file.
+const SQLITE_HEADER: &[u8; 16] = b"SQLite format 3\0";
+
+/// What a worker is to do next, from [`Study::claim`].
+#[derive(Debug, Clone, PartialEq)]
+pub enum Next {
+    /// Drive this trial (claimed for the worker), then tell it.
+    Drive(Trial),
+    /// Every remaining trial is out with another live worker: wait, then claim again.
+    Wait,
+    /// The study has told the worker's total.
+    Done,
+}
 
 /// How long a process waits for another one's transaction before reporting "busy".
 pub const BUSY_TIMEOUT: Duration = Duration::from_secs(10);
@@ -90,7 +115,7 @@ impl Study {
     /// Creates a study file; refuses to overwrite one.
     pub fn create(path: &Path, config: StudyConfig) -> Result<Study> {
         if path.exists() {
-            return Err(Error::Domain(format!(
+            return Err(Error::Conflict(format!(
                 "{}: already exists; open it, or choose another name",
                 path.display()
             )));
@@ -132,7 +157,9 @@ impl Study {
                  failure TEXT,
                  x_fail REAL,
                  asked_unix_s REAL NOT NULL,
-                 told_unix_s REAL);
+                 told_unix_s REAL,
+                 owner TEXT,
+                 lease_until_unix_s REAL);
              CREATE TABLE optimizer (id INTEGER PRIMARY KEY CHECK (id = 1), state TEXT NOT NULL);",
         )
         .map_err(err)?;
@@ -158,7 +185,7 @@ impl Study {
             Ok(()) => std::fs::remove_file(&building),
             Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
                 let _ = std::fs::remove_file(&building);
-                return Err(Error::Domain(format!(
+                return Err(Error::Conflict(format!(
                     "{}: already exists; open it, or choose another name",
                     path.display()
                 )));
@@ -174,28 +201,57 @@ impl Study {
         Ok(study)
     }
 
-    /// Opens an existing study.
+    /// Opens an existing study to ask and tell; a study of an older schema is upgraded.
     pub fn open(path: &Path) -> Result<Study> {
+        Study::open_with(path, true)
+    }
+
+    /// Opens an existing study to read it: writes nothing, and works where the file or its
+    /// folder is read-only (then as an immutable file, if SQLite cannot share it).
+    pub fn open_read_only(path: &Path) -> Result<Study> {
+        Study::open_with(path, false)
+    }
+
+    /// Opens the study at `path`, or creates it with `config` if there is none: workers
+    /// started at once on a study that does not exist yet all join the one created first.
+    /// Returns whether this call created it.
+    pub fn open_or_create(path: &Path, config: StudyConfig) -> Result<(Study, bool)> {
+        if path.exists() {
+            return Ok((Study::open(path)?, false));
+        }
+        match Study::create(path, config) {
+            Ok(s) => Ok((s, true)),
+            Err(Error::Conflict(_)) => Ok((Study::open(path)?, false)),
+            Err(e) => Err(e),
+        }
+    }
+
+    fn open_with(path: &Path, writable: bool) -> Result<Study> {
         if !path.is_file() {
             return Err(Error::NotFound(format!(
                 "{}: no such study (create it with `cdbo study create`)",
                 path.display()
             )));
         }
+        check_header(path)?;
         let err = |e| sql_error(path, e);
-        let conn =
-            Connection::open_with_flags(path, OpenFlags::SQLITE_OPEN_READ_WRITE).map_err(err)?;
-        configure(&conn).map_err(err)?;
-        let version: i64 = conn
-            .pragma_query_value(None, "user_version", |r| r.get(0))
-            .map_err(err)?;
+        let (conn, version) = if writable {
+            let conn = Connection::open_with_flags(path, OpenFlags::SQLITE_OPEN_READ_WRITE)
+                .map_err(err)?;
+            conn.busy_timeout(BUSY_TIMEOUT).map_err(err)?;
+            let version = user_version(&conn).map_err(err)?;
+            (conn, version)
+        } else {
+            read_only_connection(path)?
+        };
         if version > SCHEMA_VERSION {
             return Err(Error::Domain(format!(
                 "{}: written by a newer cdbo (study schema {version}, this version reads {SCHEMA_VERSION}); upgrade cdbo",
                 path.display()
             )));
         }
-        let config_json: Option<String> = if version == SCHEMA_VERSION {
+        // Read before anything is written: a foreign database is left as it was.
+        let config_json: Option<String> = if version >= 1 {
             conn.query_row("SELECT value FROM meta WHERE key = 'config'", [], |r| {
                 r.get(0)
             })
@@ -206,13 +262,19 @@ impl Study {
         };
         let config_json = config_json.ok_or_else(|| {
             Error::Domain(format!(
-                "{}: an SQLite database but not a cdbo study",
+                "{}: not a cdbo study (an SQLite database without a study in it)",
                 path.display()
             ))
         })?;
         let config: StudyConfig = serde_json::from_str(&config_json).map_err(|e| {
             Error::Domain(format!("{}: corrupt study settings: {e}", path.display()))
         })?;
+        if writable {
+            configure(&conn).map_err(err)?;
+            if version < SCHEMA_VERSION {
+                upgrade(&conn).map_err(err)?;
+            }
+        }
         Ok(Study {
             path: path.to_owned(),
             conn,
@@ -263,6 +325,90 @@ impl Study {
         })
     }
 
+    /// The trial `worker` is to drive next, claimed for it until its lease runs out (renew it
+    /// with [`Study::heartbeat`] while driving), or whether to wait or stop: the rules of
+    /// [`claim::hand_out`], with `total` told trials as the goal (`None`: no limit). A new
+    /// trial beside laps in flight is the optimiser's suggestion once it is told each of them
+    /// with [`claim::lie`], on a copy: a distinct point, never the same weights; a method
+    /// that cannot be told laps out of order ([`Optimizer::tells_any_weights`]) waits instead.
+    /// A single worker gets exactly the trials [`Study::ask`] would give.
+    pub fn claim(&mut self, worker: &Worker, total: Option<usize>) -> Result<Next> {
+        let path = self.path.clone();
+        let err = |e| sql_error(&path, e);
+        let tx = self
+            .conn
+            .transaction_with_behavior(TransactionBehavior::Immediate)
+            .map_err(err)?;
+        let now = unix_now();
+        let pending = pending_claims(&tx).map_err(err)?;
+        let told = told_count(&tx).map_err(err)?;
+        let claims: Vec<Claim> = pending.iter().map(|(_, c)| c.clone()).collect();
+        let lease_until = now + worker.lease.as_secs_f64();
+        let trial = match claim::hand_out(&claims, told, total, worker, now) {
+            Handout::Done => return Ok(Next::Done),
+            Handout::Wait => return Ok(Next::Wait),
+            Handout::Pending(id) => {
+                tx.execute(
+                    "UPDATE trials SET owner = ?1, lease_until_unix_s = ?2 WHERE id = ?3",
+                    params![worker.id, lease_until, id],
+                )
+                .map_err(err)?;
+                pending
+                    .into_iter()
+                    .map(|(t, _)| t)
+                    .find(|t| t.id == id)
+                    .ok_or_else(|| {
+                        Error::Domain(format!("{}: trial {id} vanished", path.display()))
+                    })?
+            }
+            Handout::New => {
+                let in_flight: Vec<Trial> = pending.into_iter().map(|(t, _)| t).collect();
+                let optimizer = load_optimizer(&tx, &path, &mut self.optimizer, told)?;
+                let weights = if in_flight.is_empty() {
+                    optimizer.ask()?
+                } else {
+                    let lie = claim::lie(told_rewards(&tx).map_err(err)?);
+                    match beside(optimizer.as_ref(), &in_flight, lie)? {
+                        Some(w) => w,
+                        None => return Ok(Next::Wait),
+                    }
+                };
+                let json =
+                    serde_json::to_string(&weights).map_err(|e| Error::Domain(e.to_string()))?;
+                tx.execute(
+                    "INSERT INTO trials (weights, asked_unix_s, owner, lease_until_unix_s) VALUES (?1, ?2, ?3, ?4)",
+                    params![json, now, worker.id, lease_until],
+                )
+                .map_err(err)?;
+                Trial {
+                    id: tx.last_insert_rowid(),
+                    weights,
+                    reward: None,
+                    lap_time_s: None,
+                    failure: None,
+                    x_fail: None,
+                }
+            }
+        };
+        tx.commit().map_err(err)?;
+        Ok(Next::Drive(trial))
+    }
+
+    /// Renews `worker`'s claim on pending trial `id` for another lease; false if the claim is
+    /// no longer the worker's (its lease ran out and another worker took the trial) or the
+    /// trial was told.
+    pub fn heartbeat(&self, id: i64, worker: &Worker) -> Result<bool> {
+        let until = unix_now() + worker.lease.as_secs_f64();
+        let n = self
+            .conn
+            .execute(
+                "UPDATE trials SET lease_until_unix_s = ?1 WHERE id = ?2 AND owner = ?3 AND reward IS NULL",
+                params![until, id, worker.id],
+            )
+            .map_err(|e| sql_error(&self.path, e))?;
+        Ok(n == 1)
+    }
+
     /// Records the outcome of pending trial `id`; returns the reward. Durable on return.
     pub fn tell(&mut self, id: i64, outcome: &Outcome) -> Result<f64> {
         let reward = outcome.reward()?;
@@ -288,7 +434,7 @@ impl Study {
             Outcome::Lap { time_s, .. } => (Some(*time_s), None, None),
             Outcome::Failed { at, reason } => (
                 None,
-                Some(reason.clone().unwrap_or_else(|| "failed".into())),
+                Some(bounded_reason(reason.as_deref().unwrap_or("failed"))),
                 *at,
             ),
         };
@@ -365,6 +511,134 @@ fn configure(conn: &Connection) -> rusqlite::Result<()> {
     Ok(())
 }
 
+/// The most of a failure reason a study keeps: an evaluator that prints megabytes fills the
+/// database with them otherwise.
+pub const MAX_REASON_BYTES: usize = 4096;
+
+/// `reason` as stored: whole up to [`MAX_REASON_BYTES`], else its last bytes up to that bound,
+/// cut at a character boundary and saying so (the end of an output says why a
+/// command failed; its start is usually progress).
+pub fn bounded_reason(reason: &str) -> String {
+    if reason.len() <= MAX_REASON_BYTES {
+        return reason.to_owned();
+    }
+    let note = format!(
+        "[{} bytes of output, cut to their last {MAX_REASON_BYTES}; the full output was not kept] ",
+        reason.len()
+    );
+    let mut start = reason.len() - MAX_REASON_BYTES + note.len();
+    while !reason.is_char_boundary(start) {
+        start += 1;
+    }
+    format!("{note}{}", &reason[start..])
+}
+
+/// Refuses a file that is not an SQLite database before SQLite touches it (opened read-write,
+/// SQLite would write its header into an empty file).
+fn check_header(path: &Path) -> Result<()> {
+    use std::io::Read;
+    let mut head = Vec::with_capacity(16);
+    std::fs::File::open(path)
+        .and_then(|f| f.take(16).read_to_end(&mut head))
+        .map_err(|e| Error::Io {
+            path: path.to_owned(),
+            source: e,
+        })?;
+    if head.is_empty() {
+        return Err(Error::Domain(format!(
+            "{}: not a cdbo study (the file is empty)",
+            path.display()
+        )));
+    }
+    if head != SQLITE_HEADER {
+        return Err(Error::Domain(format!(
+            "{}: not a cdbo study (the file is not an SQLite database)",
+            path.display()
+        )));
+    }
+    Ok(())
+}
+
+fn user_version(conn: &Connection) -> rusqlite::Result<i64> {
+    conn.pragma_query_value(None, "user_version", |r| r.get(0))
+}
+
+/// A read-only connection and the schema version. SQLite shares a WAL database through a
+/// `-shm` file beside it; where that cannot be made (a read-only folder), the file is opened
+/// as immutable, which is right while no writer has the study open.
+fn read_only_connection(path: &Path) -> Result<(Connection, i64)> {
+    let err = |e| sql_error(path, e);
+    let shared =
+        Connection::open_with_flags(path, OpenFlags::SQLITE_OPEN_READ_ONLY).and_then(|c| {
+            c.busy_timeout(BUSY_TIMEOUT)?;
+            let v = user_version(&c)?;
+            Ok((c, v))
+        });
+    if let Ok(opened) = shared {
+        return Ok(opened);
+    }
+    let uri = format!("file:{}?immutable=1", uri_path(path));
+    let conn = Connection::open_with_flags(
+        uri,
+        OpenFlags::SQLITE_OPEN_READ_ONLY | OpenFlags::SQLITE_OPEN_URI,
+    )
+    .map_err(err)?;
+    let v = user_version(&conn).map_err(err)?;
+    Ok((conn, v))
+}
+
+/// A path as the path of an SQLite `file:` URI.
+fn uri_path(path: &Path) -> String {
+    let text = path.to_string_lossy();
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '%' => out.push_str("%25"),
+            '?' => out.push_str("%3f"),
+            '#' => out.push_str("%23"),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// Schema 1 → 2: the claims' columns.
+fn upgrade(conn: &Connection) -> rusqlite::Result<()> {
+    conn.execute_batch(&format!(
+        "BEGIN IMMEDIATE;
+         ALTER TABLE trials ADD COLUMN owner TEXT;
+         ALTER TABLE trials ADD COLUMN lease_until_unix_s REAL;
+         PRAGMA user_version = {SCHEMA_VERSION};
+         COMMIT;"
+    ))
+}
+
+/// A new suggestion beside the laps in flight: a copy of the optimiser is told each of them
+/// with reward `lie`, then asked; `None` if the method cannot be told laps out of order, or
+/// keeps suggesting a lap in flight.
+fn beside(
+    optimizer: &(dyn Optimizer + Send),
+    in_flight: &[Trial],
+    lie: f64,
+) -> Result<Option<Vec<f64>>> {
+    if !optimizer.tells_any_weights() {
+        return Ok(None);
+    }
+    let mut fantasy = optimizer.save().resume()?;
+    for t in in_flight {
+        fantasy.ask()?;
+        fantasy.tell(&t.weights, lie)?;
+    }
+    for _ in 0..4 {
+        let w = fantasy.ask()?;
+        if in_flight.iter().all(|t| t.weights != w) {
+            return Ok(Some(w));
+        }
+        fantasy.tell(&w, lie)?;
+    }
+    Ok(None)
+}
+
 fn unix_now() -> f64 {
     std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
@@ -393,6 +667,29 @@ fn pending(conn: &Connection) -> rusqlite::Result<Option<Trial>> {
         row_to_trial,
     )
     .optional()
+}
+
+/// The pending trials in order, with their claims.
+fn pending_claims(conn: &Connection) -> rusqlite::Result<Vec<(Trial, Claim)>> {
+    let mut stmt = conn.prepare(
+        "SELECT id, weights, reward, lap_time_s, failure, x_fail, owner, lease_until_unix_s FROM trials WHERE reward IS NULL ORDER BY id",
+    )?;
+    let rows = stmt.query_map([], |r| {
+        let t = row_to_trial(r)?;
+        let c = Claim {
+            trial: t.id,
+            owner: r.get(6)?,
+            lease_until: r.get(7)?,
+        };
+        Ok((t, c))
+    })?;
+    rows.collect()
+}
+
+fn told_rewards(conn: &Connection) -> rusqlite::Result<Vec<f64>> {
+    let mut stmt = conn.prepare("SELECT reward FROM trials WHERE reward IS NOT NULL")?;
+    let rows = stmt.query_map([], |r| r.get(0))?;
+    rows.collect()
 }
 
 fn trial(conn: &Connection, id: i64) -> rusqlite::Result<Option<Trial>> {
@@ -499,6 +796,19 @@ mod tests {
         assert_eq!(s.history().unwrap().len(), 2);
         assert_eq!(s.best().unwrap().unwrap().reward, Some(25.0));
         assert!(Study::create(&path, config()).is_err());
+    }
+
+    #[test]
+    fn long_reasons_keep_a_bounded_tail_cut_at_a_character() {
+        assert_eq!(bounded_reason("spun at turn 3"), "spun at turn 3");
+        let long = "é".repeat(10_000) + "the end";
+        let kept = bounded_reason(&long);
+        assert!(kept.len() <= MAX_REASON_BYTES, "{}", kept.len());
+        assert!(
+            kept.starts_with("[20007 bytes of output, cut to their last 4096"),
+            "{kept}"
+        );
+        assert!(kept.ends_with("éthe end"));
     }
 
     #[test]

@@ -24,13 +24,13 @@ pub struct OptimizersArgs {
     #[arg(long, default_value = "hartmann6")]
     problem: String,
     /// Dimensions.
-    #[arg(long, default_value_t = 100)]
+    #[arg(long, default_value_t = 100, value_parser = super::value::dims)]
     dims: usize,
     /// Evaluations per run.
-    #[arg(long, default_value_t = 60)]
+    #[arg(long, default_value_t = 60, value_parser = super::value::evals)]
     evals: usize,
     /// Seeds (runs per method).
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = 10, value_parser = super::value::seeds)]
     seeds: u64,
     /// Methods, comma-separated.
     #[arg(long, value_delimiter = ',', default_values_t = cdbo::optimizers::METHODS.iter().map(|m| m.to_string()).collect::<Vec<_>>())]
@@ -60,19 +60,19 @@ struct OptimizersBench {
 #[derive(Debug, Args)]
 pub struct SuggestArgs {
     /// Observations in the GP.
-    #[arg(long, default_value_t = 300)]
+    #[arg(long, default_value_t = 300, value_parser = super::value::observations)]
     observations: usize,
     /// Dimensions (policy weights).
-    #[arg(long, default_value_t = 100)]
+    #[arg(long, default_value_t = 100, value_parser = super::value::dims)]
     dims: usize,
     /// Suggestions timed.
-    #[arg(long, default_value_t = 20)]
+    #[arg(long, default_value_t = 20, value_parser = super::value::repeats)]
     repeats: usize,
     /// Values scanned per axis (default: the library's).
-    #[arg(long)]
+    #[arg(long, value_parser = super::value::repeats)]
     scan: Option<usize>,
     /// COBYLA evaluations per axis (default: the library's).
-    #[arg(long)]
+    #[arg(long, value_parser = super::value::repeats)]
     polish: Option<usize>,
     /// Print JSON.
     #[arg(long)]
@@ -95,7 +95,7 @@ pub struct SimArgs {
     #[command(flatten)]
     setup: Setup,
     /// Number of laps.
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = 10, value_parser = super::value::laps)]
     laps: usize,
     /// Print JSON.
     #[arg(long)]
@@ -131,9 +131,6 @@ fn optimizers(args: &OptimizersArgs) -> CliResult {
             PROBLEMS.join(", ")
         )
     })?;
-    if args.evals == 0 || args.seeds == 0 {
-        return Err("--evals and --seeds must be at least 1".into());
-    }
     let mut results = Vec::new();
     for method in &args.methods {
         let (mut bests, mut seconds) = (Vec::new(), 0.0);
@@ -187,8 +184,8 @@ fn suggest(args: &SuggestArgs) -> CliResult {
     use cdbo::optimizers::Optimizer;
     use cdbo::optimizers::bo::{Bo, BoConfig, Maximiser};
     use cdbo::optimizers::coordinate_ascent::AxisSearch;
-    if args.observations < 2 || args.dims == 0 || args.repeats == 0 {
-        return Err("--observations must be at least 2, --dims and --repeats at least 1".into());
+    if args.observations < 2 {
+        return Err("--observations must be at least 2".into());
     }
     let defaults = AxisSearch::default();
     let search = AxisSearch {
@@ -250,9 +247,6 @@ fn suggest(args: &SuggestArgs) -> CliResult {
 }
 
 fn sim(args: &SimArgs, data: &DataPath) -> CliResult {
-    if args.laps == 0 {
-        return Err("--laps must be at least 1".into());
-    }
     let (track, car) = args.setup.load(data)?;
     let sim = Simulator::new(track, &car);
     sim.lap(&mut SpeedHold::new(DEFAULT_TARGET_SPEED)); // warm-up

@@ -24,7 +24,7 @@ pub struct ExperimentArgs {
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
     /// Runs in parallel (default: the number of cores).
-    #[arg(long)]
+    #[arg(long, value_parser = super::value::jobs)]
     jobs: Option<usize>,
     /// Run only shard I of N (0 ≤ I < N), e.g. --shard $SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT.
     #[arg(long, value_name = "I/N")]
@@ -94,7 +94,20 @@ pub fn run_grid(args: &ExperimentArgs, data: &DataPath) -> CliResult {
         runs = Shard::parse(s)?.select(runs);
     }
     let shard_size = runs.len();
-    runs.retain(|r| !RunRecord::path(&out, r).exists());
+    // A run is done when its record reads back; one cut short (a kill, a full disk) runs again.
+    runs.retain(|r| {
+        let path = RunRecord::path(&out, r);
+        if !path.exists() {
+            return true;
+        }
+        match RunRecord::load(&path) {
+            Ok(_) => false,
+            Err(e) => {
+                eprintln!("warning: {e}; running {} again", r.id());
+                true
+            }
+        }
+    });
     let skipped = shard_size - runs.len();
     let car = cars::find(&args.car, data)?;
     let mut tracks: BTreeMap<String, Track> = BTreeMap::new();
@@ -108,9 +121,6 @@ pub fn run_grid(args: &ExperimentArgs, data: &DataPath) -> CliResult {
     let jobs = args
         .jobs
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
-    if jobs == 0 {
-        return Err("--jobs must be at least 1".into());
-    }
     println!(
         "{} runs in the grid, {shard_size} in this shard: {skipped} already done, {} to run on {jobs} threads into {}",
         total,

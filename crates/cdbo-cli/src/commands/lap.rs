@@ -20,10 +20,10 @@ pub struct LapArgs {
     #[command(flatten)]
     setup: Setup,
     /// Drive the demonstrator: a PI controller holding this speed (m/s). The default.
-    #[arg(long, value_name = "SPEED", allow_negative_numbers = true)]
+    #[arg(long, value_name = "SPEED", allow_negative_numbers = true, value_parser = super::value::positive)]
     demo: Option<f64>,
     /// Hold this pedal command everywhere (1 = full throttle, -1 = full brake).
-    #[arg(long, value_name = "A", allow_negative_numbers = true)]
+    #[arg(long, value_name = "A", allow_negative_numbers = true, value_parser = super::value::pedal)]
     throttle: Option<f64>,
     /// Drive a policy: a table of CSV rows `x,a`, or weights as JSON (`.json`, as written by
     /// `cdbo race`, `cdbo policy fit` and `cdbo optimize`).

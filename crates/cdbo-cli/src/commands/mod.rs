@@ -95,3 +95,114 @@ pub fn print_json<T: serde::Serialize>(value: &T) -> CliResult {
     println!("{}", serde_json::to_string_pretty(value)?);
     Ok(())
 }
+
+/// Value parsers for numeric flags: clap reports a bad value as one line naming the flag, the
+/// value and the bound, and exits with status 2 before the command allocates anything.
+pub mod value {
+    use cdbo::sizes::{self, Size};
+
+    fn size(text: &str, size: &Size) -> Result<usize, String> {
+        let v: usize = text
+            .trim()
+            .parse()
+            .map_err(|_| "not a whole number".to_string())?;
+        size.check(v)
+    }
+
+    fn number(text: &str) -> Result<f64, String> {
+        let v: f64 = text
+            .trim()
+            .parse()
+            .map_err(|_| "not a number".to_string())?;
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err("must be a finite number".into())
+        }
+    }
+
+    /// Policy kernels M, within [`sizes::KERNELS`].
+    pub fn kernels(text: &str) -> Result<usize, String> {
+        size(text, &sizes::KERNELS)
+    }
+    /// Laps, within [`sizes::LAPS`].
+    pub fn laps(text: &str) -> Result<usize, String> {
+        size(text, &sizes::LAPS)
+    }
+    /// A study's total of told trials: 0 (open or create the study, drive nothing) up to
+    /// [`sizes::LAPS`].
+    pub fn total_laps(text: &str) -> Result<usize, String> {
+        if text.trim() == "0" {
+            return Ok(0);
+        }
+        laps(text)
+    }
+    /// Table points, within [`sizes::POINTS`].
+    pub fn points(text: &str) -> Result<usize, String> {
+        size(text, &sizes::POINTS)
+    }
+    /// Parallel jobs, within [`sizes::JOBS`].
+    pub fn jobs(text: &str) -> Result<usize, String> {
+        size(text, &sizes::JOBS)
+    }
+    /// Problem dimensions, within [`sizes::DIMS`].
+    pub fn dims(text: &str) -> Result<usize, String> {
+        size(text, &sizes::DIMS)
+    }
+    /// Evaluations per run, within [`sizes::EVALUATIONS`].
+    pub fn evals(text: &str) -> Result<usize, String> {
+        size(text, &sizes::EVALUATIONS)
+    }
+    /// GP observations, within [`sizes::OBSERVATIONS`].
+    pub fn observations(text: &str) -> Result<usize, String> {
+        size(text, &sizes::OBSERVATIONS)
+    }
+    /// Repeats, seeds, scan points, within [`sizes::REPEATS`].
+    pub fn repeats(text: &str) -> Result<usize, String> {
+        size(text, &sizes::REPEATS)
+    }
+    /// Seeds of a benchmark (a count, as [`repeats`]).
+    pub fn seeds(text: &str) -> Result<u64, String> {
+        repeats(text).map(|v| v as u64)
+    }
+    /// A finite number (a reward, a seed-free setting).
+    pub fn finite(text: &str) -> Result<f64, String> {
+        number(text)
+    }
+    /// A finite number above zero (speeds, seconds, length-scales, lengths).
+    pub fn positive(text: &str) -> Result<f64, String> {
+        let v = number(text)?;
+        if v > 0.0 {
+            Ok(v)
+        } else {
+            Err("must be above 0".into())
+        }
+    }
+    /// A finite number of at least zero (β, the ridge factor).
+    pub fn non_negative(text: &str) -> Result<f64, String> {
+        let v = number(text)?;
+        if v >= 0.0 {
+            Ok(v)
+        } else {
+            Err("must be at least 0".into())
+        }
+    }
+    /// A pedal command in [−1, 1].
+    pub fn pedal(text: &str) -> Result<f64, String> {
+        let v = number(text)?;
+        if (-1.0..=1.0).contains(&v) {
+            Ok(v)
+        } else {
+            Err("must be within [-1, 1] (1 = full throttle, -1 = full brake)".into())
+        }
+    }
+    /// A fraction of the lap in [0, 1].
+    pub fn fraction(text: &str) -> Result<f64, String> {
+        let v = number(text)?;
+        if (0.0..=1.0).contains(&v) {
+            Ok(v)
+        } else {
+            Err("must be a fraction of the lap within [0, 1]".into())
+        }
+    }
+}

@@ -16,13 +16,13 @@ pub enum PolicyCommand {
         #[arg(long, value_name = "FILE.csv")]
         demo: PathBuf,
         /// Number of kernels M.
-        #[arg(long)]
+        #[arg(long, value_parser = super::value::kernels)]
         kernels: usize,
         /// Kernel length-scale (default 1/(M − 1)).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true, value_parser = super::value::positive)]
         lengthscale: Option<f64>,
         /// Ridge factor λ.
-        #[arg(long, default_value_t = DEFAULT_RIDGE)]
+        #[arg(long, default_value_t = DEFAULT_RIDGE, allow_negative_numbers = true, value_parser = super::value::non_negative)]
         ridge: f64,
         /// Output weights (JSON).
         #[arg(short, long, value_name = "FILE.json")]
@@ -33,7 +33,7 @@ pub enum PolicyCommand {
         /// Weights written by `cdbo policy fit` (JSON).
         weights: PathBuf,
         /// Points in the table.
-        #[arg(long, default_value_t = 101)]
+        #[arg(long, default_value_t = 101, value_parser = super::value::points)]
         points: usize,
     },
 }

@@ -17,23 +17,23 @@ pub struct RaceArgs {
     #[command(flatten)]
     setup: Setup,
     /// Policy kernels M (the paper: 10 to 100).
-    #[arg(long, default_value_t = 30)]
+    #[arg(long, default_value_t = 30, value_parser = super::value::kernels)]
     kernels: usize,
     /// Optimiser: cdbo, cmaes, bo-cmaes, rembo-5d, rembo-10d, turbo, linebo, random,
     /// pattern-search.
     #[arg(long, default_value = "cdbo")]
     method: String,
     /// Laps (the paper: 300).
-    #[arg(long, default_value_t = 300)]
+    #[arg(long, default_value_t = 300, value_parser = super::value::laps)]
     laps: usize,
     /// Seed of every random choice.
     #[arg(long, default_value_t = 0)]
     seed: u64,
     /// UCB exploration weight β (the paper: 0.5 to 2).
-    #[arg(long, default_value_t = cdbo::acquisition::ucb::DEFAULT_BETA)]
+    #[arg(long, default_value_t = cdbo::acquisition::ucb::DEFAULT_BETA, allow_negative_numbers = true, value_parser = super::value::non_negative)]
     beta: f64,
     /// Speed of the demonstrator (m/s).
-    #[arg(long, default_value_t = 15.0)]
+    #[arg(long, default_value_t = 15.0, allow_negative_numbers = true, value_parser = super::value::positive)]
     demo_speed: f64,
     /// Output folder (default: runs/race-TRACK-METHOD-mM-sSEED).
     #[arg(long, value_name = "DIR")]
@@ -66,8 +66,8 @@ struct Summary {
 }
 
 pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult {
-    if !(args.beta.is_finite() && args.beta >= 0.0) {
-        return Err(format!("--beta {}: must be a non-negative number", args.beta).into());
+    if let Some(w) = cdbo::sizes::slow_race_warning(args.kernels, args.laps) {
+        eprintln!("warning: {w}");
     }
     // In the game, the track and car are the game's, read by cdbo for the limit and plots.
     let game = match simulator {

@@ -3,9 +3,11 @@
 //! - `{"info": true}` → `{"dim", "w0", "lower", "upper", "lengthscale", "track", "length_m",
 //!   "limit_reward_mps"}`,
 //! - `{"weights": [...]}` → `{"reward_mps", "lap_time_s", "failure"}`,
-//! - anything else → `{"error": "..."}` (the service keeps going).
+//! - anything else → `{"error": "..."}` naming the line and what was wrong: not UTF-8, longer
+//!   than [`MAX_LINE_BYTES`], not JSON, wrong types, a wrong number of weights, a weight that
+//!   is not a finite number. The service keeps answering the next line.
 
-use std::io::{BufRead, Write};
+use std::io::{BufRead, Read, Write};
 
 use clap::Args;
 use serde_json::{Value, json};
@@ -23,10 +25,10 @@ pub struct ServeSimArgs {
     #[command(flatten)]
     setup: Setup,
     /// Policy kernels M.
-    #[arg(long)]
+    #[arg(long, value_parser = super::value::kernels)]
     kernels: usize,
     /// Speed of the demonstrator whose fit is w₀ (m/s).
-    #[arg(long, default_value_t = 15.0)]
+    #[arg(long, default_value_t = 15.0, allow_negative_numbers = true, value_parser = super::value::positive)]
     demo_speed: f64,
 }
 
@@ -48,20 +50,67 @@ pub fn run(args: &ServeSimArgs, data: &DataPath) -> CliResult {
         "length_m": sim.track.length,
         "limit_reward_mps": limit.reward_mps,
     });
-    let stdin = std::io::stdin();
+    let mut input = std::io::stdin().lock();
     let mut out = std::io::stdout().lock();
-    for (k, line) in stdin.lock().lines().enumerate() {
-        let line = line?;
-        if line.trim().is_empty() {
-            continue;
-        }
-        let answer = answer(&line, &info, &sim, lengthscale, args.kernels)
-            .unwrap_or_else(|e| json!({ "error": format!("line {}: {e}", k + 1) }));
+    let mut line = Vec::new();
+    for k in 1.. {
+        let Some(read) = read_line(&mut input, &mut line)? else {
+            break;
+        };
+        let answer = match read {
+            Line::TooLong => Err(format!(
+                "longer than {MAX_LINE_BYTES} bytes (the cap on a request line); skipped"
+            )),
+            Line::Complete => match std::str::from_utf8(&line) {
+                Err(e) => Err(format!("not UTF-8 text: {e}")),
+                Ok(text) if text.trim().is_empty() => continue,
+                Ok(text) => answer(text, &info, &sim, lengthscale, args.kernels),
+            },
+        };
+        let answer = answer.unwrap_or_else(|e| json!({ "error": format!("line {k}: {e}") }));
         if writeln!(out, "{answer}").and_then(|_| out.flush()).is_err() {
             break; // The client hung up.
         }
     }
     Ok(())
+}
+
+/// The longest request line: 1 MiB, forty times the 1000 weights of the largest policy.
+pub const MAX_LINE_BYTES: usize = 1 << 20;
+
+/// How a line was read.
+enum Line {
+    /// Whole, in the buffer (without its newline).
+    Complete,
+    /// Over [`MAX_LINE_BYTES`]: read to its end and dropped.
+    TooLong,
+}
+
+/// Reads the next line as bytes into `line`, never holding more than the cap; `None` at the
+/// end of the input.
+fn read_line(input: &mut impl BufRead, line: &mut Vec<u8>) -> std::io::Result<Option<Line>> {
+    line.clear();
+    let cap = MAX_LINE_BYTES as u64 + 1;
+    let n = input.by_ref().take(cap).read_until(b'\n', line)?;
+    if n == 0 {
+        return Ok(None);
+    }
+    if line.last() == Some(&b'\n') {
+        line.pop();
+        return Ok(Some(Line::Complete));
+    }
+    if line.len() <= MAX_LINE_BYTES {
+        return Ok(Some(Line::Complete)); // The last line, without a newline.
+    }
+    // Drop the rest of the over-long line, a buffer at a time.
+    loop {
+        line.clear();
+        let n = input.by_ref().take(cap).read_until(b'\n', line)?;
+        if n == 0 || line.last() == Some(&b'\n') {
+            line.clear();
+            return Ok(Some(Line::TooLong));
+        }
+    }
 }
 
 fn answer(

@@ -46,21 +46,21 @@ pub struct InitialPolicy {
     #[arg(long, value_name = "w0.json")]
     weights: Option<PathBuf>,
     /// Policy kernels M.
-    #[arg(long)]
+    #[arg(long, value_parser = super::value::kernels)]
     pub kernels: usize,
     /// Policy length-scale (default 1/(M − 1)).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = super::value::positive)]
     lengthscale: Option<f64>,
-    /// Optimiser: cdbo, cmaes, bo-cmaes, rembo-5d, rembo-10d, turbo, linebo, random,
-    /// pattern-search.
-    #[arg(long, default_value = "cdbo")]
-    method: String,
-    /// Seed of every random choice.
-    #[arg(long, default_value_t = 0)]
-    seed: u64,
-    /// UCB exploration weight β.
-    #[arg(long, default_value_t = cdbo::acquisition::ucb::DEFAULT_BETA)]
-    beta: f64,
+    /// Optimiser: cdbo (the default), cmaes, bo-cmaes, rembo-5d, rembo-10d, turbo, linebo,
+    /// random, pattern-search.
+    #[arg(long)]
+    method: Option<String>,
+    /// Seed of every random choice (default 0).
+    #[arg(long)]
+    seed: Option<u64>,
+    /// UCB exploration weight β (default 1).
+    #[arg(long, allow_negative_numbers = true, value_parser = super::value::non_negative)]
+    beta: Option<f64>,
 }
 
 impl InitialPolicy {
@@ -88,13 +88,48 @@ impl InitialPolicy {
             .into());
         }
         Ok(StudyConfig {
-            method: self.method.clone(),
+            method: self.method.clone().unwrap_or_else(|| "cdbo".into()),
             kernels: self.kernels,
             lengthscale: policy.lengthscale,
-            seed: self.seed,
-            beta: self.beta,
+            seed: self.seed.unwrap_or(0),
+            beta: self.beta.unwrap_or(cdbo::acquisition::ucb::DEFAULT_BETA),
             w0: policy.weights,
         })
+    }
+
+    /// Refuses to resume a study with settings other than its own: every flag given must
+    /// match the stored value (a flag left out takes the stored one).
+    pub fn check_resume(&self, path: &Path, stored: &StudyConfig) -> Result<(), String> {
+        let differs = |flag: &str, given: String, kept: String| {
+            Err(format!(
+                "{}: the study was created with {flag} {kept}, not {given}; resume it with {flag} {kept} (or leave the flag out), or start a new study with another --db",
+                path.display()
+            ))
+        };
+        if self.kernels != stored.kernels {
+            return differs(
+                "--kernels",
+                self.kernels.to_string(),
+                stored.kernels.to_string(),
+            );
+        }
+        if let Some(m) = self.method.as_ref().filter(|m| **m != stored.method) {
+            return differs("--method", m.clone(), stored.method.clone());
+        }
+        if let Some(s) = self.seed.filter(|s| *s != stored.seed) {
+            return differs("--seed", s.to_string(), stored.seed.to_string());
+        }
+        if let Some(b) = self.beta.filter(|b| *b != stored.beta) {
+            return differs("--beta", b.to_string(), stored.beta.to_string());
+        }
+        if let Some(l) = self.lengthscale.filter(|l| *l != stored.lengthscale) {
+            return differs(
+                "--lengthscale",
+                l.to_string(),
+                stored.lengthscale.to_string(),
+            );
+        }
+        Ok(())
     }
 }
 
@@ -123,24 +158,25 @@ pub enum StudyCommand {
         #[arg(long)]
         trial: i64,
         /// The reward.
-        #[arg(long, conflicts_with_all = ["lap_time", "failed"], allow_negative_numbers = true)]
+        #[arg(long, conflicts_with_all = ["lap_time", "failed"], allow_negative_numbers = true, value_parser = super::value::finite)]
         reward: Option<f64>,
         /// Lap time in seconds (with --length: reward = length / time).
         #[arg(
             long,
             requires = "length",
             conflicts_with = "failed",
-            allow_negative_numbers = true
+            allow_negative_numbers = true,
+            value_parser = super::value::positive
         )]
         lap_time: Option<f64>,
         /// Lap length in metres.
-        #[arg(long, requires = "lap_time", allow_negative_numbers = true)]
+        #[arg(long, requires = "lap_time", allow_negative_numbers = true, value_parser = super::value::positive)]
         length: Option<f64>,
         /// The lap failed (reward 0).
         #[arg(long)]
         failed: bool,
         /// Where it failed, as a fraction of the lap.
-        #[arg(long, requires = "failed", allow_negative_numbers = true)]
+        #[arg(long, requires = "failed", allow_negative_numbers = true, value_parser = super::value::fraction)]
         at: Option<f64>,
     },
     /// Progress: trials told, failures, the best reward.
@@ -223,16 +259,18 @@ pub fn run(cmd: &StudyCommand) -> CliResult {
             println!("trial {trial}: reward {r} saved");
             Ok(())
         }
-        StudyCommand::Status { study, json } => status(&Study::open(&study.path())?, *json),
+        StudyCommand::Status { study, json } => {
+            status(&Study::open_read_only(&study.path())?, *json)
+        }
         StudyCommand::Best { study, format } => {
-            let s = Study::open(&study.path())?;
+            let s = Study::open_read_only(&study.path())?;
             match s.best()? {
                 Some(t) => print_policy(&s, &t, *format),
                 None => Err(format!("{}: no trial has been told yet", s.path().display()).into()),
             }
         }
         StudyCommand::History { study, json } => {
-            let s = Study::open(&study.path())?;
+            let s = Study::open_read_only(&study.path())?;
             let h = s.history()?;
             if *json {
                 return print_json(&h);
@@ -241,7 +279,7 @@ pub fn run(cmd: &StudyCommand) -> CliResult {
             Ok(())
         }
         StudyCommand::Export { study, out } => {
-            let s = Study::open(&study.path())?;
+            let s = Study::open_read_only(&study.path())?;
             let out = out
                 .clone()
                 .unwrap_or_else(|| PathBuf::from(format!("{}-export", study.name)));

@@ -130,9 +130,8 @@ impl ExperimentConfig {
 
     /// Checks the grid is non-empty, its methods known and its numbers sensible.
     pub fn check(&self) -> Result<()> {
-        if self.laps == 0 || self.repeats == 0 {
-            return Err(Error::Domain("laps and repeats must be at least 1".into()));
-        }
+        crate::sizes::LAPS.checked(self.laps)?;
+        crate::sizes::REPEATS.checked(self.repeats)?;
         if self.methods.is_empty() || self.tracks.is_empty() {
             return Err(Error::Domain(
                 "the grid needs at least one method and one track".into(),
@@ -148,15 +147,18 @@ impl ExperimentConfig {
                 crate::optimizers::METHODS.join(", ")
             )));
         }
-        if let Some(t) = self
-            .tracks
-            .iter()
-            .find(|t| t.kernels.is_empty() || t.kernels.iter().any(|&k| k < 2))
-        {
-            return Err(Error::Domain(format!(
-                "track {:?}: kernels must be a non-empty list of sizes of at least 2",
-                t.track
-            )));
+        for t in &self.tracks {
+            if t.kernels.is_empty() {
+                return Err(Error::Domain(format!(
+                    "track {:?}: kernels must be a non-empty list",
+                    t.track
+                )));
+            }
+            for &k in &t.kernels {
+                crate::sizes::KERNELS
+                    .checked(k)
+                    .map_err(|e| Error::Domain(format!("track {:?}: {e}", t.track)))?;
+            }
         }
         if !(self.demo_speed.is_finite() && self.demo_speed > 0.0) {
             return Err(Error::Domain(format!(

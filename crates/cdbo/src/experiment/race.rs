@@ -122,13 +122,21 @@ pub fn race_with(
     mut drive: impl FnMut(&RkhsPolicy) -> Result<LapResult>,
     mut progress: impl FnMut(&LapRecord),
 ) -> Result<RaceOutcome> {
-    if config.laps == 0 {
-        return Err(Error::Domain("a race needs at least one lap".into()));
+    crate::sizes::KERNELS.checked(config.kernels)?;
+    crate::sizes::LAPS.checked(config.laps)?;
+    if !(config.demo_speed.is_finite() && config.demo_speed > 0.0) {
+        return Err(Error::Domain(format!(
+            "the demonstration speed must be a positive number of m/s, got {}",
+            config.demo_speed
+        )));
     }
     if !demo.completed {
+        let why = demo.failure.map_or("it did not finish".into(), |f| {
+            format!("{} at {:.0} % of the lap", f.reason.name(), 100.0 * f.x)
+        });
         return Err(Error::Domain(format!(
-            "the {} m/s demonstration does not complete {} ({:?}): choose a slower --demo-speed",
-            config.demo_speed, track_name, demo.failure
+            "the {} m/s demonstration does not complete {} ({why}): choose a slower --demo-speed",
+            config.demo_speed, track_name
         )));
     }
     let lengthscale = default_lengthscale(config.kernels);

@@ -41,6 +41,13 @@ pub trait Optimizer {
         self.tell(weights, reward)
     }
 
+    /// Whether [`tell`](Optimizer::tell) takes any weights, not only those of the last ask:
+    /// what a study needs to hand several workers distinct laps at once (it tells a copy of
+    /// the optimiser each lap in flight with a made-up reward, then asks the copy).
+    fn tells_any_weights(&self) -> bool {
+        true
+    }
+
     /// The best weights told so far and their reward.
     fn best(&self) -> Option<(&[f64], f64)>;
 

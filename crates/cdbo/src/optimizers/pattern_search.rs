@@ -205,6 +205,11 @@ impl Optimizer for PatternSearch {
         self.tell_lap(weights, reward, None)
     }
 
+    /// Its tell reads the reward as the outcome of its last step.
+    fn tells_any_weights(&self) -> bool {
+        false
+    }
+
     fn tell_lap(&mut self, weights: &[f64], reward: f64, failed_at: Option<f64>) -> Result<()> {
         check_tell(self.dim(), weights, reward)?;
         if let Some(at) = failed_at.filter(|x| !(x.is_finite() && (0.0..=1.0).contains(x))) {

@@ -200,6 +200,11 @@ impl Optimizer for Rembo {
         Ok(())
     }
 
+    /// Its tell needs the embedded point of its last ask.
+    fn tells_any_weights(&self) -> bool {
+        false
+    }
+
     fn best(&self) -> Option<(&[f64], f64)> {
         self.best.get()
     }

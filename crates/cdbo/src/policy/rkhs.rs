@@ -228,6 +228,7 @@ fn check_shape(kernels: usize, lengthscale: f64) -> Result<()> {
             "a policy needs at least 2 kernels, got {kernels}"
         )));
     }
+    crate::sizes::KERNELS.checked(kernels)?;
     if !(lengthscale.is_finite() && lengthscale > 0.0) {
         return Err(Error::Domain(format!(
             "the policy length-scale must be positive, got {lengthscale}"

@@ -1,0 +1,166 @@
+//! Upper bounds on every size a user gives — kernels, laps, points, jobs, dimensions,
+//! evaluations, observations, repeats — checked before anything is allocated, and the cost
+//! estimate that warns of a legal size that will be slow.
+//!
+//! A bound is where a size stops making sense or stops fitting a workstation: the paper's
+//! policies have 10 to 100 kernels (1000 is already one kernel per 50 Hz driver step on a
+//! one-minute lap), and a GP over n laps holds an n × n covariance (10,000 laps: 800 MB, and
+//! every hyperparameter fit costs O(n³)).
+
+use crate::error::{Error, Result};
+
+/// One kind of size and its legal range.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Size {
+    /// What it counts, as a command-line flag would name it (`kernels`).
+    pub name: &'static str,
+    /// Smallest legal value.
+    pub min: usize,
+    /// Largest legal value.
+    pub max: usize,
+    /// Why the bound is where it is.
+    pub why: &'static str,
+}
+
+/// Policy kernels M (and the dimension of every optimiser's search).
+pub const KERNELS: Size = Size {
+    name: "kernels",
+    min: 2,
+    max: 1000,
+    why: "one kernel per 50 Hz driver step of a one-minute lap; the paper uses 10 to 100",
+};
+
+/// Laps of a race or a study (GP observations).
+pub const LAPS: Size = Size {
+    name: "laps",
+    min: 1,
+    max: 10_000,
+    why: "a GP over 10,000 laps holds an 800 MB covariance and refits in O(n³)",
+};
+
+/// Points of a policy table.
+pub const POINTS: Size = Size {
+    name: "points",
+    min: 2,
+    max: 1_000_000,
+    why: "a table finer than a millionth of the lap adds nothing",
+};
+
+/// Parallel jobs.
+pub const JOBS: Size = Size {
+    name: "jobs",
+    min: 1,
+    max: 1024,
+    why: "one thread per run; more threads than that only share the same cores",
+};
+
+/// Dimensions of a benchmark problem.
+pub const DIMS: Size = Size {
+    name: "dims",
+    min: 1,
+    max: 1000,
+    why: "the same bound as --kernels",
+};
+
+/// Evaluations of a benchmark run.
+pub const EVALUATIONS: Size = Size {
+    name: "evals",
+    min: 1,
+    max: 10_000,
+    why: "the same bound as --laps",
+};
+
+/// Observations of a GP benchmark.
+pub const OBSERVATIONS: Size = Size {
+    name: "observations",
+    min: 1,
+    max: 10_000,
+    why: "the same bound as --laps",
+};
+
+/// Repeats (runs per cell, seeds, timed suggestions, scan points).
+pub const REPEATS: Size = Size {
+    name: "repeats",
+    min: 1,
+    max: 10_000,
+    why: "beyond that a repeat adds no precision worth its time",
+};
+
+impl Size {
+    /// `value` if it is within the bounds, else the bound it breaks (the caller names the
+    /// flag and the value: clap does, and so does [`Size::checked`]).
+    pub fn check(&self, value: usize) -> std::result::Result<usize, String> {
+        if value < self.min {
+            return Err(format!("must be at least {}", self.min));
+        }
+        if value > self.max {
+            return Err(format!("must be at most {} ({})", self.max, self.why));
+        }
+        Ok(value)
+    }
+
+    /// [`Size::check`] as a library error naming the size and the value:
+    /// `kernels 100000: must be at most 1000 (…)`.
+    pub fn checked(&self, value: usize) -> Result<usize> {
+        self.check(value)
+            .map_err(|e| Error::Domain(format!("{} {value}: {e}", self.name)))
+    }
+}
+
+/// Seconds a race of `laps` laps with `kernels` kernels takes on one free core, roughly: the
+/// simulator's share grows with M² (every driver step sums the kernels near x, the policy fit
+/// solves an M × M system), the GP's with n³ summed over the laps (refits over n observations).
+/// Calibrated on `cdbo race`: 30 kernels, 300 laps ≈ 3 s; 1000 kernels, 30 laps ≈ 8 s;
+/// 100 kernels, 1000 laps ≈ 90 s.
+pub fn race_seconds(kernels: usize, laps: usize) -> f64 {
+    let (m, n) = (kernels as f64, laps as f64);
+    n * (0.008 + 2.5e-7 * m * m) + 8e-8 * n * n * n
+}
+
+/// Bytes a GP over `laps` observations of `kernels` dimensions holds at its peak, roughly: a
+/// few n × n matrices (covariance, its factor, a gradient's work space) and the n × M inputs.
+pub fn race_bytes(kernels: usize, laps: usize) -> f64 {
+    let (m, n) = (kernels as f64, laps as f64);
+    8.0 * (4.0 * n * n + 2.0 * n * m)
+}
+
+/// A warning for a legal race that will be slow (over a minute) or large (over 1 GiB), with
+/// the estimate; `None` for an ordinary one.
+pub fn slow_race_warning(kernels: usize, laps: usize) -> Option<String> {
+    let (s, b) = (race_seconds(kernels, laps), race_bytes(kernels, laps));
+    if s < 60.0 && b < (1u64 << 30) as f64 {
+        return None;
+    }
+    let time = if s < 3600.0 {
+        format!("{:.0} min", (s / 60.0).ceil())
+    } else {
+        format!("{:.1} h", s / 3600.0)
+    };
+    Some(format!(
+        "{kernels} kernels and {laps} laps: expect about {time} on one free core and {:.0} MB of memory (the GP's cost grows as laps³, the simulator's as kernels²)",
+        b / 1e6
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_outside_their_bounds_are_named() {
+        assert_eq!(KERNELS.check(30), Ok(30));
+        let e = KERNELS.checked(100_000).unwrap_err().to_string();
+        assert!(e.starts_with("kernels 100000: must be at most 1000"), "{e}");
+        assert!(KERNELS.check(1).unwrap_err().contains("at least 2"));
+        assert!(LAPS.check(0).is_err() && LAPS.check(10_000).is_ok());
+    }
+
+    #[test]
+    fn the_default_race_is_not_slow_and_a_large_one_is() {
+        assert_eq!(slow_race_warning(30, 300), None);
+        assert_eq!(slow_race_warning(100, 300), None);
+        let w = slow_race_warning(100, 5000).unwrap();
+        assert!(w.contains("5000 laps") && w.contains(" h "), "{w}");
+        assert!(slow_race_warning(1000, 300).is_some());
+    }
+}
