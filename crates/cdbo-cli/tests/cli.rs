@@ -302,7 +302,7 @@ fn policies_fit_to_a_trace_and_print_tables() {
             "-o",
             weights.to_str().unwrap(),
         ],
-        &["at least 2 kernels"],
+        &["--kernels", "at least 2"],
     );
     let empty = scratch("empty.csv", "x,a\n");
     fails_with(
