@@ -182,6 +182,20 @@ fn every_size_has_a_bound_and_every_number_a_domain() {
         "laps = 1000000\nrepeats = 1\nmethods = [\"cdbo\"]\n[[tracks]]\ntrack = \"ridgeway\"\nkernels = [10]\n",
     )
     .unwrap();
+    // A legal but slow grid says so before its first run (here the unknown track then ends it).
+    std::fs::write(
+        dir.join("slow.toml"),
+        "laps = 5000\nrepeats = 1\nmethods = [\"cdbo\"]\n[[tracks]]\ntrack = \"nowhere\"\nkernels = [10, 100]\n",
+    )
+    .unwrap();
+    let out = cdbo(&dir, &["experiment", "slow.toml", "--out", "slow"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.starts_with(
+            "warning: slow: each of its largest runs: 100 kernels and 5000 laps: expect about"
+        ),
+        "{err}"
+    );
     refused(
         &dir,
         &["experiment", "laps.toml", "--out", "laps"],

@@ -88,6 +88,10 @@ pub fn run_grid(args: &ExperimentArgs, data: &DataPath) -> CliResult {
         Ok(_) => {}
         Err(_) => std::fs::write(&grid_file, grid_text)?,
     }
+    let largest = config.tracks.iter().flat_map(|t| t.kernels.iter()).max();
+    if let Some(w) = largest.and_then(|&k| cdbo::sizes::slow_race_warning(k, config.laps)) {
+        eprintln!("warning: {name}: each of its largest runs: {w}");
+    }
     let mut runs = config.runs();
     let total = runs.len();
     if let Some(s) = &args.shard {
