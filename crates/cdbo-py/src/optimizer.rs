@@ -130,13 +130,10 @@ impl PyOptimizer {
     /// The optimiser saved by `save()`.
     #[classmethod]
     fn load(_cls: &Bound<'_, PyType>, py: Python<'_>, state: &[u8]) -> PyResult<Self> {
-        let inner = py
-            .detach(|| {
-                let saved: Saved = serde_json::from_slice(state)
-                    .map_err(|e| cdbo::Error::Domain(format!("not a saved cdbo optimiser: {e}")))?;
-                saved.resume()
-            })
-            .py()?;
+        let saved: Saved = serde_json::from_slice(state).map_err(|e| {
+            pyo3::exceptions::PyValueError::new_err(format!("not a saved cdbo optimiser: {e}"))
+        })?;
+        let inner = py.detach(|| saved.resume()).py()?;
         Ok(PyOptimizer::wrap(inner))
     }
 

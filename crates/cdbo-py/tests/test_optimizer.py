@@ -93,7 +93,7 @@ def test_bad_input_raises_value_error_with_the_librarys_message():
         opt.tell(w[:2], 1.0)
     with pytest.raises(ValueError, match="reward must be finite"):
         opt.tell(w, math.nan)
-    with pytest.raises(ValueError, match="weight 1 is inf"):
+    with pytest.raises(ValueError, match="weight 1 (is|must be finite, got) inf"):
         opt.tell(np.array([0.0, math.inf, 0.0]), 1.0)
     # Refused input changes nothing.
     assert opt.evaluations == 0 and opt.best is None
