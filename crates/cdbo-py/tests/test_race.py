@@ -57,7 +57,7 @@ def test_progress_is_called_after_every_lap_and_its_errors_propagate():
 
 
 def test_race_refuses_bad_settings():
-    with pytest.raises(ValueError, match="at least one lap|laps: need at least 1"):
+    with pytest.raises(ValueError, match="at least one lap|laps.*at least 1"):
         cdbo.race(laps=0)
     with pytest.raises(ValueError, match="unknown method"):
         cdbo.race(method="nope", laps=2)
