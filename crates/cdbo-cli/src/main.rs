@@ -94,7 +94,15 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            // The library names no flags: point at the one that adds a data folder.
+            let hint = match e.downcast_ref::<cdbo::Error>() {
+                Some(cdbo::Error::NotFound {
+                    what: "track" | "car",
+                    ..
+                }) => "; or add a folder with --data-dir DIR",
+                _ => "",
+            };
+            eprintln!("error: {e}{hint}");
             ExitCode::from(2)
         }
     }

@@ -19,17 +19,15 @@ use cdbo::data_path::DataPath;
 /// names, unparsable files — `ValueError`.
 pub fn to_py(e: Error) -> PyErr {
     let message = e.to_string();
-    if matches!(e, Error::Io { .. }) {
-        return PyOSError::new_err(message);
-    }
-    if message.contains("already exists") {
-        PyFileExistsError::new_err(message)
-    } else if message.contains("no such study") {
-        PyFileNotFoundError::new_err(message)
-    } else if message.contains("busy:") || message.contains("not a cdbo study") {
-        PyOSError::new_err(message)
-    } else {
-        PyValueError::new_err(message)
+    match e {
+        Error::AlreadyExists { .. } => PyFileExistsError::new_err(message),
+        Error::NoStudy { .. } => PyFileNotFoundError::new_err(message),
+        Error::Io { .. }
+        | Error::Busy { .. }
+        | Error::NotAStudy { .. }
+        | Error::Sql { .. }
+        | Error::Command { .. } => PyOSError::new_err(message),
+        _ => PyValueError::new_err(message),
     }
 }
 

@@ -125,7 +125,7 @@ pub fn tracked_profile(sim: &Simulator, limit: &Limit) -> Result<(f64, f64)> {
         }
     }
     if lo_reward == 0.0 {
-        return Err(Error::Domain(format!(
+        return Err(Error::Numerical(format!(
             "no scale of the limit's speed profile completes {}",
             sim.track.name
         )));

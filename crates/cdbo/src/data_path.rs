@@ -71,7 +71,7 @@ impl DataPath {
     pub fn describe(&self) -> String {
         let list: Vec<String> = self.dirs.iter().map(|d| display(d)).collect();
         format!(
-            "the data folders [{}] (add one with --data-dir DIR or CDBO_DATA_PATH)",
+            "the data folders [{}] (add one to CDBO_DATA_PATH)",
             list.join(", ")
         )
     }

@@ -99,11 +99,22 @@ impl Size {
         Ok(value)
     }
 
-    /// [`Size::check`] as a library error naming the size and the value:
+    /// [`Size::check`] as a library error ([`Error::TooSmall`], [`Error::TooLarge`]) naming the
+    /// size and the value:
     /// `kernels 100000: must be at most 1000 (…)`.
     pub fn checked(&self, value: usize) -> Result<usize> {
-        self.check(value)
-            .map_err(|e| Error::Domain(format!("{} {value}: {e}", self.name)))
+        if value < self.min {
+            return Err(Error::too_small(self.name, value, self.min));
+        }
+        if value > self.max {
+            return Err(Error::TooLarge {
+                what: self.name.into(),
+                value: value as u64,
+                max: self.max as u64,
+                why: self.why.into(),
+            });
+        }
+        Ok(value)
     }
 }
 

@@ -94,38 +94,34 @@ pub struct Study {
     optimizer: Option<(Box<dyn Optimizer + Send>, usize)>,
 }
 
-fn sql_error(path: &Path, e: rusqlite::Error) -> Error {
-    let text = e.to_string();
-    if text.contains("not a database") {
-        return Error::Domain(format!(
-            "{}: not a cdbo study (the file is not an SQLite database)",
-            path.display()
-        ));
+/// Sorts an SQLite error by its code: busy or locked, not a database, or another failure.
+fn sql_error(path: &Path, source: rusqlite::Error) -> Error {
+    use rusqlite::ErrorCode;
+    let path = path.to_owned();
+    match source.sqlite_error_code() {
+        Some(ErrorCode::DatabaseBusy | ErrorCode::DatabaseLocked) => Error::Busy { path },
+        Some(ErrorCode::NotADatabase) => Error::NotAStudy {
+            path,
+            reason: "the file is not an SQLite database".into(),
+        },
+        _ => Error::Sql { path, source },
     }
-    if text.contains("locked") || text.contains("busy") {
-        return Error::Domain(format!(
-            "{}: busy: another process is using the study; try again",
-            path.display()
-        ));
-    }
-    Error::Domain(format!("{}: {text}", path.display()))
 }
 
 impl Study {
     /// Creates a study file; refuses to overwrite one.
     pub fn create(path: &Path, config: StudyConfig) -> Result<Study> {
         if path.exists() {
-            return Err(Error::Conflict(format!(
-                "{}: already exists; open it, or choose another name",
-                path.display()
-            )));
+            return Err(Error::AlreadyExists {
+                path: path.to_owned(),
+            });
         }
         if config.w0.len() != config.kernels {
-            return Err(Error::Domain(format!(
-                "the initial policy has {} weights but the study has {} kernels",
+            return Err(Error::dimension(
+                "initial weights (one per kernel)",
+                config.kernels,
                 config.w0.len(),
-                config.kernels
-            )));
+            ));
         }
         // Fails on a bad method or w₀ before anything is written.
         let optimizer = by_name(
@@ -133,8 +129,8 @@ impl Study {
             config.w0.clone(),
             &Settings::race(config.seed, config.beta),
         )?;
-        let state =
-            serde_json::to_string(&optimizer.save()).map_err(|e| Error::Domain(e.to_string()))?;
+        let state = serde_json::to_string(&optimizer.save())
+            .map_err(|e| Error::json("optimiser state", e))?;
         // Built under a temporary name and renamed into place once complete, so that a
         // create killed half-way leaves no half-made study behind.
         let building = path.with_file_name(format!(
@@ -164,7 +160,7 @@ impl Study {
         )
         .map_err(err)?;
         let config_json =
-            serde_json::to_string(&config).map_err(|e| Error::Domain(e.to_string()))?;
+            serde_json::to_string(&config).map_err(|e| Error::json("study settings", e))?;
         tx.execute(
             "INSERT INTO meta (key, value) VALUES ('config', ?1)",
             params![config_json],
@@ -185,10 +181,9 @@ impl Study {
             Ok(()) => std::fs::remove_file(&building),
             Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
                 let _ = std::fs::remove_file(&building);
-                return Err(Error::Conflict(format!(
-                    "{}: already exists; open it, or choose another name",
-                    path.display()
-                )));
+                return Err(Error::AlreadyExists {
+                    path: path.to_owned(),
+                });
             }
             Err(_) => std::fs::rename(&building, path),
         };
@@ -221,17 +216,16 @@ impl Study {
         }
         match Study::create(path, config) {
             Ok(s) => Ok((s, true)),
-            Err(Error::Conflict(_)) => Ok((Study::open(path)?, false)),
+            Err(Error::AlreadyExists { .. }) => Ok((Study::open(path)?, false)),
             Err(e) => Err(e),
         }
     }
 
     fn open_with(path: &Path, writable: bool) -> Result<Study> {
         if !path.is_file() {
-            return Err(Error::NotFound(format!(
-                "{}: no such study (create it with `cdbo study create`)",
-                path.display()
-            )));
+            return Err(Error::NoStudy {
+                path: path.to_owned(),
+            });
         }
         check_header(path)?;
         let err = |e| sql_error(path, e);
@@ -245,10 +239,12 @@ impl Study {
             read_only_connection(path)?
         };
         if version > SCHEMA_VERSION {
-            return Err(Error::Domain(format!(
-                "{}: written by a newer cdbo (study schema {version}, this version reads {SCHEMA_VERSION}); upgrade cdbo",
-                path.display()
-            )));
+            return Err(Error::NotAStudy {
+                path: path.to_owned(),
+                reason: format!(
+                    "written by a newer cdbo (study schema {version}, this version reads {SCHEMA_VERSION}); upgrade cdbo"
+                ),
+            });
         }
         // Read before anything is written: a foreign database is left as it was.
         let config_json: Option<String> = if version >= 1 {
@@ -260,15 +256,15 @@ impl Study {
         } else {
             None
         };
-        let config_json = config_json.ok_or_else(|| {
-            Error::Domain(format!(
-                "{}: not a cdbo study (an SQLite database without a study in it)",
-                path.display()
-            ))
+        let config_json = config_json.ok_or_else(|| Error::NotAStudy {
+            path: path.to_owned(),
+            reason: "an SQLite database without a study in it".into(),
         })?;
-        let config: StudyConfig = serde_json::from_str(&config_json).map_err(|e| {
-            Error::Domain(format!("{}: corrupt study settings: {e}", path.display()))
-        })?;
+        let config: StudyConfig =
+            serde_json::from_str(&config_json).map_err(|e| Error::NotAStudy {
+                path: path.to_owned(),
+                reason: format!("corrupt study settings: {e}"),
+            })?;
         if writable {
             configure(&conn).map_err(err)?;
             if version < SCHEMA_VERSION {
@@ -307,7 +303,7 @@ impl Study {
         let told = told_count(&tx).map_err(err)?;
         let optimizer = load_optimizer(&tx, &path, &mut self.optimizer, told)?;
         let weights = optimizer.ask()?;
-        let json = serde_json::to_string(&weights).map_err(|e| Error::Domain(e.to_string()))?;
+        let json = serde_json::to_string(&weights).map_err(|e| Error::json("trial weights", e))?;
         tx.execute(
             "INSERT INTO trials (weights, asked_unix_s) VALUES (?1, ?2)",
             params![json, unix_now()],
@@ -357,8 +353,9 @@ impl Study {
                     .into_iter()
                     .map(|(t, _)| t)
                     .find(|t| t.id == id)
-                    .ok_or_else(|| {
-                        Error::Domain(format!("{}: trial {id} vanished", path.display()))
+                    .ok_or_else(|| Error::NoTrial {
+                        path: path.clone(),
+                        trial: id,
                     })?
             }
             Handout::New => {
@@ -374,7 +371,7 @@ impl Study {
                     }
                 };
                 let json =
-                    serde_json::to_string(&weights).map_err(|e| Error::Domain(e.to_string()))?;
+                    serde_json::to_string(&weights).map_err(|e| Error::json("trial weights", e))?;
                 tx.execute(
                     "INSERT INTO trials (weights, asked_unix_s, owner, lease_until_unix_s) VALUES (?1, ?2, ?3, ?4)",
                     params![json, now, worker.id, lease_until],
@@ -418,15 +415,19 @@ impl Study {
             .conn
             .transaction_with_behavior(TransactionBehavior::Immediate)
             .map_err(err)?;
-        let trial = trial(&tx, id).map_err(err)?.ok_or_else(|| {
-            Error::NotFound(format!("{}: no trial {id} in this study", path.display()))
+        let trial = trial(&tx, id).map_err(err)?.ok_or_else(|| Error::NoTrial {
+            path: path.clone(),
+            trial: id,
         })?;
         if trial.reward.is_some() {
-            return Err(Error::Conflict(format!(
-                "{}: trial {id} was already told (reward {}); ask for the next trial",
-                path.display(),
-                trial.reward.unwrap_or_default()
-            )));
+            return Err(Error::Conflict {
+                path: path.clone(),
+                trial: id,
+                reason: format!(
+                    "was already told (reward {}); ask for the next trial",
+                    trial.reward.unwrap_or_default()
+                ),
+            });
         }
         let told = told_count(&tx).map_err(err)?;
         let (lap_time, failure, x_fail) = match outcome {
@@ -444,7 +445,7 @@ impl Study {
             optimizer.ask()?;
             optimizer.tell_lap(&trial.weights, reward, x_fail)?;
             let state = serde_json::to_string(&optimizer.save())
-                .map_err(|e| Error::Domain(e.to_string()))?;
+                .map_err(|e| Error::json("optimiser state", e))?;
             tx.execute(
                 "UPDATE trials SET reward = ?1, lap_time_s = ?2, failure = ?3, x_fail = ?4, told_unix_s = ?5 WHERE id = ?6",
                 params![reward, lap_time, failure, x_fail, unix_now(), id],
@@ -545,16 +546,16 @@ fn check_header(path: &Path) -> Result<()> {
             source: e,
         })?;
     if head.is_empty() {
-        return Err(Error::Domain(format!(
-            "{}: not a cdbo study (the file is empty)",
-            path.display()
-        )));
+        return Err(Error::NotAStudy {
+            path: path.to_owned(),
+            reason: "the file is empty".into(),
+        });
     }
     if head != SQLITE_HEADER {
-        return Err(Error::Domain(format!(
-            "{}: not a cdbo study (the file is not an SQLite database)",
-            path.display()
-        )));
+        return Err(Error::NotAStudy {
+            path: path.to_owned(),
+            reason: "the file is not an SQLite database".into(),
+        });
     }
     Ok(())
 }
@@ -718,19 +719,20 @@ fn load_optimizer<'a>(
     cache: &'a mut Option<(Box<dyn Optimizer + Send>, usize)>,
     told: usize,
 ) -> Result<&'a mut Box<dyn Optimizer + Send>> {
-    if cache.as_ref().is_none_or(|c| c.1 != told) {
-        let state: String = conn
-            .query_row("SELECT state FROM optimizer WHERE id = 1", [], |r| r.get(0))
-            .map_err(|e| sql_error(path, e))?;
-        let saved: Saved = serde_json::from_str(&state).map_err(|e| {
-            Error::Domain(format!("{}: corrupt optimiser state: {e}", path.display()))
-        })?;
-        *cache = Some((saved.resume()?, told));
-    }
-    match cache {
-        Some((opt, _)) => Ok(opt),
-        None => Err(Error::Domain("the optimiser could not be loaded".into())),
-    }
+    let current = match cache.take().filter(|c| c.1 == told) {
+        Some(c) => c,
+        None => {
+            let state: String = conn
+                .query_row("SELECT state FROM optimizer WHERE id = 1", [], |r| r.get(0))
+                .map_err(|e| sql_error(path, e))?;
+            let saved: Saved = serde_json::from_str(&state).map_err(|e| Error::Json {
+                what: format!("{}: the optimiser state", path.display()),
+                source: e,
+            })?;
+            (saved.resume()?, told)
+        }
+    };
+    Ok(&mut cache.insert(current).0)
 }
 
 #[cfg(test)]

@@ -9,7 +9,7 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 
-use super::{CliResult, load_track};
+use super::{CliResult, from_flag, load_track};
 use cdbo::car::catalog as cars;
 use cdbo::data_path::DataPath;
 use cdbo::experiment::grid::{ExperimentConfig, PRESETS, Shard};
@@ -95,7 +95,7 @@ pub fn run_grid(args: &ExperimentArgs, data: &DataPath) -> CliResult {
     let mut runs = config.runs();
     let total = runs.len();
     if let Some(s) = &args.shard {
-        runs = Shard::parse(s)?.select(runs);
+        runs = Shard::parse(s).map_err(from_flag("--shard"))?.select(runs);
     }
     let shard_size = runs.len();
     // A run is done when its record reads back; one cut short (a kill, a full disk) runs again.

@@ -46,6 +46,12 @@ impl Simulator {
     }
 }
 
+/// Prefixes a library error with the command-line flag its value came from (the library
+/// names no flags).
+pub fn from_flag(flag: &'static str) -> impl Fn(cdbo::Error) -> Box<dyn std::error::Error> {
+    move |e| format!("{flag}: {e}").into()
+}
+
 /// `--track` and `--car`.
 #[derive(Debug, Args, Clone)]
 pub struct Setup {

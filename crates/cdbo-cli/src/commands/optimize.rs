@@ -104,8 +104,8 @@ pub fn run(args: &OptimizeArgs) -> CliResult {
         let reward = match study.tell(trial.id, &outcome) {
             Ok(r) => r,
             // Another worker told this trial first (ours had lost its lease): go on.
-            Err(cdbo::Error::Conflict(msg)) => {
-                eprintln!("note: {msg}");
+            Err(e @ cdbo::Error::Conflict { .. }) => {
+                eprintln!("note: {e}");
                 continue;
             }
             Err(e) => return Err(e.into()),

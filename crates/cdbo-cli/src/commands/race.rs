@@ -7,7 +7,7 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 
-use super::{CliResult, Setup, Simulator, print_json};
+use super::{CliResult, Setup, Simulator, from_flag, print_json};
 use cdbo::data_path::DataPath;
 use cdbo::experiment::race::{RaceConfig, RaceOutcome, race};
 use cdbo::policy::RkhsPolicy;
@@ -129,9 +129,13 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         ));
     };
     let outcome = match &game {
-        Some((g, req)) => cdbo::torcs::race::race(g, req, &track, &config, progress)?,
-        None => race(track.clone(), &car, &config, progress)?,
-    };
+        Some((g, req)) => cdbo::torcs::race::race(g, req, &track, &config, progress),
+        None => race(track.clone(), &car, &config, progress),
+    }
+    .map_err(|e| match e {
+        cdbo::Error::DemoFailed { .. } => from_flag("--demo-speed")(e),
+        e => e.into(),
+    })?;
     bar.finish_and_clear();
     let wall_s = start.elapsed().as_secs_f64();
     let ceiling_sim = cdbo::sim::Simulator::new(track.clone(), &car);

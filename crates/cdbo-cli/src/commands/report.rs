@@ -56,7 +56,10 @@ fn curves_name(track: &str) -> String {
 }
 
 pub fn run(args: &ReportArgs, data: &DataPath) -> CliResult {
-    let records = RunRecord::load_all(&args.dirs)?;
+    let records = RunRecord::load_all(&args.dirs).map_err(|e| match e {
+        cdbo::Error::Io { .. } => format!("{e} (expected the output folder of `cdbo experiment`)"),
+        e => e.to_string(),
+    })?;
     if records.is_empty() {
         return Err(format!(
             "no finished runs under {} (run `cdbo experiment` first)",

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use clap::{Args, Subcommand, ValueEnum};
 
 use super::policy::{read_demo, read_policy};
-use super::{CliResult, print_json};
+use super::{CliResult, from_flag, print_json};
 use cdbo::policy::RkhsPolicy;
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 use cdbo::study::{Outcome, Study, StudyConfig, Trial};
@@ -254,6 +254,12 @@ pub fn run(cmd: &StudyCommand) -> CliResult {
                 },
                 _ => return Err("give --reward R, --lap-time T --length L, or --failed".into()),
             };
+            let flag = match outcome {
+                Outcome::Reward(_) => "--reward",
+                Outcome::Lap { .. } => "--lap-time / --length",
+                Outcome::Failed { .. } => "--at",
+            };
+            outcome.reward().map_err(from_flag(flag))?;
             let mut s = Study::open(&study.path())?;
             let r = s.tell(*trial, &outcome)?;
             println!("trial {trial}: reward {r} saved");

@@ -24,7 +24,7 @@ pub fn draw(means: &[f64], cov: &Mat<f64>, rng: &mut impl rand::Rng) -> Result<V
             .map(|i| means[i] + (0..=i).map(|j| l[(i, j)] * z[j]).sum::<f64>())
             .collect());
     }
-    Err(Error::Domain(format!(
+    Err(Error::Numerical(format!(
         "the posterior covariance of {b} candidates is not positive semi-definite even with jitter"
     )))
 }

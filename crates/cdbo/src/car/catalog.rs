@@ -28,10 +28,14 @@ pub fn find(spec: &str, data: &DataPath) -> Result<Car> {
     ];
     match data.find(&rels) {
         Some(p) => super::torcs::read(&p, None),
-        None => Err(Error::NotFound(format!(
-            "unknown car {spec:?}: not built in ({}), not a file, and not found in {}",
-            BUILTIN.join(", "),
-            data.describe()
-        ))),
+        None => Err(Error::NotFound {
+            what: "car",
+            name: format!("{spec:?}"),
+            detail: format!(
+                "not built in ({}), not a file, and not found in {}",
+                BUILTIN.join(", "),
+                data.describe()
+            ),
+        }),
     }
 }

@@ -19,7 +19,7 @@ pub fn read(path: &Path, category: Option<&Path>) -> Result<Car> {
         Some(c) => Some(c.to_owned()),
         None => match car.section("Car").and_then(|c| c.str("category")) {
             Some(cat) => Some(find_category(path, cat).ok_or_else(|| {
-                Error::invalid(
+                Error::parse(
                     car.file.clone(),
                     "Car/category",
                     format!("category file {cat}.xml not found in ../../categories or ../../../categories/../cars/categories; pass it explicitly"),

@@ -95,7 +95,7 @@ impl Evaluator for CommandEvaluator {
         let policy = RkhsPolicy::new(weights.to_vec(), self.lengthscale)?;
         let file = &self.policy_file;
         let text = serde_json::to_string(&policy_json(&policy))
-            .map_err(|e| Error::Domain(e.to_string()))?;
+            .map_err(|e| Error::json(file.display().to_string(), e))?;
         std::fs::write(file, text).map_err(|e| Error::Io {
             path: file.clone(),
             source: e,
@@ -110,7 +110,10 @@ impl Evaluator for CommandEvaluator {
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())
             .spawn()
-            .map_err(|e| Error::Domain(format!("cannot run `sh -c {line}`: {e}")))?;
+            .map_err(|source| Error::Command {
+                line: line.clone(),
+                source,
+            })?;
         let mut pipe_out = child.stdout.take();
         let mut pipe_err = child.stderr.take();
         let out = std::thread::spawn(move || {
@@ -143,7 +146,7 @@ impl Evaluator for CommandEvaluator {
                     });
                 }
                 Ok(None) => std::thread::sleep(Duration::from_millis(5)),
-                Err(e) => return Err(Error::Domain(format!("waiting for `{line}`: {e}"))),
+                Err(source) => return Err(Error::Command { line, source }),
             }
         };
         let stdout = out.join().unwrap_or_default();

@@ -43,26 +43,28 @@ impl Outcome {
     pub fn reward(&self) -> Result<f64> {
         match self {
             Outcome::Reward(r) if r.is_finite() => Ok(*r),
-            Outcome::Reward(r) => Err(Error::Domain(format!(
-                "the reward must be a finite number, got {r}"
-            ))),
+            Outcome::Reward(r) => Err(Error::invalid_value("the reward", r, "a finite number")),
             Outcome::Lap { time_s, length_m } => {
                 if !(time_s.is_finite() && *time_s > 0.0) {
-                    return Err(Error::Domain(format!(
-                        "the lap time must be a positive number of seconds, got {time_s}"
-                    )));
+                    return Err(Error::invalid_value(
+                        "the lap time",
+                        time_s,
+                        "a positive number of seconds",
+                    ));
                 }
                 if !(length_m.is_finite() && *length_m > 0.0) {
-                    return Err(Error::Domain(format!(
-                        "the lap length must be a positive number of metres, got {length_m}"
-                    )));
+                    return Err(Error::invalid_value(
+                        "the lap length",
+                        length_m,
+                        "a positive number of metres",
+                    ));
                 }
                 Ok(length_m / time_s)
             }
             Outcome::Failed { at, .. } => match at {
-                Some(x) if !(x.is_finite() && (0.0..=1.0).contains(x)) => Err(Error::Domain(
-                    format!("--at must be a lap fraction in [0, 1], got {x}"),
-                )),
+                Some(x) if !(x.is_finite() && (0.0..=1.0).contains(x)) => Err(
+                    Error::invalid_value("where the lap failed", x, "a lap fraction in [0, 1]"),
+                ),
                 _ => Ok(0.0),
             },
         }

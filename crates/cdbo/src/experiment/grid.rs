@@ -120,11 +120,27 @@ impl ExperimentConfig {
 
     /// Reads a grid from TOML text; `origin` names the file in errors.
     pub fn from_toml(text: &str, origin: &str) -> Result<ExperimentConfig> {
-        let config: ExperimentConfig =
-            toml::from_str(text).map_err(|e| Error::Domain(format!("{origin}: {e}")))?;
-        config
-            .check()
-            .map_err(|e| Error::Domain(format!("{origin}: {e}")))?;
+        let config: ExperimentConfig = toml::from_str(text).map_err(|e| {
+            // The line of the offending span, and its key (the text before `=`).
+            let start = e.span().map_or(0, |s| s.start.min(text.len()));
+            let line_start = text[..start].rfind('\n').map_or(0, |i| i + 1);
+            let line_text = text[line_start..].lines().next().unwrap_or("");
+            let key = line_text.split_once('=').map_or("grid", |(k, _)| k.trim());
+            Error::Parse {
+                file: origin.to_owned(),
+                line: e
+                    .span()
+                    .map(|_| 1 + text[..start].matches('\n').count() as u32),
+                element: key.to_owned(),
+                message: e.message().trim().to_owned(),
+            }
+        })?;
+        config.check().map_err(|e| Error::Parse {
+            file: origin.to_owned(),
+            line: None,
+            element: "grid".into(),
+            message: e.to_string(),
+        })?;
         Ok(config)
     }
 
@@ -133,8 +149,10 @@ impl ExperimentConfig {
         crate::sizes::LAPS.checked(self.laps)?;
         crate::sizes::REPEATS.checked(self.repeats)?;
         if self.methods.is_empty() || self.tracks.is_empty() {
-            return Err(Error::Domain(
-                "the grid needs at least one method and one track".into(),
+            return Err(Error::too_small(
+                "methods and tracks",
+                self.methods.len().min(self.tracks.len()),
+                1,
             ));
         }
         if let Some(m) = self
@@ -142,35 +160,47 @@ impl ExperimentConfig {
             .iter()
             .find(|m| !crate::optimizers::METHODS.contains(&m.as_str()))
         {
-            return Err(Error::Domain(format!(
-                "unknown method {m:?} (available: {})",
-                crate::optimizers::METHODS.join(", ")
-            )));
+            return Err(crate::optimizers::unknown_method(m));
         }
         for t in &self.tracks {
             if t.kernels.is_empty() {
-                return Err(Error::Domain(format!(
-                    "track {:?}: kernels must be a non-empty list",
-                    t.track
-                )));
+                return Err(Error::too_small(
+                    format!("track {:?}'s kernels", t.track),
+                    0,
+                    1,
+                ));
             }
             for &k in &t.kernels {
-                crate::sizes::KERNELS
-                    .checked(k)
-                    .map_err(|e| Error::Domain(format!("track {:?}: {e}", t.track)))?;
+                crate::sizes::KERNELS.checked(k).map_err(|e| match e {
+                    Error::TooSmall { what, value, min } => Error::TooSmall {
+                        what: format!("track {:?}'s {what}", t.track),
+                        value,
+                        min,
+                    },
+                    Error::TooLarge {
+                        what,
+                        value,
+                        max,
+                        why,
+                    } => Error::TooLarge {
+                        what: format!("track {:?}'s {what}", t.track),
+                        value,
+                        max,
+                        why,
+                    },
+                    e => e,
+                })?;
             }
         }
         if !(self.demo_speed.is_finite() && self.demo_speed > 0.0) {
-            return Err(Error::Domain(format!(
-                "demo_speed must be positive, got {}",
-                self.demo_speed
-            )));
+            return Err(Error::invalid_value(
+                "demo_speed",
+                self.demo_speed,
+                "positive",
+            ));
         }
         if !(self.beta.is_finite() && self.beta >= 0.0) {
-            return Err(Error::Domain(format!(
-                "beta must be non-negative, got {}",
-                self.beta
-            )));
+            return Err(Error::invalid_value("beta", self.beta, "non-negative"));
         }
         Ok(())
     }
@@ -239,9 +269,11 @@ impl Shard {
     /// Parses `I/N`.
     pub fn parse(text: &str) -> Result<Shard> {
         let bad = || {
-            Error::Domain(format!(
-                "--shard {text:?}: expected I/N with 0 ≤ I < N, e.g. 0/4"
-            ))
+            Error::invalid_value(
+                "the shard",
+                format!("{text:?}"),
+                "I/N with 0 ≤ I < N, e.g. 0/4",
+            )
         };
         let (i, n) = text.split_once('/').ok_or_else(bad)?;
         let (index, count): (usize, usize) = (

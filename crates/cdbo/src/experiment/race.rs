@@ -125,19 +125,21 @@ pub fn race_with(
     crate::sizes::KERNELS.checked(config.kernels)?;
     crate::sizes::LAPS.checked(config.laps)?;
     if !(config.demo_speed.is_finite() && config.demo_speed > 0.0) {
-        return Err(Error::Domain(format!(
-            "the demonstration speed must be a positive number of m/s, got {}",
-            config.demo_speed
-        )));
+        return Err(Error::invalid_value(
+            "the demonstration speed",
+            config.demo_speed,
+            "a positive number of m/s",
+        ));
     }
     if !demo.completed {
         let why = demo.failure.map_or("it did not finish".into(), |f| {
             format!("{} at {:.0} % of the lap", f.reason.name(), 100.0 * f.x)
         });
-        return Err(Error::Domain(format!(
-            "the {} m/s demonstration does not complete {} ({why}): choose a slower --demo-speed",
-            config.demo_speed, track_name
-        )));
+        return Err(Error::DemoFailed {
+            speed: config.demo_speed,
+            track: track_name.to_string(),
+            failure: why,
+        });
     }
     let lengthscale = default_lengthscale(config.kernels);
     let initial = RkhsPolicy::fit(&demo_pairs, config.kernels, lengthscale, DEFAULT_RIDGE)?;

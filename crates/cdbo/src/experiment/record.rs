@@ -64,19 +64,29 @@ impl RunRecord {
     pub fn save(&self, dir: &Path) -> Result<()> {
         let path = RunRecord::path(dir, &self.spec);
         let tmp = path.with_extension("json.tmp");
-        let io = |e: std::io::Error, p: &Path| Error::Domain(format!("{}: {e}", p.display()));
+        let io = |source: std::io::Error, p: &Path| Error::Io {
+            path: p.to_owned(),
+            source,
+        };
         std::fs::create_dir_all(dir.join("runs")).map_err(|e| io(e, dir))?;
-        let text = serde_json::to_string(self).map_err(|e| Error::Domain(e.to_string()))?;
+        let text =
+            serde_json::to_string(self).map_err(|e| Error::json(path.display().to_string(), e))?;
         std::fs::write(&tmp, text).map_err(|e| io(e, &tmp))?;
         std::fs::rename(&tmp, &path).map_err(|e| io(e, &path))
     }
 
     /// Loads one saved run.
     pub fn load(path: &Path) -> Result<RunRecord> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| Error::Domain(format!("{}: {e}", path.display())))?;
-        serde_json::from_str(&text)
-            .map_err(|e| Error::Domain(format!("{}: not a cdbo run record: {e}", path.display())))
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            path: path.to_owned(),
+            source,
+        })?;
+        serde_json::from_str(&text).map_err(|e| Error::Parse {
+            file: path.display().to_string(),
+            line: u32::try_from(e.line()).ok().filter(|&l| l > 0),
+            element: "run record".into(),
+            message: format!("not a cdbo run record: {e}"),
+        })
     }
 
     /// Every run saved under the experiment folders, the first copy of each run kept.
@@ -84,11 +94,9 @@ impl RunRecord {
         let mut records: Vec<RunRecord> = Vec::new();
         for dir in dirs {
             let runs = dir.join("runs");
-            let entries = std::fs::read_dir(&runs).map_err(|e| {
-                Error::Domain(format!(
-                    "{}: {e} (expected the output folder of `cdbo experiment`)",
-                    runs.display()
-                ))
+            let entries = std::fs::read_dir(&runs).map_err(|source| Error::Io {
+                path: runs.clone(),
+                source,
             })?;
             let mut paths: Vec<PathBuf> = entries
                 .filter_map(|e| e.ok().map(|e| e.path()))

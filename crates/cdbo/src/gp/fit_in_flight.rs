@@ -47,7 +47,7 @@ impl FitInFlight {
         match self.thread {
             Some(thread) => thread
                 .join()
-                .map_err(|_| Error::Domain("the hyperparameter fit's thread panicked".into()))?,
+                .map_err(|_| Error::Panicked("hyperparameter fit"))?,
             None => fit_copy(&self.start, &self.bounds, self.iterations),
         }
     }

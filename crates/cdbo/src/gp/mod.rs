@@ -166,9 +166,7 @@ impl GaussianProcess {
     pub fn add(&mut self, w: &[f64], z: f64) -> Result<()> {
         self.check_point(w)?;
         if !z.is_finite() {
-            return Err(Error::Domain(format!(
-                "observation value {z} is not finite"
-            )));
+            return Err(Error::invalid_value("the observed value", z, "finite"));
         }
         let n = self.len();
         let mut l: Vec<f64> = (0..n).map(|i| self.k(self.input(i), w)).collect();
@@ -290,7 +288,7 @@ impl GaussianProcess {
                 }
             }
         }
-        Err(Error::Domain(format!(
+        Err(Error::Numerical(format!(
             "the GP covariance of {n} points is not positive definite even with jitter 1e-4·σ_f²"
         )))
     }
@@ -416,14 +414,10 @@ impl GaussianProcess {
 
     fn check_point(&self, w: &[f64]) -> Result<()> {
         if w.len() != self.dim {
-            return Err(Error::Domain(format!(
-                "expected {} weights, got {}",
-                self.dim,
-                w.len()
-            )));
+            return Err(Error::dimension("weights", self.dim, w.len()));
         }
         if let Some(i) = w.iter().position(|v| !v.is_finite()) {
-            return Err(Error::Domain(format!("weight {i} is {}", w[i])));
+            return Err(Error::invalid_value(format!("weight {i}"), w[i], "finite"));
         }
         Ok(())
     }
@@ -431,23 +425,24 @@ impl GaussianProcess {
 
 fn check_hyper(dim: usize, h: &Hyper) -> Result<()> {
     if dim == 0 {
-        return Err(Error::Domain(
-            "a GP needs at least one input dimension".into(),
-        ));
+        return Err(Error::too_small("GP input dimensions", 0, 1));
     }
     if h.lengthscales.len() != 1 && h.lengthscales.len() != dim {
-        return Err(Error::Domain(format!(
-            "{} length-scales for {dim} dimensions (give 1 or {dim})",
-            h.lengthscales.len()
-        )));
+        return Err(Error::invalid_value(
+            format!("the number of length-scales for {dim} dimensions"),
+            h.lengthscales.len(),
+            format!("1 or {dim}"),
+        ));
     }
     if h.lengthscales.iter().any(|l| !(l.is_finite() && *l > 0.0))
         || !(h.signal_var.is_finite() && h.signal_var > 0.0)
         || !(h.noise_var.is_finite() && h.noise_var >= 0.0)
     {
-        return Err(Error::Domain(format!(
-            "hyperparameters must be positive and finite: {h:?}"
-        )));
+        return Err(Error::invalid_value(
+            "the GP hyperparameters",
+            format!("{h:?}"),
+            "positive and finite",
+        ));
     }
     Ok(())
 }

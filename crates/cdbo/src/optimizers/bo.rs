@@ -168,18 +168,21 @@ impl Bo {
     /// A new run from the demonstration's weights.
     pub fn new(w0: Vec<f64>, config: BoConfig) -> Result<Bo> {
         if w0.is_empty() {
-            return Err(Error::Domain(
-                "Bayesian optimisation needs at least one weight".into(),
-            ));
+            return Err(Error::too_small("Bayesian optimisation's weights", 0, 1));
         }
         if let Some(i) = w0.iter().position(|w| !w.is_finite()) {
-            return Err(Error::Domain(format!("initial weight {i} is {}", w0[i])));
+            return Err(Error::invalid_value(
+                format!("initial weight {i}"),
+                w0[i],
+                "finite",
+            ));
         }
         if !(config.initial_sigma.is_finite() && config.initial_sigma >= 0.0) {
-            return Err(Error::Domain(format!(
-                "σ₀ must be non-negative, got {}",
-                config.initial_sigma
-            )));
+            return Err(Error::invalid_value(
+                "σ₀",
+                config.initial_sigma,
+                "non-negative",
+            ));
         }
         let hyper = initial_hyper(&config, w0.len());
         let lengthscale_max = LENGTHSCALE_MAX_FRACTION * 2.0 * config.box_radius;
@@ -198,11 +201,14 @@ impl Bo {
     /// so that it continues exactly as the uninterrupted run would.
     pub fn resume(saved: BoState) -> Result<Bo> {
         if saved.bounds_used.len() != saved.observations.len() {
-            return Err(Error::Domain(format!(
-                "corrupt BO state: {} observations but {} recorded bounds",
-                saved.observations.len(),
-                saved.bounds_used.len()
-            )));
+            return Err(Error::CorruptState {
+                method: "BO",
+                reason: format!(
+                    "{} observations but {} recorded bounds",
+                    saved.observations.len(),
+                    saved.bounds_used.len()
+                ),
+            });
         }
         let dim = saved.w0.len();
         let mut state = BoState {
@@ -364,7 +370,8 @@ impl Bo {
             // While every lap has scored the same (all failed, say), the GP carries no
             // direction: the initial design goes on.
             let sigma = self.state.config.initial_sigma;
-            let normal = Normal::new(0.0, sigma).map_err(|e| Error::Domain(e.to_string()))?;
+            let normal = Normal::new(0.0, sigma)
+                .map_err(|_| Error::invalid_value("σ₀", sigma, "non-negative"))?;
             let mut w: Vec<f64> = self
                 .state
                 .w0

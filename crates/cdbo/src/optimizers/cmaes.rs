@@ -168,15 +168,14 @@ impl Cmaes {
     pub fn new(start: Vec<f64>, config: CmaesConfig) -> Result<Cmaes> {
         let n = start.len();
         if n == 0 || start.iter().any(|v| !v.is_finite()) {
-            return Err(Error::Domain(
-                "CMA-ES needs a finite start point of at least one weight".into(),
+            return Err(Error::invalid_value(
+                "CMA-ES's start point",
+                format!("{start:?}"),
+                "finite, of at least one weight",
             ));
         }
         if !(config.sigma0.is_finite() && config.sigma0 > 0.0) {
-            return Err(Error::Domain(format!(
-                "σ₀ must be positive, got {}",
-                config.sigma0
-            )));
+            return Err(Error::invalid_value("σ₀", config.sigma0, "positive"));
         }
         let mut cov = vec![0.0; n * n];
         for i in 0..n {
@@ -204,9 +203,10 @@ impl Cmaes {
     pub fn resume(state: CmaesState) -> Result<Cmaes> {
         let n = state.start.len();
         if state.cov.len() != n * n || state.mean.len() != n {
-            return Err(Error::Domain(
-                "corrupt CMA-ES state: sizes do not match the dimension".into(),
-            ));
+            return Err(Error::CorruptState {
+                method: "CMA-ES",
+                reason: "sizes do not match the dimension".into(),
+            });
         }
         let base = if state.config.population > 0 {
             state.config.population
@@ -217,9 +217,10 @@ impl Cmaes {
         let bounds = match &state.config.bounds {
             Some(b) if b.lower.len() == n && b.upper.len() == n => b.clone(),
             Some(_) => {
-                return Err(Error::Domain(
-                    "corrupt CMA-ES state: the box does not match the dimension".into(),
-                ));
+                return Err(Error::CorruptState {
+                    method: "CMA-ES",
+                    reason: "the box does not match the dimension".into(),
+                });
             }
             None => SearchBox {
                 lower: vec![f64::NEG_INFINITY; n],
@@ -254,7 +255,7 @@ impl Cmaes {
         let n = self.state.mean.len();
         let c = Mat::from_fn(n, n, |i, j| self.state.cov[i * n + j]);
         let evd = c.self_adjoint_eigen(Side::Lower).map_err(|e| {
-            Error::Domain(format!(
+            Error::Numerical(format!(
                 "CMA-ES covariance eigendecomposition failed: {e:?}"
             ))
         })?;

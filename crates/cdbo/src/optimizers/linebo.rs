@@ -95,13 +95,17 @@ impl LineBo {
     pub fn resume(saved: LineBoState) -> Result<LineBo> {
         let dim = saved.w0.len();
         if dim == 0 || saved.w0.iter().any(|w| !w.is_finite()) {
-            return Err(Error::Domain(
-                "LineBO needs a finite start point of at least one weight".into(),
+            return Err(Error::invalid_value(
+                "LineBO's start point",
+                format!("{:?}", saved.w0),
+                "finite, of at least one weight",
             ));
         }
         if saved.config.laps_per_line == 0 || saved.config.grid < 2 {
-            return Err(Error::Domain(
-                "LineBO needs at least one lap per line and a grid of two points".into(),
+            return Err(Error::invalid_value(
+                "LineBO's laps per line and grid points",
+                format!("{} and {}", saved.config.laps_per_line, saved.config.grid),
+                "at least 1 and 2",
             ));
         }
         let r = saved.config.box_radius;

@@ -143,6 +143,15 @@ impl Settings {
     }
 }
 
+/// The error for a method name that is not in [`METHODS`].
+pub fn unknown_method(name: &str) -> Error {
+    Error::NotFound {
+        what: "method",
+        name: format!("{name:?}"),
+        detail: format!("available: {}", METHODS.join(", ")),
+    }
+}
+
 /// An optimiser by its command-line name, from w₀ and the settings shared by every method.
 pub fn by_name(name: &str, w0: Vec<f64>, settings: &Settings) -> Result<Box<dyn Optimizer + Send>> {
     let Settings {
@@ -219,12 +228,7 @@ pub fn by_name(name: &str, w0: Vec<f64>, settings: &Settings) -> Result<Box<dyn 
                 repair: true,
             },
         )?),
-        other => {
-            return Err(Error::Domain(format!(
-                "unknown method {other:?} (available: {})",
-                METHODS.join(", ")
-            )));
-        }
+        other => return Err(unknown_method(other)),
     })
 }
 
@@ -244,9 +248,11 @@ impl SearchBox {
     /// [w₀ − r, w₀ + r].
     pub fn around(w0: &[f64], radius: f64) -> Result<SearchBox> {
         if !(radius.is_finite() && radius > 0.0) {
-            return Err(Error::Domain(format!(
-                "the search-box radius must be positive, got {radius}"
-            )));
+            return Err(Error::invalid_value(
+                "the search-box radius",
+                radius,
+                "positive",
+            ));
         }
         Ok(SearchBox {
             lower: w0.iter().map(|w| w - radius).collect(),
@@ -285,18 +291,21 @@ impl Best {
 /// Checks a told (weights, reward) pair against the dimension.
 pub fn check_tell(dim: usize, weights: &[f64], reward: f64) -> Result<()> {
     if weights.len() != dim {
-        return Err(Error::Domain(format!(
-            "expected {dim} weights, got {}",
-            weights.len()
-        )));
+        return Err(Error::dimension("weights", dim, weights.len()));
     }
     if let Some(i) = weights.iter().position(|w| !w.is_finite()) {
-        return Err(Error::Domain(format!("weight {i} is {}", weights[i])));
+        return Err(Error::invalid_value(
+            format!("weight {i}"),
+            weights[i],
+            "finite",
+        ));
     }
     if !reward.is_finite() {
-        return Err(Error::Domain(format!(
-            "the reward must be finite (0 for a failed lap), got {reward}"
-        )));
+        return Err(Error::invalid_value(
+            "the reward",
+            reward,
+            "finite (0 for a failed lap)",
+        ));
     }
     Ok(())
 }

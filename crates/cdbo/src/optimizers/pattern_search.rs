@@ -100,15 +100,14 @@ impl PatternSearch {
     /// A search from `start` (driven first, unmoved).
     pub fn new(start: Vec<f64>, config: PatternSearchConfig) -> Result<PatternSearch> {
         if start.is_empty() || start.iter().any(|v| !v.is_finite()) {
-            return Err(Error::Domain(
-                "pattern search needs a finite start point of at least one weight".into(),
+            return Err(Error::invalid_value(
+                "pattern search's start point",
+                format!("{start:?}"),
+                "finite, of at least one weight",
             ));
         }
         if !(config.sigma0.is_finite() && config.sigma0 > 0.0) {
-            return Err(Error::Domain(format!(
-                "σ₀ must be positive, got {}",
-                config.sigma0
-            )));
+            return Err(Error::invalid_value("σ₀", config.sigma0, "positive"));
         }
         let n = start.len();
         PatternSearch::resume(PatternSearchState {
@@ -128,11 +127,14 @@ impl PatternSearch {
     pub fn resume(state: PatternSearchState) -> Result<PatternSearch> {
         let n = state.start.len();
         if state.steps.len() != n || state.order.iter().any(|&i| i >= n) {
-            return Err(Error::Domain(format!(
-                "pattern search state of {n} weights has {} steps and order {:?}",
-                state.steps.len(),
-                state.order
-            )));
+            return Err(Error::CorruptState {
+                method: "pattern search",
+                reason: format!(
+                    "{n} weights but {} steps and order {:?}",
+                    state.steps.len(),
+                    state.order
+                ),
+            });
         }
         Ok(PatternSearch {
             bounds: SearchBox::around(&state.start, state.config.box_radius)?,
@@ -213,9 +215,11 @@ impl Optimizer for PatternSearch {
     fn tell_lap(&mut self, weights: &[f64], reward: f64, failed_at: Option<f64>) -> Result<()> {
         check_tell(self.dim(), weights, reward)?;
         if let Some(at) = failed_at.filter(|x| !(x.is_finite() && (0.0..=1.0).contains(x))) {
-            return Err(Error::Domain(format!(
-                "the failure place must be a lap fraction in [0, 1], got {at}"
-            )));
+            return Err(Error::invalid_value(
+                "the failure place",
+                at,
+                "a lap fraction in [0, 1]",
+            ));
         }
         self.state.evaluations += 1;
         let better = self.state.best.offer(weights, reward);

@@ -53,15 +53,14 @@ impl RandomSearch {
     /// A search from `start` (asked first, unperturbed).
     pub fn new(start: Vec<f64>, config: RandomConfig) -> Result<RandomSearch> {
         if start.is_empty() || start.iter().any(|v| !v.is_finite()) {
-            return Err(Error::Domain(
-                "random search needs a finite start point of at least one weight".into(),
+            return Err(Error::invalid_value(
+                "random search's start point",
+                format!("{start:?}"),
+                "finite, of at least one weight",
             ));
         }
         if !(config.sigma.is_finite() && config.sigma > 0.0) {
-            return Err(Error::Domain(format!(
-                "σ must be positive, got {}",
-                config.sigma
-            )));
+            return Err(Error::invalid_value("σ", config.sigma, "positive"));
         }
         RandomSearch::resume(RandomState {
             config,
@@ -104,8 +103,8 @@ impl Optimizer for RandomSearch {
         let w = if s.evaluations == 0 {
             s.start.clone()
         } else {
-            let normal =
-                Normal::new(0.0, s.config.sigma).map_err(|e| Error::Domain(e.to_string()))?;
+            let normal = Normal::new(0.0, s.config.sigma)
+                .map_err(|_| Error::invalid_value("σ", s.config.sigma, "positive"))?;
             let mut rng = rng_for(s.config.seed, s.evaluations as u64);
             let mut w: Vec<f64> = centre.iter().map(|c| c + normal.sample(&mut rng)).collect();
             self.bounds.clamp(&mut w);

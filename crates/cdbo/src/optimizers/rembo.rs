@@ -72,8 +72,10 @@ impl Rembo {
     pub fn new(w0: Vec<f64>, config: RemboConfig) -> Result<Rembo> {
         let d = config.embedding_dim;
         if d == 0 || w0.is_empty() {
-            return Err(Error::Domain(
-                "REMBO needs at least one weight and an embedding of dimension ≥ 1".into(),
+            return Err(Error::too_small(
+                "REMBO's weights and embedding dimension",
+                d.min(w0.len()),
+                1,
             ));
         }
         let inner = BoConfig {
@@ -106,10 +108,13 @@ impl Rembo {
     pub fn resume(state: RemboState) -> Result<Rembo> {
         let (dim, d) = (state.w0.len(), state.config.embedding_dim);
         if state.inner.w0.len() != d {
-            return Err(Error::Domain(format!(
-                "corrupt REMBO state: an embedding of dimension {d} but a {}-dimensional GP",
-                state.inner.w0.len()
-            )));
+            return Err(Error::CorruptState {
+                method: "REMBO",
+                reason: format!(
+                    "an embedding of dimension {d} but a {}-dimensional GP",
+                    state.inner.w0.len()
+                ),
+            });
         }
         let mut rng = rng_for(state.config.seed, EMBEDDING_STREAM);
         let embedding = (0..dim * d)
@@ -189,9 +194,7 @@ impl Optimizer for Rembo {
         let y = match &self.pending {
             Some((y, w)) if w.as_slice() == weights => y.clone(),
             _ => {
-                return Err(Error::Domain(
-                    "REMBO can only be told the reward of the weights it asked for last".into(),
-                ));
+                return Err(Error::NotAsked { method: "REMBO" });
             }
         };
         self.inner.tell(&y, reward)?;

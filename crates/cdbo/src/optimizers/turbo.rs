@@ -139,14 +139,14 @@ impl Turbo {
     pub fn resume(saved: TurboState) -> Result<Turbo> {
         let dim = saved.w0.len();
         if dim == 0 || saved.w0.iter().any(|w| !w.is_finite()) {
-            return Err(Error::Domain(
-                "TuRBO needs a finite start point of at least one weight".into(),
+            return Err(Error::invalid_value(
+                "TuRBO's start point",
+                format!("{:?}", saved.w0),
+                "finite, of at least one weight",
             ));
         }
         if saved.config.initial_samples == 0 {
-            return Err(Error::Domain(
-                "TuRBO needs an initial design of at least one point".into(),
-            ));
+            return Err(Error::too_small("TuRBO's initial design points", 0, 1));
         }
         let mut run = Turbo {
             bounds: SearchBox::around(&saved.w0, saved.config.box_radius)?,

@@ -71,7 +71,7 @@ impl Params {
     pub fn parse(text: &str, file: &str, dir: Option<&Path>) -> Result<Params> {
         let mut warnings = Vec::new();
         let expanded = expand_entities(text, file, dir, &mut warnings)?;
-        let doc = roxmltree::Document::parse(&expanded).map_err(|e| Error::Invalid {
+        let doc = roxmltree::Document::parse(&expanded).map_err(|e| Error::Parse {
             file: file.to_owned(),
             line: Some(e.pos().row),
             element: "XML".to_owned(),
@@ -79,7 +79,7 @@ impl Params {
         })?;
         let root = doc.root_element();
         if root.tag_name().name() != "params" {
-            return Err(Error::Invalid {
+            return Err(Error::Parse {
                 file: file.to_owned(),
                 line: Some(doc.text_pos_at(root.range().start).row),
                 element: format!("<{}>", root.tag_name().name()),
@@ -97,7 +97,7 @@ impl Params {
 
     /// An error about an element of this file.
     pub fn error(&self, element: &str, line: Option<u32>, message: impl Into<String>) -> Error {
-        Error::Invalid {
+        Error::Parse {
             file: self.file.clone(),
             line,
             element: element.to_owned(),
@@ -162,7 +162,7 @@ impl Section {
                     value: Value::Str(s),
                     ..
                 },
-            ) => Err(Error::Invalid {
+            ) => Err(Error::Parse {
                 file: file.to_owned(),
                 line: Some(a.line),
                 element: format!("{}/{}", self.path, name),
@@ -178,7 +178,7 @@ impl Section {
 
     /// A required number attribute.
     pub fn require_num(&self, file: &str, name: &str) -> Result<f64> {
-        self.num(file, name)?.ok_or_else(|| Error::Invalid {
+        self.num(file, name)?.ok_or_else(|| Error::Parse {
             file: file.to_owned(),
             line: Some(self.line),
             element: format!("{}/{}", self.path, name),
@@ -227,7 +227,7 @@ fn read_section(
                 format!("{}/{}", section.path, n)
             }
         };
-        let invalid = |element: String, message: String| Error::Invalid {
+        let invalid = |element: String, message: String| Error::Parse {
             file: file.to_owned(),
             line: Some(line),
             element,
@@ -305,7 +305,7 @@ fn expand_entities(
     let Some(start) = text.find("<!DOCTYPE") else {
         return Ok(text.to_owned());
     };
-    let end = doctype_end(text, start).ok_or_else(|| Error::Invalid {
+    let end = doctype_end(text, start).ok_or_else(|| Error::Parse {
         file: file.to_owned(),
         line: Some(line_of(text, start)),
         element: "<!DOCTYPE>".to_owned(),

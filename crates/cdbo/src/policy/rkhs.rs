@@ -35,10 +35,11 @@ impl RkhsPolicy {
     pub fn new(weights: Vec<f64>, lengthscale: f64) -> Result<RkhsPolicy> {
         check_shape(weights.len(), lengthscale)?;
         if let Some(i) = weights.iter().position(|w| !w.is_finite()) {
-            return Err(Error::Domain(format!(
-                "policy weight {i} is {}",
-                weights[i]
-            )));
+            return Err(Error::invalid_value(
+                format!("policy weight {i}"),
+                weights[i],
+                "finite",
+            ));
         }
         Ok(RkhsPolicy {
             lengthscale,
@@ -55,19 +56,17 @@ impl RkhsPolicy {
     ) -> Result<RkhsPolicy> {
         check_shape(kernels, lengthscale)?;
         if demo.is_empty() {
-            return Err(Error::Domain(
-                "the demonstration is empty: record at least one (x, a) pair".into(),
-            ));
+            return Err(Error::too_small("demonstration (x, a) pairs", 0, 1));
         }
         if let Some((x, a)) = demo.iter().find(|(x, a)| !x.is_finite() || !a.is_finite()) {
-            return Err(Error::Domain(format!(
-                "demonstration pair (x {x}, a {a}) is not finite"
-            )));
+            return Err(Error::invalid_value(
+                "a demonstration pair",
+                format!("(x {x}, a {a})"),
+                "finite",
+            ));
         }
         if !(ridge.is_finite() && ridge > 0.0) {
-            return Err(Error::Domain(format!(
-                "the ridge factor must be positive, got {ridge}"
-            )));
+            return Err(Error::invalid_value("the ridge factor", ridge, "positive"));
         }
         let mut phi = vec![0.0; kernels];
         let mut gram = Mat::<f64>::zeros(kernels, kernels);
@@ -89,7 +88,7 @@ impl RkhsPolicy {
         }
         let llt = gram
             .llt(Side::Lower)
-            .map_err(|e| Error::Domain(format!("ridge system is singular: {e:?}")))?;
+            .map_err(|e| Error::Numerical(format!("the ridge system is singular: {e:?}")))?;
         let w = llt.solve(&rhs);
         RkhsPolicy::new((0..kernels).map(|i| w[(i, 0)]).collect(), lengthscale)
     }
@@ -224,15 +223,15 @@ pub fn features_into(x: f64, lengthscale: f64, out: &mut [f64]) {
 
 fn check_shape(kernels: usize, lengthscale: f64) -> Result<()> {
     if kernels < 2 {
-        return Err(Error::Domain(format!(
-            "a policy needs at least 2 kernels, got {kernels}"
-        )));
+        return Err(Error::too_small("policy kernels", kernels, 2));
     }
     crate::sizes::KERNELS.checked(kernels)?;
     if !(lengthscale.is_finite() && lengthscale > 0.0) {
-        return Err(Error::Domain(format!(
-            "the policy length-scale must be positive, got {lengthscale}"
-        )));
+        return Err(Error::invalid_value(
+            "the policy length-scale",
+            lengthscale,
+            "positive",
+        ));
     }
     Ok(())
 }

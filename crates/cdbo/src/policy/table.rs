@@ -16,20 +16,22 @@ impl PolicyTable {
     /// A table from points; x must increase strictly and a lie in [−1, 1].
     pub fn new(points: Vec<(f64, f64)>) -> Result<PolicyTable> {
         if points.is_empty() {
-            return Err(Error::Domain(
-                "a policy table needs at least one point".into(),
-            ));
+            return Err(Error::too_small("policy table points", 0, 1));
         }
         for (i, &(x, a)) in points.iter().enumerate() {
             if !x.is_finite() || !a.is_finite() || !(-1.0..=1.0).contains(&a) {
-                return Err(Error::Domain(format!(
-                    "policy point {i}: (x {x}, a {a}) must be finite with a in [-1, 1]"
-                )));
+                return Err(Error::invalid_value(
+                    format!("policy point {i}"),
+                    format!("(x {x}, a {a})"),
+                    "finite with a in [-1, 1]",
+                ));
             }
             if i > 0 && x <= points[i - 1].0 {
-                return Err(Error::Domain(format!(
-                    "policy point {i}: x {x} does not increase"
-                )));
+                return Err(Error::invalid_value(
+                    format!("policy point {i}'s x"),
+                    x,
+                    format!("above the previous point's {}", points[i - 1].0),
+                ));
             }
         }
         Ok(PolicyTable { points })
@@ -51,7 +53,7 @@ impl PolicyTable {
             {
                 continue;
             }
-            let err = |m: String| Error::Invalid {
+            let err = |m: String| Error::Parse {
                 file: file.clone(),
                 line: Some(i as u32 + 1),
                 element: "row".into(),
@@ -67,7 +69,7 @@ impl PolicyTable {
             };
             points.push((num(cols[0])?, num(cols[1])?));
         }
-        PolicyTable::new(points).map_err(|e| Error::invalid(file, "rows", e.to_string()))
+        PolicyTable::new(points).map_err(|e| Error::parse(file, "rows", e.to_string()))
     }
 
     /// The points (xᵢ, aᵢ).

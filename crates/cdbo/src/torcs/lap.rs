@@ -302,13 +302,15 @@ impl Game {
                 tail(&stderr_path)
             )));
         };
-        let robot: RobotLine = serde_json::from_str(line).map_err(|e| {
-            Error::Domain(format!(
-                "the TORCS robot wrote an unreadable line ({e}): {line}"
-            ))
+        let robot: RobotLine = serde_json::from_str(line).map_err(|e| Error::External {
+            program: "the TORCS robot".into(),
+            message: format!("an unreadable line ({e}): {line}"),
         })?;
         if let Some(error) = robot.error {
-            return Err(Error::Domain(format!("the TORCS robot: {error}")));
+            return Err(Error::External {
+                program: "the TORCS robot".into(),
+                message: error,
+            });
         }
         let trace = match trace.filter(|_| req.record) {
             Some(path) => read_trace(&path)?,
@@ -363,11 +365,9 @@ impl Game {
             .stderr(file("stderr.txt")?)
             .process_group(0)
             .spawn()
-            .map_err(|e| {
-                Error::Domain(format!(
-                    "cannot start TORCS ({}): {e}",
-                    self.lib_dir().join("torcs-bin").display()
-                ))
+            .map_err(|source| Error::Command {
+                line: self.lib_dir().join("torcs-bin").display().to_string(),
+                source,
             })?;
         let group = child.id() as i32;
         let start = Instant::now();
@@ -387,7 +387,10 @@ impl Game {
                 Err(e) => {
                     kill_group(group);
                     let _ = child.wait();
-                    return Err(Error::Domain(format!("waiting for TORCS: {e}")));
+                    return Err(Error::Command {
+                        line: self.lib_dir().join("torcs-bin").display().to_string(),
+                        source: e,
+                    });
                 }
             }
         }
@@ -454,7 +457,10 @@ impl Game {
             }
         })?;
         self.run_race(&dir.0, DEFAULT_TIMEOUT)?
-            .map_err(|why| Error::Domain(format!("{robot} on {track}: {why}")))?;
+            .map_err(|why| Error::External {
+                program: format!("the TORCS robot {robot} on {track}"),
+                message: why,
+            })?;
         // "Sim Time: T [s], Leader Laps: 1, ..." is printed as the first lap ends.
         let stdout = std::fs::read_to_string(dir.0.join("stdout.txt")).unwrap_or_default();
         let first = stdout
@@ -465,10 +471,13 @@ impl Game {
         let best = find_number(&dir.0.join("results"), "best lap time");
         match (first, best) {
             (Some(first), Some(best)) => Ok((first, best)),
-            _ => Err(Error::Domain(format!(
-                "{robot} on {track} in {car}: no lap times in the game's output ({})",
-                tail(&dir.0.join("stderr.txt"))
-            ))),
+            _ => Err(Error::External {
+                program: format!("the TORCS robot {robot} on {track} in {car}"),
+                message: format!(
+                    "no lap times in the game's output ({})",
+                    tail(&dir.0.join("stderr.txt"))
+                ),
+            }),
         }
     }
 }
@@ -518,7 +527,7 @@ pub fn read_trace(path: &Path) -> Result<Vec<TracePoint>> {
     let file = path.display().to_string();
     let mut points = Vec::new();
     for (i, line) in text.lines().enumerate().skip(1) {
-        let bad = |m: String| Error::Invalid {
+        let bad = |m: String| Error::Parse {
             file: file.clone(),
             line: Some(i as u32 + 1),
             element: "row".into(),

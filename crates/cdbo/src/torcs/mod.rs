@@ -54,13 +54,13 @@ impl Install {
             data_dir: var("CDBO_TORCS_DATA", DATA_DIR),
         };
         if !install.lib_dir.join("torcs-bin").is_file() {
-            return Err(Error::NotFound(format!(
+            return Err(Error::Setup(format!(
                 "TORCS is not installed: no {} (install it with `apt-get install torcs libplib-dev`, or set CDBO_TORCS_LIB)",
                 install.lib_dir.join("torcs-bin").display()
             )));
         }
         if !install.data_dir.join("tracks").is_dir() {
-            return Err(Error::NotFound(format!(
+            return Err(Error::Setup(format!(
                 "TORCS's data is missing: no {} (install it with `apt-get install torcs-data`, or set CDBO_TORCS_DATA)",
                 install.data_dir.join("tracks").display()
             )));
@@ -91,11 +91,11 @@ impl Install {
             names.extend(read_dir_names(&dir));
         }
         names.sort();
-        Err(Error::NotFound(format!(
-            "unknown TORCS track {name:?}: not in {} (there: {})",
-            tracks.display(),
-            names.join(", ")
-        )))
+        Err(Error::NotFound {
+            what: "TORCS track",
+            name: format!("{name:?}"),
+            detail: format!("not in {} (there: {})", tracks.display(), names.join(", ")),
+        })
     }
 
     /// Checks that the game has a car of this name (`cars/NAME/NAME.xml`).
@@ -106,11 +106,11 @@ impl Install {
         }
         let mut names = read_dir_names(&cars);
         names.sort();
-        Err(Error::NotFound(format!(
-            "unknown TORCS car {name:?}: not in {} (there: {})",
-            cars.display(),
-            names.join(", ")
-        )))
+        Err(Error::NotFound {
+            what: "TORCS car",
+            name: format!("{name:?}"),
+            detail: format!("not in {} (there: {})", cars.display(), names.join(", ")),
+        })
     }
 }
 
@@ -146,7 +146,7 @@ pub fn cache_dir() -> Result<PathBuf> {
             .join(".cache")
             .join("cdbo")
             .join("torcs")),
-        None => Err(Error::NotFound(
+        None => Err(Error::Setup(
             "no cache folder for TORCS: set CDBO_TORCS_CACHE (or HOME)".into(),
         )),
     }
@@ -161,7 +161,7 @@ pub fn sdk_dir() -> Result<PathBuf> {
     if dir.join("include").join("robot.h").is_file() {
         return Ok(dir);
     }
-    Err(Error::NotFound(format!(
+    Err(Error::Setup(format!(
         "the TORCS robot headers are not at {}: set CDBO_TORCS_SDK to a folder whose include/ holds \
          robot.h, car.h, track.h, tgf.h, ... (they come with the TORCS source: `apt-get source torcs`, \
          see torcs-robot/README.md)",
@@ -202,7 +202,7 @@ impl Game {
             } else {
                 "was built from another version of the robot"
             };
-            return Err(Error::NotFound(format!(
+            return Err(Error::Setup(format!(
                 "TORCS {why} in {}: run `cdbo torcs setup`",
                 root.display()
             )));
@@ -246,7 +246,7 @@ impl Game {
 /// previous tree untouched.
 pub fn setup(install: &Install, sdk: &Path, cache: &Path) -> Result<Game> {
     if !Path::new("/usr/include/plib/sg.h").is_file() {
-        return Err(Error::NotFound(
+        return Err(Error::Setup(
             "plib's headers are missing (/usr/include/plib/sg.h): install them with `apt-get install libplib-dev`"
                 .into(),
         ));
@@ -321,7 +321,7 @@ fn build_tree(install: &Install, sdk: &Path, dir: &Path) -> Result<()> {
         .args(["-lrobottools", "-ltgf"])
         .output()
         .map_err(|e| {
-            Error::NotFound(format!(
+            Error::Setup(format!(
                 "cannot run the C++ compiler `c++` ({e}): install it with `apt-get install g++`"
             ))
         })?;
@@ -332,7 +332,7 @@ fn build_tree(install: &Install, sdk: &Path, dir: &Path) -> Result<()> {
             .find(|l| l.contains("error"))
             .or_else(|| stderr.lines().next())
             .unwrap_or("no message");
-        return Err(Error::Domain(format!(
+        return Err(Error::Setup(format!(
             "the TORCS robot did not compile against {}: {}",
             include.display(),
             first.trim()

@@ -43,10 +43,14 @@ pub fn find(spec: &str, data: &DataPath) -> Result<Track> {
     match data.find(&rels) {
         Some(p) if p.extension().is_some_and(|e| e == "csv") => super::csv::read(&p),
         Some(p) => super::torcs::read(&p),
-        None => Err(Error::NotFound(format!(
-            "unknown track {spec:?}: not built in ({}), not a .xml or .csv file, and not found in {}",
-            builtin::names().collect::<Vec<_>>().join(", "),
-            data.describe()
-        ))),
+        None => Err(Error::NotFound {
+            what: "track",
+            name: format!("{spec:?}"),
+            detail: format!(
+                "not built in ({}), not a .xml or .csv file, and not found in {}",
+                builtin::names().collect::<Vec<_>>().join(", "),
+                data.describe()
+            ),
+        }),
     }
 }

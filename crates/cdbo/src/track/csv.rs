@@ -38,7 +38,7 @@ pub fn parse(text: &str, name: &str, file: &str) -> Result<Track> {
         if line.is_empty() || line.starts_with('#') {
             continue;
         }
-        let err = |msg: String| Error::Invalid {
+        let err = |msg: String| Error::Parse {
             file: file.to_owned(),
             line: Some(i as u32 + 1),
             element: "row".into(),
@@ -81,7 +81,7 @@ pub fn parse(text: &str, name: &str, file: &str) -> Result<Track> {
         rows.pop(); // the closing point repeats the first
     }
     if rows.len() < 10 {
-        return Err(Error::invalid(
+        return Err(Error::parse(
             file,
             "rows",
             format!(
@@ -97,7 +97,7 @@ pub fn parse(text: &str, name: &str, file: &str) -> Result<Track> {
         })
         .sum();
     if perimeter > MAX_LENGTH_M {
-        return Err(Error::invalid(
+        return Err(Error::parse(
             file,
             "rows",
             format!("the track is {perimeter:.0} m long, more than {MAX_LENGTH_M} m"),
