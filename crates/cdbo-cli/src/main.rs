@@ -75,6 +75,18 @@ fn main() -> ExitCode {
         Err(e) => return usage_error(&e),
     };
     let data = cdbo::data_path::DataPath::new(&cli.data_dirs);
+    // Only `lap` and `race` drive laps in the game so far; anything else would silently drive
+    // cdbo's simulator instead.
+    let drives_torcs = matches!(
+        cli.command,
+        Command::Lap(_) | Command::Race(_) | Command::Torcs(_)
+    );
+    if cli.simulator == commands::Simulator::Torcs && !drives_torcs {
+        eprintln!(
+            "error: --simulator torcs works with `lap` and `race` (and `cdbo torcs ...`); for `optimize` use --evaluator 'cdbo --simulator torcs lap --track T --policy {{policy}} --json'"
+        );
+        return ExitCode::from(2);
+    }
     let result = match cli.command {
         Command::Race(args) => commands::race::run(&args, &data, cli.simulator),
         Command::Experiment(args) => commands::experiment::run_grid(&args, &data),

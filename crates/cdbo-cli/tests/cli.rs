@@ -408,3 +408,16 @@ fn bench_optimizers_compares_every_method() {
         &["unknown method", "cdbo"],
     );
 }
+
+/// A command that cannot drive the game says so instead of quietly driving cdbo's simulator.
+#[test]
+fn simulator_torcs_is_refused_where_it_is_not_supported() {
+    fails_with(
+        &["--simulator", "torcs", "experiment", "quick"],
+        &["--simulator torcs works with `lap` and `race`"],
+    );
+    fails_with(
+        &["--simulator", "torcs", "serve-sim", "--kernels", "10"],
+        &["--simulator torcs works with `lap` and `race`"],
+    );
+}
