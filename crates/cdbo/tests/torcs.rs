@@ -106,3 +106,21 @@ fn unknown_names_are_clear_errors() {
         "{e}"
     );
 }
+
+/// A game that outlives its time-out is killed with its process group: the lap is reported
+/// as not driven, with the reason, and its folder is gone.
+#[test]
+fn a_hung_game_is_killed_and_says_so() {
+    let _one = one_at_a_time();
+    let Some(game) = game() else { return };
+    let mut req = game
+        .request("forza", "car1-trb1", GamePedal::Demo(15.0))
+        .unwrap();
+    req.timeout = std::time::Duration::from_millis(20);
+    let reason = game.lap(&req).unwrap().unwrap_err();
+    assert!(reason.contains("the game hung: killed after"), "{reason}");
+    assert_eq!(
+        std::fs::read_dir(game.root.join("laps")).unwrap().count(),
+        0
+    );
+}
