@@ -251,7 +251,8 @@ mod cmaes {
 fn cdbo_never_re_drives_a_lap() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../../shared/torcs/tracks/road/forza/forza.xml");
-    let track = cdbo::track::torcs::read(&path).unwrap_or_else(|e| panic!("{e}"));
+    let track = cdbo::track::torcs::read(&path, cdbo::track::Ends::MustMeet)
+        .unwrap_or_else(|e| panic!("{e}"));
     let config = cdbo::experiment::race::RaceConfig {
         kernels: 10,
         laps: 20,

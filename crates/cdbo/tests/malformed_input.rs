@@ -4,6 +4,7 @@
 mod common;
 
 use cdbo::params::Params;
+use cdbo::track::Ends;
 use common::shared;
 
 /// A small deterministic generator (SplitMix64), so that failures reproduce.
@@ -58,9 +59,9 @@ fn mutated_track_files_never_panic() {
     let mut errors = 0;
     for m in mutants(&text, 300, 1) {
         match Params::parse(&m, "mutant.xml", None)
-            .and_then(|p| cdbo::track::torcs::from_params(&p, "mutant.xml"))
+            .and_then(|p| cdbo::track::torcs::from_params(&p, "mutant.xml", Ends::MustMeet))
         {
-            Ok(t) => assert!(t.length.is_finite() && t.length > 0.0),
+            Ok(t) => assert!(t.length.is_finite() && t.length > 0.0 && t.closure.is_closed()),
             Err(e) => {
                 errors += 1;
                 assert!(e.to_string().starts_with("mutant.xml"), "{e}");

@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use cdbo::track::{Track, torcs};
+use cdbo::track::{Ends, Track, torcs};
 
 /// `../shared` beside the repository root.
 pub fn shared(rel: &str) -> PathBuf {
@@ -12,7 +12,7 @@ pub fn shared(rel: &str) -> PathBuf {
 }
 
 fn load(rel: &str) -> Track {
-    let t = torcs::read(&shared(rel)).unwrap_or_else(|e| panic!("{e}"));
+    let t = torcs::read(&shared(rel), Ends::MustMeet).unwrap_or_else(|e| panic!("{e}"));
     // The shared subset lacks objects.xml: that entity is skipped with a warning; every
     // surface must still be found.
     assert!(

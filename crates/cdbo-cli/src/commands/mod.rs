@@ -20,7 +20,7 @@ use clap::Args;
 
 use cdbo::car::{Car, catalog as cars};
 use cdbo::data_path::DataPath;
-use cdbo::track::{Track, builtin, catalog as tracks};
+use cdbo::track::{Ends, Track, builtin, catalog as tracks};
 
 /// The boxed error every command returns; printed as one line by `main`.
 pub type CliResult = Result<(), Box<dyn std::error::Error>>;
@@ -76,7 +76,12 @@ impl Setup {
 
 /// Loads a track, printing its warnings to stderr.
 pub fn load_track(spec: &str, data: &DataPath) -> Result<Track, cdbo::Error> {
-    let track = tracks::find(spec, data)?;
+    load_track_with(spec, data, Ends::MustMeet)
+}
+
+/// [`load_track`], saying what to do with a track that does not close.
+pub fn load_track_with(spec: &str, data: &DataPath, ends: Ends) -> Result<Track, cdbo::Error> {
+    let track = tracks::find_with(spec, data, ends)?;
     for w in &track.warnings {
         eprintln!("warning: {w}");
     }

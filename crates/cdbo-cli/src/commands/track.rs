@@ -3,8 +3,9 @@
 use clap::Subcommand;
 use serde::Serialize;
 
-use super::{CliResult, load_track, print_json};
+use super::{CliResult, load_track_with, print_json};
 use cdbo::data_path::DataPath;
+use cdbo::track::Ends;
 
 #[derive(Debug, Subcommand)]
 pub enum TrackCommand {
@@ -15,6 +16,10 @@ pub enum TrackCommand {
         /// Print JSON.
         #[arg(long)]
         json: bool,
+        /// Load a TORCS track whose end misses its start (by more than 1 m or 2°) with a
+        /// warning instead of refusing it: an open track can be inspected, not raced.
+        #[arg(long)]
+        open: bool,
     },
 }
 
@@ -32,8 +37,9 @@ struct Info {
 }
 
 pub fn run(cmd: &TrackCommand, data: &DataPath) -> CliResult {
-    let TrackCommand::Info { track, json } = cmd;
-    let t = load_track(track, data)?;
+    let TrackCommand::Info { track, json, open } = cmd;
+    let ends = if *open { Ends::MayMiss } else { Ends::MustMeet };
+    let t = load_track_with(track, data, ends)?;
     let (z_min_m, z_max_m) = t.z_range();
     let info = Info {
         name: t.name.clone(),

@@ -3,7 +3,14 @@
 //!
 //! External entities declared in the DOCTYPE (`<!ENTITY default-surfaces SYSTEM "...">`) are
 //! resolved relative to the file, as TORCS does; a missing entity file is skipped with a
-//! warning. Numbers are converted to SI through their `unit` attribute ([`units`]).
+//! warning, and so is an entity used without being declared (TORCS's e-track-4 uses
+//! `&default-objects;` that way). Numbers are converted to SI through their `unit` attribute
+//! ([`units`]).
+//!
+//! Files are read as bytes and decoded as UTF-8, or as Latin-1 where they are not valid UTF-8:
+//! TORCS's own `data/tracks/objects.xml` declares UTF-8 but holds a Latin-1 `é` in a comment,
+//! and the game reads it. Latin-1 maps every byte to a character, so nothing is refused; the
+//! fallback is silent because it is what the game does with the same file.
 
 pub mod units;
 
@@ -60,10 +67,7 @@ pub struct Params {
 impl Params {
     /// Reads and parses a file, resolving its external entities relative to its folder.
     pub fn read(path: &Path) -> Result<Params> {
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-            path: path.to_owned(),
-            source,
-        })?;
+        let text = read_text(path)?;
         Params::parse(&text, &path.display().to_string(), path.parent())
     }
 
@@ -303,7 +307,7 @@ fn expand_entities(
     warnings: &mut Vec<String>,
 ) -> Result<String> {
     let Some(start) = text.find("<!DOCTYPE") else {
-        return Ok(text.to_owned());
+        return skip_undeclared(text.to_owned(), &[], file, text, 0, warnings);
     };
     let end = doctype_end(text, start).ok_or_else(|| Error::Parse {
         file: file.to_owned(),
@@ -324,10 +328,7 @@ fn expand_entities(
             let rel = quoted.get(1).copied().unwrap_or_default();
             match dir.map(|d| d.join(rel)) {
                 Some(p) if p.is_file() => {
-                    let body = std::fs::read_to_string(&p).map_err(|source| Error::Io {
-                        path: p.clone(),
-                        source,
-                    })?;
+                    let body = read_text(&p)?;
                     strip_xml_decl(&body).replace(['\n', '\r'], " ")
                 }
                 Some(p) => {
@@ -356,9 +357,102 @@ fn expand_entities(
     let mut body = text[end..].to_owned();
     for (name, content) in &entities {
         body = body.replace(&format!("&{name};"), content);
+        if body.len() > MAX_EXPANDED_BYTES {
+            return Err(Error::Invalid {
+                file: file.to_owned(),
+                line: None,
+                element: format!("&{name};"),
+                message: format!(
+                    "the entities expand the file past {} MiB",
+                    MAX_EXPANDED_BYTES >> 20
+                ),
+            });
+        }
     }
     out.push_str(&body);
+    let declared: Vec<&str> = entities.iter().map(|(n, _)| n.as_str()).collect();
+    skip_undeclared(out, &declared, file, text, start, warnings)
+}
+
+/// Largest text accepted once entities are expanded (a guard against entities that
+/// multiply each other).
+const MAX_EXPANDED_BYTES: usize = 64 << 20;
+
+/// Removes references to entities that are neither declared nor predefined (`&amp;` ...) nor
+/// character references, with one warning each: TORCS skips them, an XML parser would stop.
+/// `original` is the file as read, searched for the reference's line (after `from`, where
+/// its DOCTYPE starts).
+fn skip_undeclared(
+    expanded: String,
+    declared: &[&str],
+    file: &str,
+    original: &str,
+    from: usize,
+    warnings: &mut Vec<String>,
+) -> Result<String> {
+    const PREDEFINED: [&str; 5] = ["amp", "lt", "gt", "quot", "apos"];
+    let mut undeclared: Vec<String> = Vec::new();
+    let mut rest = expanded.as_str();
+    while let Some(i) = rest.find('&') {
+        let after = &rest[i + 1..];
+        let len = after
+            .find(|c: char| !(c.is_alphanumeric() || matches!(c, '-' | '.' | '_' | ':')))
+            .unwrap_or(after.len());
+        if after[len..].starts_with(';') && is_xml_name(&after[..len]) {
+            let name = &after[..len];
+            if !PREDEFINED.contains(&name)
+                && !declared.contains(&name)
+                && !undeclared.iter().any(|u| u == name)
+            {
+                undeclared.push(name.to_owned());
+            }
+        }
+        rest = after;
+    }
+    if undeclared.is_empty() {
+        return Ok(expanded);
+    }
+    let mut out = expanded;
+    for name in &undeclared {
+        let reference = format!("&{name};");
+        let line = original[from..]
+            .find(&reference)
+            .map(|i| format!(":{}", line_of(original, from + i)))
+            .unwrap_or_default();
+        warnings.push(format!(
+            "{file}{line}: entity {reference} is used but not declared, skipped (as TORCS does)"
+        ));
+        out = out.replace(&reference, "");
+    }
     Ok(out)
+}
+
+/// An XML name as an entity reference uses it: a letter, `_` or `:` then letters, digits,
+/// `-`, `.`, `_`, `:`.
+fn is_xml_name(s: &str) -> bool {
+    let mut chars = s.chars();
+    chars
+        .next()
+        .is_some_and(|c| c.is_alphabetic() || c == '_' || c == ':')
+        && chars.all(|c| c.is_alphanumeric() || matches!(c, '-' | '.' | '_' | ':'))
+}
+
+/// Reads a file as text: UTF-8, or Latin-1 where it is not valid UTF-8 (see the module doc).
+pub fn read_text(path: &Path) -> Result<String> {
+    let bytes = std::fs::read(path).map_err(|source| Error::Io {
+        path: path.to_owned(),
+        source,
+    })?;
+    Ok(decode(bytes))
+}
+
+/// Decodes bytes as UTF-8, or as Latin-1 (each byte the character of that code) when they are
+/// not valid UTF-8.
+pub fn decode(bytes: Vec<u8>) -> String {
+    match String::from_utf8(bytes) {
+        Ok(text) => text,
+        Err(e) => e.into_bytes().iter().map(|&b| char::from(b)).collect(),
+    }
 }
 
 /// A decimal number, or a hexadecimal integer such as `0x00FF00` (C's `strtod` reads both).
@@ -446,6 +540,46 @@ mod tests {
         assert!(e.starts_with("sample.xml:"), "{e}");
         let e = p_missing();
         assert!(e.contains("A/width") && e.contains("missing"), "{e}");
+    }
+
+    #[test]
+    fn latin1_bytes_decode_as_latin1() {
+        // TORCS's objects.xml: declared UTF-8, a Latin-1 é (0xE9) in a comment.
+        let bytes =
+            b"<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<!-- cr\xe9\xe9 -->\n<params/>".to_vec();
+        let text = decode(bytes);
+        assert!(text.contains("cr\u{e9}\u{e9}"), "{text}");
+        assert!(Params::parse(&text, "o.xml", None).is_ok());
+        assert_eq!(
+            decode("d\u{e9}j\u{e0}".as_bytes().to_vec()),
+            "d\u{e9}j\u{e0}"
+        );
+    }
+
+    #[test]
+    fn an_undeclared_entity_is_skipped_with_a_warning_naming_its_line() {
+        let text = SAMPLE.replace(
+            "<section name=\"B\">",
+            "<section name=\"B\">&default-objects;",
+        );
+        let p = Params::parse(&text, "e.xml", None).unwrap();
+        assert!(p.section("A/B").is_some());
+        assert!(
+            p.warnings
+                .iter()
+                .any(|w| w.starts_with("e.xml:9:") && w.contains("&default-objects;")),
+            "{:?}",
+            p.warnings
+        );
+        // Predefined and character references are XML's own, left to the parser.
+        let p = Params::parse(
+            r#"<params><attstr name="a" val="x &amp; y &#233;"/></params>"#,
+            "p.xml",
+            None,
+        )
+        .unwrap();
+        assert_eq!(p.root.str("a"), Some("x & y \u{e9}"));
+        assert!(p.warnings.is_empty(), "{:?}", p.warnings);
     }
 
     fn p_missing() -> String {

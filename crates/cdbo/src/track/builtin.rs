@@ -21,7 +21,10 @@ pub fn names() -> impl Iterator<Item = &'static str> {
 pub fn load(name: &str) -> Option<Result<Track>> {
     let (name, xml) = TRACKS.iter().find(|(n, _)| *n == name)?;
     let source = format!("builtin:{name}");
-    Some(Params::parse(xml, &source, None).and_then(|p| super::torcs::from_params(&p, &source)))
+    Some(
+        Params::parse(xml, &source, None)
+            .and_then(|p| super::torcs::from_params(&p, &source, super::Ends::MustMeet)),
+    )
 }
 
 #[cfg(test)]

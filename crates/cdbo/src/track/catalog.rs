@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use super::{Track, builtin};
+use super::{Ends, Track, builtin};
 use crate::data_path::DataPath;
 use crate::error::{Error, Result};
 
@@ -20,12 +20,17 @@ const CATEGORIES: &[&str] = &[
 /// Resolves `spec`: a built-in name, a `.xml` (TORCS) or `.csv` (TUMFTM) path, or a track
 /// name in the data folders (`tracks/CATEGORY/NAME/NAME.xml` or `tracks/csv/NAME.csv`).
 pub fn find(spec: &str, data: &DataPath) -> Result<Track> {
+    find_with(spec, data, Ends::MustMeet)
+}
+
+/// [`find`], with what to do when a TORCS track does not close (a CSV centre line always does).
+pub fn find_with(spec: &str, data: &DataPath, ends: Ends) -> Result<Track> {
     if let Some(t) = builtin::load(spec) {
         return t;
     }
     let path = Path::new(spec);
     match path.extension().and_then(|e| e.to_str()) {
-        Some("xml") => return super::torcs::read(path),
+        Some("xml") => return super::torcs::read(path, ends),
         Some("csv") => return super::csv::read(path),
         _ => {}
     }
@@ -42,7 +47,7 @@ pub fn find(spec: &str, data: &DataPath) -> Result<Track> {
     rels.push(format!("tracks/csv/{cap}.csv"));
     match data.find(&rels) {
         Some(p) if p.extension().is_some_and(|e| e == "csv") => super::csv::read(&p),
-        Some(p) => super::torcs::read(&p),
+        Some(p) => super::torcs::read(&p, ends),
         None => Err(Error::NotFound {
             what: "track",
             name: format!("{spec:?}"),

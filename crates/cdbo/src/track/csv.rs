@@ -90,6 +90,16 @@ pub fn parse(text: &str, name: &str, file: &str) -> Result<Track> {
             ),
         ));
     }
+    if let Some(spread) = collinear_spread(&rows) {
+        return Err(Error::invalid(
+            file,
+            "rows",
+            format!(
+                "a degenerate centre line: its {} points lie within {spread:.3} m of one straight line (a circuit needs at least {MIN_SPREAD_M} m across it)",
+                rows.len()
+            ),
+        ));
+    }
     let perimeter: f64 = (0..rows.len())
         .map(|i| {
             let (p, q) = (rows[i], rows[(i + 1) % rows.len()]);
@@ -104,6 +114,37 @@ pub fn parse(text: &str, name: &str, file: &str) -> Result<Track> {
         ));
     }
     Ok(build(&rows, name, file))
+}
+
+/// Least width across its main axis a centre line must span to be a circuit (m).
+pub const MIN_SPREAD_M: f64 = 1.0;
+
+/// `Some(spread)` when the points lie within a band narrower than [`MIN_SPREAD_M`] around
+/// their principal axis (the eigenvector of the largest eigenvalue of their covariance);
+/// the spread is the band's width, max − min of the offsets across that axis.
+fn collinear_spread(rows: &[[f64; 4]]) -> Option<f64> {
+    let n = rows.len() as f64;
+    let (mx, my) = rows
+        .iter()
+        .fold((0.0, 0.0), |(x, y), r| (x + r[0] / n, y + r[1] / n));
+    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
+    for r in rows {
+        let (dx, dy) = (r[0] - mx, r[1] - my);
+        sxx += dx * dx;
+        sxy += dx * dy;
+        syy += dy * dy;
+    }
+    // Direction of the principal axis: θ = ½·atan2(2·sxy, sxx − syy).
+    let theta = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+    let (sin, cos) = theta.sin_cos();
+    let (lo, hi) = rows
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), r| {
+            let across = -(r[0] - mx) * sin + (r[1] - my) * cos;
+            (lo.min(across), hi.max(across))
+        });
+    let spread = hi - lo;
+    (spread < MIN_SPREAD_M).then_some(spread)
 }
 
 fn build(rows: &[[f64; 4]], name: &str, file: &str) -> Track {
@@ -264,5 +305,28 @@ mod tests {
         assert!(e.contains("at least 10 points"), "{e}");
         let e = parse("1,2,3\n", "c", "c.csv").unwrap_err().to_string();
         assert!(e.contains("expected 4 columns"), "{e}");
+    }
+
+    #[test]
+    fn collinear_centre_lines_are_refused() {
+        // Out and back along a tilted line, 0.2 mm of noise across it: no circuit.
+        let mut s = String::new();
+        for i in 0..40 {
+            let t = if i < 20 { i } else { 40 - i } as f64 * 10.0;
+            let jitter = if i % 2 == 0 { 1e-4 } else { -1e-4 };
+            s += &format!("{},{},4,4\n", 3.0 * t - jitter, 4.0 * t + jitter);
+        }
+        let e = parse(&s, "c", "c.csv").unwrap_err().to_string();
+        assert!(e.contains("degenerate") && e.contains("40 points"), "{e}");
+        // A 2 m-wide sliver passes this check; a circle is nowhere near it.
+        assert!(
+            collinear_spread(&[
+                [0.0, 0.0, 1.0, 1.0],
+                [10.0, 2.0, 1.0, 1.0],
+                [20.0, 0.0, 1.0, 1.0]
+            ])
+            .is_none()
+        );
+        assert!(parse(&circle_csv(72, 200.0), "c", "c.csv").is_ok());
     }
 }

@@ -354,6 +354,41 @@ impl Track {
     }
 }
 
+/// Largest gap between a circuit's end and its start (m) accepted as closed. The 38 tracks of
+/// TORCS 1.3.7 and Speed Dreams' Allondaz miss by at most 0.27 m (wheel-2), from the game's
+/// own rounding of segment lengths; a gap of metres is a mistake in the file.
+pub const CLOSURE_GAP_M: f64 = 1.0;
+
+/// Largest difference between a circuit's end and start headings accepted as closed (deg);
+/// real tracks are within 0.02°.
+pub const CLOSURE_HEADING_DEG: f64 = 2.0;
+
+/// What a loader does with a track whose end misses its start by more than
+/// [`CLOSURE_GAP_M`] or [`CLOSURE_HEADING_DEG`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Ends {
+    /// Refuse it, naming the gap: a lap must end where it starts (the default).
+    #[default]
+    MustMeet,
+    /// Load it with a warning naming the gap (the user asked for an open track).
+    MayMiss,
+}
+
+impl Closure {
+    /// Whether the ends meet within [`CLOSURE_GAP_M`] and [`CLOSURE_HEADING_DEG`].
+    pub fn is_closed(&self) -> bool {
+        self.gap_m <= CLOSURE_GAP_M && self.heading_deg.abs() <= CLOSURE_HEADING_DEG
+    }
+
+    /// "its end misses its start by G m and H°".
+    pub fn describe(&self) -> String {
+        format!(
+            "its end misses its start by {:.2} m and {:.2}° (a circuit closes within {CLOSURE_GAP_M} m and {CLOSURE_HEADING_DEG}°)",
+            self.gap_m, self.heading_deg
+        )
+    }
+}
+
 /// Longest track accepted (m): longer files are refused rather than sampled.
 pub const MAX_LENGTH_M: f64 = 100_000.0;
 

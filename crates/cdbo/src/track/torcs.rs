@@ -1,6 +1,12 @@
-//! TORCS / Speed Dreams track files (`tracks/road/NAME/NAME.xml`, version 4 segments).
+//! TORCS / Speed Dreams track files (`tracks/road/NAME/NAME.xml`).
 //!
-//! Follows TORCS's `track4.cpp` rules, so lengths equal the game's:
+//! `Header/version` chooses the layout, as TORCS's `TrackBuildv1` does: versions 0–3
+//! (`track3.cpp`) keep the segments in `Main Track/segments` and the surfaces in
+//! `Surfaces/List`, where a `z start` / `z end` sets both edges (so the banking defaults to
+//! level); version 4 and up (`track4.cpp`, Speed Dreams' 5) use `Main Track/Track Segments`
+//! and `Surfaces`. A file without a version uses whichever segment list it has.
+//!
+//! Both follow the same rules otherwise, so lengths equal the game's:
 //! - `str`: length `lg`. `lft` / `rgt`: radius r, `end radius` r₁ (default r), `arc` α;
 //!   nominal length (r + r₁)/2 · α.
 //! - Each segment is cut into `steps` = ⌊length / `profil steps length`⌋ + 1 sub-segments (or
@@ -14,18 +20,19 @@
 
 use std::path::Path;
 
-use super::{MAX_LENGTH_M, Piece, Track};
+use super::{Ends, MAX_LENGTH_M, Piece, Track};
 use crate::error::Result;
 use crate::params::{Params, Section};
 
-/// Reads a TORCS track file.
-pub fn read(path: &Path) -> Result<Track> {
+/// Reads a TORCS track file; `ends` says what to do when it does not close.
+pub fn read(path: &Path, ends: Ends) -> Result<Track> {
     let params = Params::read(path)?;
-    from_params(&params, &path.display().to_string())
+    from_params(&params, &path.display().to_string(), ends)
 }
 
-/// Builds a track from parsed parameters; `source` is recorded in the track.
-pub fn from_params(params: &Params, source: &str) -> Result<Track> {
+/// Builds a track from parsed parameters; `source` is recorded in the track. A track whose end
+/// misses its start is refused, or loaded with a warning when `ends` is [`Ends::MayMiss`].
+pub fn from_params(params: &Params, source: &str, ends: Ends) -> Result<Track> {
     let file = params.file.as_str();
     let mut warnings = params.warnings.clone();
     let main = params.require_section("Main Track")?;
@@ -38,12 +45,16 @@ pub fn from_params(params: &Params, source: &str) -> Result<Track> {
         ));
     }
     let global_step = main.num_or(file, "profil steps length", 0.0)?;
-    let segments = params.require_section("Main Track/Track Segments")?;
+    let layout = Layout::of(params)?;
+    let segments = params.require_section(layout.segments())?;
     if segments.sections.is_empty() {
         return Err(params.error(&segments.path, Some(segments.line), "no segments"));
     }
     let mut surface = main.str("surface").unwrap_or("asphalt").to_owned();
-    let mut state = ProfileState::default();
+    let mut state = ProfileState {
+        sides_follow_z: layout == Layout::V3,
+        ..ProfileState::default()
+    };
     let mut pieces = Vec::new();
     for seg in &segments.sections {
         if let Some(name) = seg.str("surface") {
@@ -78,12 +89,68 @@ pub fn from_params(params: &Params, source: &str) -> Result<Track> {
                 .map(|s| s.to_string_lossy().into_owned())
                 .unwrap_or_default()
         });
-    Ok(Track::from_pieces(&name, source, &pieces, warnings))
+    let mut track = Track::from_pieces(&name, source, &pieces, warnings);
+    if !track.closure.is_closed() {
+        match ends {
+            Ends::MustMeet => {
+                return Err(params.error(
+                    &segments.path,
+                    Some(segments.line),
+                    format!("not a circuit: {}", track.closure.describe()),
+                ));
+            }
+            Ends::MayMiss => track.warnings.push(format!(
+                "{file}: an open track: {}",
+                track.closure.describe()
+            )),
+        }
+    }
+    Ok(track)
 }
 
-/// Friction of a named surface; 1.0 with a warning when the surface is not defined.
+/// Where a track file keeps its segments and surfaces.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Layout {
+    /// Versions 0–3 (`track3.cpp`).
+    V3,
+    /// Versions 4 and up (`track4.cpp`).
+    V4,
+}
+
+impl Layout {
+    const V3_SEGMENTS: &str = "Main Track/segments";
+    const V4_SEGMENTS: &str = "Main Track/Track Segments";
+
+    fn of(params: &Params) -> Result<Layout> {
+        let header = params.section("Header");
+        match header.map(|h| h.num(&params.file, "version")).transpose()? {
+            Some(Some(v)) if v < 4.0 => Ok(Layout::V3),
+            Some(Some(_)) => Ok(Layout::V4),
+            _ if params.section(Self::V4_SEGMENTS).is_none()
+                && params.section(Self::V3_SEGMENTS).is_some() =>
+            {
+                Ok(Layout::V3)
+            }
+            _ => Ok(Layout::V4),
+        }
+    }
+
+    fn segments(self) -> &'static str {
+        match self {
+            Layout::V3 => Self::V3_SEGMENTS,
+            Layout::V4 => Self::V4_SEGMENTS,
+        }
+    }
+}
+
+/// Friction of a named surface (in `Surfaces` or, for version 3, `Surfaces/List`); 1.0 with
+/// a warning when the surface is not defined.
 fn surface_friction(params: &Params, surface: &str, warnings: &mut Vec<String>) -> Result<f64> {
-    match params.section("Surfaces").and_then(|s| s.section(surface)) {
+    let surfaces = params.section("Surfaces");
+    let found = surfaces
+        .and_then(|s| s.section(surface))
+        .or_else(|| surfaces.and_then(|s| s.section("List")?.section(surface)));
+    match found {
         Some(sec) => {
             let f = sec.num_or(&params.file, "friction", 1.0)?;
             if f <= 0.0 {
@@ -119,6 +186,8 @@ struct ProfileState {
     etgtr: f64,
     /// The last `grade` given, if any.
     grade: Option<f64>,
+    /// Version 3: `z start` / `z end` set both edges before the banking is derived.
+    sides_follow_z: bool,
 }
 
 /// Cubic Hermite interpolation between heights p0, p1 with end slopes t0, t1 (scaled by the
@@ -199,11 +268,21 @@ fn segment_pieces(
         st.grade = Some(g);
     }
     let zs = match seg.num(file, "z start")? {
-        Some(z) => z,
+        Some(z) => {
+            if st.sides_follow_z {
+                (zsl, zsr) = (z, z);
+            }
+            z
+        }
         None => 0.5 * (zsl + zsr),
     };
     let ze = match (seg.num(file, "z end")?, st.grade) {
-        (Some(z), _) => z,
+        (Some(z), _) => {
+            if st.sides_follow_z {
+                (zel, zer) = (z, z);
+            }
+            z
+        }
         (None, Some(g)) => zs + length * g,
         (None, None) => 0.5 * (zel + zer),
     };
@@ -317,7 +396,7 @@ mod tests {
             <attnum name="profil steps length" unit="m" val="4"/>
             <section name="Track Segments">{segments}</section></section></params>"#
         );
-        from_params(&Params::parse(&xml, "t.xml", None)?, "t.xml")
+        from_params(&Params::parse(&xml, "t.xml", None)?, "t.xml", Ends::MayMiss)
     }
 
     #[test]
@@ -353,6 +432,69 @@ mod tests {
         );
         // The mean-radius length 150·π/2 ≈ 235.6 m is only approximate for a spiral.
         assert!((t.length - 235.6).abs() < 10.0, "length {}", t.length);
+    }
+
+    const HALF: &str = r#"<attstr name="type" val="lft"/><attnum name="radius" unit="m" val="50"/><attnum name="arc" unit="deg" val="180"/>"#;
+    const STRAIGHT: &str =
+        r#"<attstr name="type" val="str"/><attnum name="lg" unit="m" val="100"/>"#;
+
+    #[test]
+    fn version_3_files_keep_segments_and_surfaces_in_their_own_sections() {
+        let xml = format!(
+            r#"<params><section name="Surfaces"><section name="List"><section name="dirt">
+                 <attnum name="friction" val="0.7"/></section></section></section>
+               <section name="Header"><attnum name="version" val="3"/></section>
+               <section name="Main Track"><attstr name="surface" val="dirt"/>
+                 <section name="segments"><section name="a">{STRAIGHT}</section>
+                   <section name="b">{HALF}</section><section name="c">{STRAIGHT}</section>
+                   <section name="d">{HALF}</section></section></section></params>"#
+        );
+        let p = Params::parse(&xml, "v3.xml", None).unwrap();
+        let t = from_params(&p, "v3.xml", Ends::MustMeet).unwrap();
+        assert!((t.length - (200.0 + 100.0 * std::f64::consts::PI)).abs() < 1e-9);
+        assert!(t.samples.iter().all(|c| c.friction == 0.7));
+        assert!(t.warnings.is_empty(), "{:?}", t.warnings);
+        // Version 4 looks for `Track Segments`, and says so.
+        let v4 = xml.replace(r#"val="3""#, r#"val="4""#);
+        let e = from_params(
+            &Params::parse(&v4, "v4.xml", None).unwrap(),
+            "v4.xml",
+            Ends::MustMeet,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("Main Track/Track Segments: missing section"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_track_that_does_not_close_is_refused_unless_asked_for() {
+        // The stadium without its last half circle: its end is 100 m from its start.
+        let segs = format!(
+            r#"<section name="a">{STRAIGHT}</section><section name="b">{HALF}</section>
+               <section name="c">{STRAIGHT}</section>"#
+        );
+        let xml = format!(
+            r#"<params name="t"><section name="Main Track">
+            <section name="Track Segments">{segs}</section></section></params>"#
+        );
+        let p = Params::parse(&xml, "open.xml", None).unwrap();
+        let e = from_params(&p, "open.xml", Ends::MustMeet)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("open.xml:2: Main Track/Track Segments: not a circuit")
+                && e.contains("by 100.00 m and -180.00°"),
+            "{e}"
+        );
+        let t = from_params(&p, "open.xml", Ends::MayMiss).unwrap();
+        assert!(
+            t.warnings.iter().any(|w| w.contains("open track")),
+            "{:?}",
+            t.warnings
+        );
     }
 
     #[test]
