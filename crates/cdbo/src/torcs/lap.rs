@@ -512,7 +512,7 @@ fn default_time_limit(install: &crate::torcs::Install, track: &str, category: &s
         .join(category)
         .join(track)
         .join(format!("{track}.xml"));
-    crate::track::torcs::read(&file)
+    crate::track::torcs::read(&file, crate::track::Ends::MayMiss)
         .map(|t| 30.0 + t.length / 4.0)
         .unwrap_or(1800.0)
 }
