@@ -88,49 +88,11 @@ pub fn read_policy(path: &Path) -> Result<RkhsPolicy, Box<dyn std::error::Error>
     )
 }
 
-/// Reads `x,a` pairs; with more columns, uses the `x` and `pedal` (or `a`) columns by name.
+/// Reads a demonstration's (x, a) pairs ([`cdbo::policy::demo`]).
 pub fn read_demo(path: &Path) -> Result<Vec<(f64, f64)>, Box<dyn std::error::Error>> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let mut lines = text
-        .lines()
-        .enumerate()
-        .filter(|(_, l)| !l.trim().is_empty() && !l.starts_with('#'))
-        .peekable();
-    let (mut xc, mut ac) = (0, 1);
-    if let Some((_, first)) = lines.peek()
-        && first.chars().next().is_some_and(char::is_alphabetic)
-    {
-        let header: Vec<&str> = first.split(',').map(str::trim).collect();
-        xc = header
-            .iter()
-            .position(|h| *h == "x")
-            .ok_or_else(|| format!("{}: no x column in the header", path.display()))?;
-        ac = header
-            .iter()
-            .position(|h| *h == "a" || *h == "pedal")
-            .ok_or_else(|| format!("{}: no a (or pedal) column in the header", path.display()))?;
-        lines.next();
-    }
-    let mut pairs = Vec::new();
-    for (i, line) in lines {
-        let cols: Vec<&str> = line.split(',').map(str::trim).collect();
-        let get = |c: usize| -> Result<f64, String> {
-            cols.get(c)
-                .and_then(|s| s.parse::<f64>().ok())
-                .filter(|v| v.is_finite())
-                .ok_or_else(|| {
-                    format!(
-                        "{}:{}: column {} is not a finite number",
-                        path.display(),
-                        i + 1,
-                        c + 1
-                    )
-                })
-        };
-        pairs.push((get(xc)?, get(ac)?));
-    }
-    if pairs.is_empty() {
-        return Err(format!("{}: the demonstration is empty", path.display()).into());
-    }
-    Ok(pairs)
+    Ok(cdbo::policy::demo::parse(
+        &text,
+        &path.display().to_string(),
+    )?)
 }

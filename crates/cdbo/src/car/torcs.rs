@@ -67,7 +67,7 @@ pub fn from_params(p: &Params) -> Result<Car> {
         } else {
             Err(p.error(
                 &format!("{}/{name}", s.path),
-                Some(s.line),
+                Some(s.line_of(name)),
                 format!("must be positive, got {v}"),
             ))
         }
@@ -78,7 +78,7 @@ pub fn from_params(p: &Params) -> Result<Car> {
         } else {
             Err(p.error(
                 &format!("{}/{name}", s.path),
-                Some(s.line),
+                Some(s.line_of(name)),
                 format!("must be in [0, 1], got {v}"),
             ))
         }
@@ -128,7 +128,7 @@ pub fn from_params(p: &Params) -> Result<Car> {
         {
             return Err(p.error(
                 &format!("{}/rpm", pt.path),
-                Some(pt.line),
+                Some(pt.line_of("rpm")),
                 "engine speeds must increase",
             ));
         }

@@ -148,6 +148,12 @@ impl Section {
         }
     }
 
+    /// The line of the attribute called `name`, or of the section when it has none: where an
+    /// error about that value points.
+    pub fn line_of(&self, name: &str) -> u32 {
+        self.attr(name).map_or(self.line, |a| a.line)
+    }
+
     /// The attribute called `name`, if any.
     pub fn attr(&self, name: &str) -> Option<&Attr> {
         self.attrs.iter().find(|a| a.name == name)

@@ -1,5 +1,6 @@
 //! Driving policies π(x): the pedal command as a function of the lap fraction x ∈ [0, 1].
 
+pub mod demo;
 pub mod rkhs;
 pub mod table;
 

@@ -43,7 +43,11 @@ impl PolicyTable {
             path: path.to_owned(),
             source,
         })?;
-        let file = path.display().to_string();
+        PolicyTable::parse_csv(&text, &path.display().to_string())
+    }
+
+    /// Parses `x,a` rows; `file` names the text in errors.
+    pub fn parse_csv(text: &str, file: &str) -> Result<PolicyTable> {
         let mut points = Vec::new();
         for (i, line) in text.lines().enumerate() {
             let line = line.trim();
@@ -54,7 +58,7 @@ impl PolicyTable {
                 continue;
             }
             let err = |m: String| Error::Parse {
-                file: file.clone(),
+                file: file.to_owned(),
                 line: Some(i as u32 + 1),
                 element: "row".into(),
                 message: m,

@@ -40,7 +40,7 @@ pub fn from_params(params: &Params, source: &str, ends: Ends) -> Result<Track> {
     if width <= 0.0 {
         return Err(params.error(
             "Main Track/width",
-            Some(main.line),
+            Some(main.line_of("width")),
             format!("width must be positive, got {width} m"),
         ));
     }
@@ -156,7 +156,7 @@ fn surface_friction(params: &Params, surface: &str, warnings: &mut Vec<String>) 
             if f <= 0.0 {
                 return Err(params.error(
                     &format!("{}/friction", sec.path),
-                    Some(sec.line),
+                    Some(sec.line_of("friction")),
                     format!("friction must be positive, got {f}"),
                 ));
             }
@@ -211,7 +211,11 @@ fn segment_pieces(
 ) -> Result<()> {
     let file = params.file.as_str();
     let err = |field: &str, msg: String| {
-        params.error(&format!("{}/{field}", seg.path), Some(seg.line), msg)
+        params.error(
+            &format!("{}/{field}", seg.path),
+            Some(seg.line_of(field)),
+            msg,
+        )
     };
     let kind = seg
         .str("type")
@@ -494,6 +498,19 @@ mod tests {
             t.warnings.iter().any(|w| w.contains("open track")),
             "{:?}",
             t.warnings
+        );
+    }
+
+    #[test]
+    fn a_bad_value_names_its_own_line() {
+        let e = track_of(
+            "<section name=\"s\">\n<attstr name=\"type\" val=\"lft\"/>\n<attnum name=\"radius\" val=\"-5\"/>\n<attnum name=\"arc\" val=\"1\"/></section>",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.starts_with("t.xml:5: ") && e.contains("radii must be positive"),
+            "{e}"
         );
     }
 
