@@ -364,7 +364,7 @@ fn expand_entities(
     for (name, content) in &entities {
         body = body.replace(&format!("&{name};"), content);
         if body.len() > MAX_EXPANDED_BYTES {
-            return Err(Error::Invalid {
+            return Err(Error::Parse {
                 file: file.to_owned(),
                 line: None,
                 element: format!("&{name};"),

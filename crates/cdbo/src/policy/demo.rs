@@ -25,7 +25,7 @@ pub fn parse(text: &str, file: &str) -> Result<Vec<(f64, f64)>> {
             header
                 .iter()
                 .position(|h| names.contains(h))
-                .ok_or_else(|| Error::Invalid {
+                .ok_or_else(|| Error::Parse {
                     file: file.to_owned(),
                     line: Some(i as u32 + 1),
                     element: "header".into(),
@@ -43,7 +43,7 @@ pub fn parse(text: &str, file: &str) -> Result<Vec<(f64, f64)>> {
             cols.get(c)
                 .and_then(|s| s.parse::<f64>().ok())
                 .filter(|v| v.is_finite())
-                .ok_or_else(|| Error::Invalid {
+                .ok_or_else(|| Error::Parse {
                     file: file.to_owned(),
                     line: Some(i as u32 + 1),
                     element: format!("column {}", c + 1),
@@ -53,7 +53,7 @@ pub fn parse(text: &str, file: &str) -> Result<Vec<(f64, f64)>> {
         pairs.push((get(xc)?, get(ac)?));
     }
     if pairs.is_empty() {
-        return Err(Error::invalid(file, "rows", "the demonstration is empty"));
+        return Err(Error::parse(file, "rows", "the demonstration is empty"));
     }
     Ok(pairs)
 }

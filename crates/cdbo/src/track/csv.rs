@@ -91,7 +91,7 @@ pub fn parse(text: &str, name: &str, file: &str) -> Result<Track> {
         ));
     }
     if let Some(spread) = collinear_spread(&rows) {
-        return Err(Error::invalid(
+        return Err(Error::parse(
             file,
             "rows",
             format!(
