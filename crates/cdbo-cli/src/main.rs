@@ -46,6 +46,8 @@ enum Command {
     /// The ceiling: the fastest completed lap tracking k x the limit's speed profile, and the
     /// best M-kernel policy fitted to its pedal.
     Ceiling(commands::ceiling::CeilingArgs),
+    /// A live local web page over studies and experiment folders (read-only).
+    Dashboard(commands::dashboard::DashboardArgs),
     /// Inspect tracks.
     #[command(subcommand)]
     Track(commands::track::TrackCommand),
@@ -97,6 +99,7 @@ fn main() -> ExitCode {
         Command::Lap(args) => commands::lap::run(&args, &data, cli.simulator),
         Command::Limit(args) => commands::limit::run(&args, &data),
         Command::Ceiling(args) => commands::ceiling::run(&args, &data),
+        Command::Dashboard(args) => commands::dashboard::run(&args, &data),
         Command::Track(cmd) => commands::track::run(&cmd, &data),
         Command::Plot(cmd) => commands::plot::run(&cmd, &data),
         Command::Policy(cmd) => commands::policy::run(&cmd),

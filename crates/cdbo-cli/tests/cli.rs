@@ -421,3 +421,30 @@ fn simulator_torcs_is_refused_where_it_is_not_supported() {
         &["--simulator torcs works with `lap` and `race`"],
     );
 }
+
+#[test]
+fn dashboard_refuses_bad_sources_and_a_port_in_use_in_one_line() {
+    let missing = scratch("dash-gone", "");
+    std::fs::remove_file(&missing).unwrap();
+    let missing = missing.to_str().unwrap();
+    fails_with(&["dashboard", "--db", missing], &[missing, "no such study"]);
+    let words = scratch("dash-notes.txt", "not a study, only words\n");
+    let words = words.to_str().unwrap();
+    fails_with(&["dashboard", "--db", words], &[words, "not a cdbo study"]);
+    fails_with(
+        &["dashboard", "--experiment", missing],
+        &[missing, "no such folder"],
+    );
+    fails_with(&["dashboard"], &["nothing to show"]);
+    let taken = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    let addr = taken.local_addr().unwrap().to_string();
+    let dir = std::env::temp_dir().to_str().unwrap().to_owned();
+    fails_with(
+        &["dashboard", "--experiment", &dir, "--bind", &addr],
+        &[&addr, "in use"],
+    );
+    fails_with(
+        &["dashboard", "--experiment", &dir, "--bind", "localhost"],
+        &["--bind", "localhost", "an address and port"],
+    );
+}

@@ -2,6 +2,7 @@
 
 pub mod bench;
 pub mod ceiling;
+pub mod dashboard;
 pub mod experiment;
 pub mod lap;
 pub mod limit;

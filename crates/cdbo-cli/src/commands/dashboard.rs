@@ -1,0 +1,63 @@
+//! `cdbo dashboard`: a live local web page over studies and experiment folders (read-only).
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use cdbo::car::catalog as cars;
+use cdbo::data_path::DataPath;
+use cdbo_dashboard::store::Files;
+use cdbo_dashboard::{DEFAULT_BIND, Dashboard};
+use clap::Args;
+
+use super::CliResult;
+
+/// Arguments of `cdbo dashboard`.
+#[derive(Debug, Args)]
+pub struct DashboardArgs {
+    /// A study file to show (repeatable); opened read-only.
+    #[arg(long = "db", value_name = "STUDY")]
+    studies: Vec<PathBuf>,
+    /// An experiment output folder to show (repeatable); runs appear as they finish.
+    #[arg(long = "experiment", value_name = "DIR")]
+    experiments: Vec<PathBuf>,
+    /// Address and port to serve on (this machine only by default).
+    #[arg(long, default_value = DEFAULT_BIND)]
+    bind: String,
+    /// The track the studies' laps are driven on, to re-drive their trials on the map.
+    #[arg(long)]
+    track: Option<String>,
+    /// The car re-driven on the map.
+    #[arg(long, default_value = cars::DEFAULT)]
+    car: String,
+}
+
+/// Serves the dashboard until interrupted.
+pub fn run(args: &DashboardArgs, data: &DataPath) -> CliResult {
+    if args.studies.is_empty() && args.experiments.is_empty() {
+        return Err("nothing to show: give --db STUDY and/or --experiment DIR".into());
+    }
+    let mut sources = Vec::new();
+    for path in &args.studies {
+        sources.push(Files::study_source(path)?);
+    }
+    for dir in &args.experiments {
+        sources.push(Files::experiment_source(dir)?);
+    }
+    let dashboard = Dashboard {
+        sources,
+        store: Box::new(Files),
+        study_track: args.track.clone(),
+        car: args.car.clone(),
+        data: data.clone(),
+    };
+    let bound = dashboard.bind(&args.bind)?;
+    println!(
+        "cdbo dashboard on http://{}/ ({} studies, {} experiments); Ctrl-C to stop",
+        bound.local_addr()?,
+        args.studies.len(),
+        args.experiments.len()
+    );
+    std::io::stdout().flush()?;
+    bound.serve()?;
+    Ok(())
+}
