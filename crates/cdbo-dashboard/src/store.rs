@@ -42,7 +42,7 @@ pub struct Files;
 impl Files {
     /// Checks that `path` is a study, opening it read-only.
     pub fn study_source(path: &Path) -> Result<Source> {
-        Study::open(path)?;
+        Study::open_read_only(path)?;
         Ok(Source {
             kind: Kind::Study,
             location: path.display().to_string(),
@@ -75,7 +75,7 @@ impl Files {
 
 impl Store for Files {
     fn study(&self, source: &Source) -> Result<(StudyConfig, Vec<Trial>)> {
-        let study = Study::open(Path::new(&source.location))?;
+        let study = Study::open_read_only(Path::new(&source.location))?;
         Ok((study.config().clone(), study.history()?))
     }
 
