@@ -211,6 +211,7 @@ mod cmaes {
     }
 
     #[test]
+    #[ignore = "slow (3 CMA-ES runs of ~75,000 evaluations in 50-D): .ci/run runs it with --ignored"]
     fn ellipsoid_50_is_within_20_percent_of_pycma() {
         let m = median_evals(ellipsoid, 50, 1.0, 1.0, 3, 200_000) as f64;
         eprintln!("ellipsoid-50: median {m} evaluations (pycma 74565)");

@@ -158,6 +158,7 @@ fn every_method_refuses_bad_tells_and_keeps_its_state() {
 /// random search on Ackley in 20 dimensions; here over 10 seeds of 150 evaluations, against
 /// Gaussian random search around the best point.
 #[test]
+#[ignore = "slow (30 runs of 150 evaluations with GPs): .ci/run runs it with --ignored"]
 fn turbo_and_linebo_beat_random_search_on_ackley20() {
     let problem = Problem::by_name("ackley", 20).unwrap();
     let (evals, seeds) = (150, 10);
@@ -186,6 +187,7 @@ fn evaluations_to_reach(
 /// REMBO (Wang et al. 2016, Fig. 3) finds the optimum of Branin embedded in 100 dimensions
 /// far faster than uniform random search over the box, the baseline of that paper.
 #[test]
+#[ignore = "slow (10 REMBO runs of up to 150 evaluations): .ci/run runs it with --ignored"]
 fn rembo_finds_branin_in_100d_far_faster_than_random_search() {
     use rand::{Rng, SeedableRng};
     let problem = Problem::by_name("branin", 100).unwrap();
