@@ -229,3 +229,34 @@ fn rembo_finds_branin_in_100d_far_faster_than_random_search() {
     );
     assert!(rembo_counts.iter().filter(|c| c.is_some()).count() >= 7);
 }
+
+/// CMA-ES told where its failed laps failed climbs towards laps that get further even while
+/// every lap fails (reward 0 throughout, the car getting to x = 0.5 + 0.1·Σw); told only the
+/// zeros, it has nothing to follow.
+#[test]
+fn cmaes_follows_the_failure_places_while_every_lap_fails() {
+    let run = |with_places: bool| -> f64 {
+        let mut es = by_name("cmaes", vec![0.0; 5], &Settings::problem(1, 5.0)).unwrap();
+        let mut last = Vec::new();
+        for lap in 0..200 {
+            let w = es.ask().unwrap();
+            let at = (0.5 + 0.1 * w.iter().sum::<f64>()).clamp(0.0, 1.0);
+            if with_places {
+                es.tell_lap(&w, 0.0, Some(at)).unwrap();
+            } else {
+                es.tell(&w, 0.0).unwrap();
+            }
+            if lap >= 180 {
+                last.push(w.iter().sum::<f64>());
+            }
+        }
+        last.iter().sum::<f64>() / last.len() as f64
+    };
+    let (with, without) = (run(true), run(false));
+    eprintln!(
+        "mean sum of weights over the last 20 laps: with places {with:.3}, without {without:.3}"
+    );
+    assert!(with > 3.0, "{with}");
+    // (Σw = 5 is x = 1: the end of the lap.)
+    assert!(without < 1.5, "{without}");
+}

@@ -35,6 +35,10 @@ pub struct RaceArgs {
     /// Speed of the demonstrator (m/s).
     #[arg(long, default_value_t = 15.0, allow_negative_numbers = true, value_parser = super::value::positive)]
     demo_speed: f64,
+    /// The exploration scale σ₀ every method is given (CDBO's initial design, the evolution
+    /// strategies' and random search's σ, pattern search's first step); default 0.03.
+    #[arg(long)]
+    sigma0: Option<f64>,
     /// Output folder (default: runs/race-TRACK-METHOD-mM-sSEED).
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
@@ -107,6 +111,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         seed: args.seed,
         beta: args.beta,
         demo_speed: args.demo_speed,
+        sigma0: args.sigma0,
     };
     let bar = if args.json {
         ProgressBar::hidden()

@@ -49,6 +49,10 @@ pub struct ExperimentConfig {
     pub methods: Vec<String>,
     /// Tracks and their policy sizes.
     pub tracks: Vec<TrackGrid>,
+    /// A method's own σ₀ (its main knob, tuned on training tracks), by method name; the
+    /// others get the race default, 0.03 (`[sigma0]` table: `random = 0.01`).
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub sigma0: std::collections::BTreeMap<String, f64>,
 }
 
 fn default_demo_speed() -> f64 {
@@ -96,6 +100,7 @@ impl ExperimentConfig {
                 beta: default_beta(),
                 methods: methods(&[]),
                 tracks: paper_tracks,
+                sigma0: Default::default(),
             },
             "paper-plus" => ExperimentConfig {
                 methods: methods(&["turbo", "linebo", "random"]),
@@ -113,6 +118,7 @@ impl ExperimentConfig {
                     track: crate::track::builtin::DEFAULT.into(),
                     kernels: vec![10, 20],
                 }],
+                sigma0: Default::default(),
             },
             _ => return None,
         })
@@ -191,6 +197,15 @@ impl ExperimentConfig {
                     e => e,
                 })?;
             }
+        }
+        if let Some((m, v)) = self
+            .sigma0
+            .iter()
+            .find(|(m, v)| !self.methods.contains(m) || !(v.is_finite() && **v > 0.0))
+        {
+            return Err(Error::Domain(format!(
+                "sigma0 of {m:?} = {v}: must be a positive number for a method of the grid"
+            )));
         }
         if !(self.demo_speed.is_finite() && self.demo_speed > 0.0) {
             return Err(Error::invalid_value(

@@ -27,6 +27,12 @@ pub struct RaceConfig {
     pub beta: f64,
     /// Demonstration speed (m/s).
     pub demo_speed: f64,
+    /// The exploration scale σ₀ of every method ([`Settings::sigma0`]); `None`: the race
+    /// default, 0.03.
+    ///
+    /// [`Settings::sigma0`]: crate::optimizers::Settings::sigma0
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sigma0: Option<f64>,
 }
 
 impl Default for RaceConfig {
@@ -38,6 +44,7 @@ impl Default for RaceConfig {
             seed: 0,
             beta: crate::acquisition::ucb::DEFAULT_BETA,
             demo_speed: 15.0,
+            sigma0: None,
         }
     }
 }
@@ -143,7 +150,13 @@ pub fn race_with(
     }
     let lengthscale = default_lengthscale(config.kernels);
     let initial = RkhsPolicy::fit(&demo_pairs, config.kernels, lengthscale, DEFAULT_RIDGE)?;
-    let settings = crate::optimizers::Settings::race(config.seed, config.beta);
+    let mut settings = crate::optimizers::Settings::race(config.seed, config.beta);
+    if let Some(sigma0) = config.sigma0 {
+        if !(sigma0.is_finite() && sigma0 > 0.0) {
+            return Err(Error::Domain(format!("σ₀ must be positive, got {sigma0}")));
+        }
+        settings.sigma0 = sigma0;
+    }
     let mut optimizer =
         crate::optimizers::by_name(&config.method, initial.weights.clone(), &settings)?;
     let mut laps = Vec::with_capacity(config.laps);

@@ -131,6 +131,7 @@ pub fn run(
         seed: spec.seed(),
         beta: grid.beta,
         demo_speed: grid.demo_speed,
+        sigma0: grid.sigma0.get(&spec.method).copied(),
     };
     let (track_name, length_m) = (track.name.clone(), track.length);
     let outcome = race(track, car, &config, progress)?;

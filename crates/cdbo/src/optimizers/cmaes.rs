@@ -10,6 +10,9 @@
 //! - C ← (1 + c₁δ(h_σ) − c₁ − c_μΣwⱼ)C + c₁p_cp_cᵀ + c_μΣᵢ wᵢ° yᵢ:λ yᵢ:λᵀ, with
 //!   wᵢ° = wᵢ·n/‖C^(−1/2)yᵢ:λ‖² for the negative weights.
 //!
+//! A failed lap told with its place x (`tell_lap`) ranks by it, f = 1 − x, behind every
+//! completed lap.
+//!
 //! IPOP restarts (Auger & Hansen 2005): when the search has collapsed (σ·max√λ(C) below
 //! 1e-12 of σ₀, a condition number of C above 1e14, or a non-finite state), it restarts from
 //! the best point with σ₀ and twice the population.
@@ -332,6 +335,27 @@ impl Cmaes {
             .collect()
     }
 
+    /// Records a told individual with its fitness (minimised) and updates the generation
+    /// once all λ are told.
+    fn tell_ranked(&mut self, weights: &[f64], reward: f64, fitness: f64) -> Result<()> {
+        let k = self.state.fitness.len();
+        let mut w = weights.to_vec();
+        self.bounds.clamp(&mut w);
+        let y: Vec<f64> = w
+            .iter()
+            .zip(&self.state.mean)
+            .map(|(wi, m)| (wi - m) / self.state.sigma)
+            .collect();
+        self.state.population[k] = y;
+        self.state.fitness.push(fitness);
+        self.state.evaluations += 1;
+        self.state.best.offer(weights, reward);
+        if self.state.fitness.len() == self.params.lambda {
+            self.update()?;
+        }
+        Ok(())
+    }
+
     /// The generation's update, once all λ individuals are told.
     fn update(&mut self) -> Result<()> {
         let n = self.state.mean.len();
@@ -456,22 +480,24 @@ impl Optimizer for Cmaes {
     /// pending individual's.
     fn tell(&mut self, weights: &[f64], reward: f64) -> Result<()> {
         check_tell(self.dim(), weights, reward)?;
-        let k = self.state.fitness.len();
-        let mut w = weights.to_vec();
-        self.bounds.clamp(&mut w);
-        let y: Vec<f64> = w
-            .iter()
-            .zip(&self.state.mean)
-            .map(|(wi, m)| (wi - m) / self.state.sigma)
-            .collect();
-        self.state.population[k] = y;
-        self.state.fitness.push(-reward);
-        self.state.evaluations += 1;
-        self.state.best.offer(weights, reward);
-        if self.state.fitness.len() == self.params.lambda {
-            self.update()?;
-        }
-        Ok(())
+        self.tell_ranked(weights, reward, -reward)
+    }
+
+    /// A lap that failed at x ranks by how far it got, f = 1 − x (behind every completed lap,
+    /// f = −reward < 0): when a whole generation fails, a fitness of zeros everywhere steers
+    /// nothing, while the failure places still point the mean towards laps that got further.
+    fn tell_lap(&mut self, weights: &[f64], reward: f64, failed_at: Option<f64>) -> Result<()> {
+        check_tell(self.dim(), weights, reward)?;
+        let fitness = match failed_at {
+            Some(x) if !(x.is_finite() && (0.0..=1.0).contains(&x)) => {
+                return Err(Error::Domain(format!(
+                    "the failure place must be a lap fraction in [0, 1], got {x}"
+                )));
+            }
+            Some(x) => 1.0 - x,
+            None => -reward,
+        };
+        self.tell_ranked(weights, reward, fitness)
     }
 
     fn best(&self) -> Option<(&[f64], f64)> {
