@@ -66,13 +66,20 @@ fn default_beta() -> f64 {
 /// The presets [`ExperimentConfig::preset`] knows.
 pub const PRESETS: &[&str] = &["paper", "paper-plus", "quick"];
 
+/// The main knobs tuned on the training tracks (ridgeway, forza, e-track-2; 30 kernels,
+/// seeds 100–101; docs/results/beyond): random search's σ, CMA-ES's σ₀, the pattern search's
+/// first step. `paper-plus` runs them; `paper` keeps every method at the race default 0.03.
+pub const TUNED_SIGMA0: [(&str, f64); 3] =
+    [("random", 0.01), ("cmaes", 0.01), ("pattern-search", 0.1)];
+
 /// The paper's baselines and CDBO.
 const PAPER_METHODS: [&str; 5] = ["cdbo", "cmaes", "bo-cmaes", "rembo-5d", "rembo-10d"];
 
 impl ExperimentConfig {
     /// `paper`: Forza with 10/50/100 kernels and Allondaz with 10/30/50; CDBO, CMA-ES,
     /// BO-CMA-ES, REMBO-5d and -10d; 4 repeats of 300 laps. `paper-plus`: the same with
-    /// TuRBO, LineBO and random search. `quick`: the built-in track, 10 and 20 kernels, four
+    /// TuRBO, LineBO, random search and the pattern search, with the [`TUNED_SIGMA0`] knobs.
+    /// `quick`: the built-in track, 10 and 20 kernels, four
     /// methods, 2 repeats of 25 laps (for CI).
     pub fn preset(name: &str) -> Option<ExperimentConfig> {
         let paper_tracks = vec![
@@ -103,7 +110,11 @@ impl ExperimentConfig {
                 sigma0: Default::default(),
             },
             "paper-plus" => ExperimentConfig {
-                methods: methods(&["turbo", "linebo", "random"]),
+                methods: methods(&["turbo", "linebo", "random", "pattern-search"]),
+                sigma0: TUNED_SIGMA0
+                    .iter()
+                    .map(|&(m, s)| (m.to_string(), s))
+                    .collect(),
                 ..ExperimentConfig::preset("paper")?
             },
             "quick" => ExperimentConfig {
@@ -320,7 +331,8 @@ mod tests {
         let paper = ExperimentConfig::preset("paper").unwrap();
         assert_eq!(paper.runs().len(), 6 * 5 * 4);
         let plus = ExperimentConfig::preset("paper-plus").unwrap();
-        assert_eq!(plus.runs().len(), 6 * 8 * 4);
+        assert_eq!(plus.runs().len(), 6 * 9 * 4);
+        assert_eq!(plus.sigma0.get("random"), Some(&0.01));
         for p in PRESETS {
             ExperimentConfig::preset(p).unwrap().check().unwrap();
         }
