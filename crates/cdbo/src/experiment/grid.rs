@@ -212,7 +212,7 @@ impl ExperimentConfig {
         if let Some((m, v)) = self
             .sigma0
             .iter()
-            .find(|(m, v)| !self.methods.contains(m) || !(v.is_finite() && **v > 0.0))
+            .find(|(m, v)| !(self.methods.contains(m) && v.is_finite() && **v > 0.0))
         {
             return Err(Error::Domain(format!(
                 "sigma0 of {m:?} = {v}: must be a positive number for a method of the grid"
