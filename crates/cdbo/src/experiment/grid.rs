@@ -214,9 +214,11 @@ impl ExperimentConfig {
             .iter()
             .find(|(m, v)| !(self.methods.contains(m) && v.is_finite() && **v > 0.0))
         {
-            return Err(Error::Domain(format!(
-                "sigma0 of {m:?} = {v}: must be a positive number for a method of the grid"
-            )));
+            return Err(Error::invalid_value(
+                format!("sigma0 of {m:?}"),
+                v,
+                "a positive number, for a method of the grid",
+            ));
         }
         if !(self.demo_speed.is_finite() && self.demo_speed > 0.0) {
             return Err(Error::invalid_value(

@@ -153,7 +153,7 @@ pub fn race_with(
     let mut settings = crate::optimizers::Settings::race(config.seed, config.beta);
     if let Some(sigma0) = config.sigma0 {
         if !(sigma0.is_finite() && sigma0 > 0.0) {
-            return Err(Error::Domain(format!("σ₀ must be positive, got {sigma0}")));
+            return Err(Error::invalid_value("σ₀", sigma0, "positive"));
         }
         settings.sigma0 = sigma0;
     }

@@ -490,9 +490,11 @@ impl Optimizer for Cmaes {
         check_tell(self.dim(), weights, reward)?;
         let fitness = match failed_at {
             Some(x) if !(x.is_finite() && (0.0..=1.0).contains(&x)) => {
-                return Err(Error::Domain(format!(
-                    "the failure place must be a lap fraction in [0, 1], got {x}"
-                )));
+                return Err(Error::invalid_value(
+                    "the failure place",
+                    x,
+                    "a lap fraction in [0, 1]",
+                ));
             }
             Some(x) => 1.0 - x,
             None => -reward,
