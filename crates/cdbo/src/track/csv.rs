@@ -113,7 +113,7 @@ pub fn parse(text: &str, name: &str, file: &str) -> Result<Track> {
             format!("the track is {perimeter:.0} m long, more than {MAX_LENGTH_M} m"),
         ));
     }
-    Ok(build(&rows, name, file))
+    build(&rows, name, file)
 }
 
 /// Least width across its main axis a centre line must span to be a circuit (m).
@@ -147,7 +147,7 @@ fn collinear_spread(rows: &[[f64; 4]]) -> Option<f64> {
     (spread < MIN_SPREAD_M).then_some(spread)
 }
 
-fn build(rows: &[[f64; 4]], name: &str, file: &str) -> Track {
+fn build(rows: &[[f64; 4]], name: &str, file: &str) -> Result<Track> {
     let n = rows.len();
     // Centre points: move the reference line by (w_left − w_right)/2 along its left normal.
     let centre: Vec<(f64, f64, f64)> = (0..n)
@@ -200,7 +200,16 @@ fn build(rows: &[[f64; 4]], name: &str, file: &str) -> Track {
         ss.push(s);
     }
     let length = s;
-    let count = (length / TARGET_DS).round() as usize;
+    // The centre moves off the reference by half the width difference: a road kilometres wide
+    // makes a centre line far longer than the points' perimeter.
+    if !length.is_finite() || length > MAX_LENGTH_M {
+        return Err(Error::parse(
+            file,
+            "rows",
+            format!("the centre line is {length:.0} m long, more than {MAX_LENGTH_M} m"),
+        ));
+    }
+    let count = ((length / TARGET_DS).round() as usize).max(8);
     let ds = length / count as f64;
     let (x0, y0) = (sx.eval(0.0).0, sy.eval(0.0).0);
     let mut samples = Vec::with_capacity(count);
@@ -236,7 +245,7 @@ fn build(rows: &[[f64; 4]], name: &str, file: &str) -> Track {
         &mut samples,
         (0.5 * CURVATURE_WINDOW_M / ds).round() as usize,
     );
-    Track::new(
+    Ok(Track::new(
         name,
         file,
         length,
@@ -246,12 +255,14 @@ fn build(rows: &[[f64; 4]], name: &str, file: &str) -> Track {
         },
         samples,
         Vec::new(),
-    )
+    ))
 }
 
 /// Replaces each curvature by its mean over samples i−half..=i+half (periodic).
+/// The window is cut to the lap on a lap shorter than it.
 fn smooth_curvature(samples: &mut [Sample], half: usize) {
     let n = samples.len();
+    let half = half.min(n.saturating_sub(1) / 2);
     let raw: Vec<f64> = samples.iter().map(|c| c.curvature).collect();
     let width = (2 * half + 1) as f64;
     let mut sum: f64 = (0..=2 * half).map(|k| raw[(k + n - half) % n]).sum();
