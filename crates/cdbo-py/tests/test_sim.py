@@ -75,7 +75,7 @@ def test_bad_input_raises_with_the_librarys_message(tmp_path):
         cdbo.Policy([0.0, math.nan, 0.0])
     with pytest.raises(ValueError, match="same length"):
         cdbo.Policy.fit([0.0, 0.5], [0.1], 4)
-    with pytest.raises(ValueError, match="empty"):
+    with pytest.raises(ValueError, match=r"demonstration \(x, a\) pairs 0: must be at least 1"):
         cdbo.Policy.fit([], [], 4)
     with pytest.raises(TypeError):
         cdbo.Simulator().lap([0.1, 0.2])
