@@ -1,3 +1,4 @@
+#![warn(missing_docs)]
 //! # cdbo — Coordinate Descent Bayesian Optimisation for learning to race
 //!
 //! A toolkit that teaches a car (or any robot) a fast control policy in few trials, after
@@ -14,7 +15,7 @@
 //! - [`experiment`]: learning to race a track end to end, and the paper's experiment grid.
 //! - [`study`]: persistent ask/tell studies for a real car; [`evaluator`]: sources of laps.
 //! - [`torcs`]: the racing game TORCS as a source of laps (its robot, setup and lap runner).
-//! - [`benchmarks`]: standard test functions; [`simd`]: AVX2 for the hottest loops.
+//! - [`benchmarks`]: standard test functions.
 //! - [`sizes`]: the bounds on every size a user gives, and the slow-size estimate.
 
 pub mod acquisition;
@@ -33,7 +34,7 @@ pub mod optimizers;
 pub mod params;
 pub mod policy;
 pub mod sim;
-pub mod simd;
+mod simd;
 pub mod sizes;
 pub mod study;
 pub mod torcs;

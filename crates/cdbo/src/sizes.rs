@@ -121,8 +121,7 @@ impl Size {
 /// Seconds a race of `laps` laps with `kernels` kernels takes on one free core, roughly: the
 /// simulator's share grows with M² (every driver step sums the kernels near x, the policy fit
 /// solves an M × M system), the GP's with n³ summed over the laps (refits over n observations).
-/// Calibrated on `cdbo race`: 30 kernels, 300 laps ≈ 3 s; 1000 kernels, 30 laps ≈ 8 s;
-/// 100 kernels, 1000 laps ≈ 90 s.
+/// The coefficients are calibrated on `cdbo race` timings (docs/results/design.md).
 pub fn race_seconds(kernels: usize, laps: usize) -> f64 {
     let (m, n) = (kernels as f64, laps as f64);
     n * (0.008 + 2.5e-7 * m * m) + 8e-8 * n * n * n

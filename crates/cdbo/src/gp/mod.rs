@@ -6,7 +6,7 @@
 //! jitter is the smallest of 0, 1e-10, 1e-9, … that keeps L finite, raised only when needed
 //! and reported by [`GaussianProcess::jitter`].
 
-pub mod fit_in_flight;
+pub(crate) mod fit_in_flight;
 pub mod kernel;
 pub mod likelihood;
 
@@ -151,7 +151,7 @@ impl GaussianProcess {
     }
 
     /// The lower Cholesky factor L of K.
-    pub fn cholesky(&self) -> faer::MatRef<'_, f64> {
+    pub(crate) fn cholesky(&self) -> faer::MatRef<'_, f64> {
         self.chol.as_ref()
     }
 
@@ -229,7 +229,7 @@ impl GaussianProcess {
     }
 
     /// The inputs by dimension: entry d·n + j is coordinate d of observation j.
-    pub fn inputs_by_dim(&self) -> Vec<f64> {
+    pub(crate) fn inputs_by_dim(&self) -> Vec<f64> {
         let n = self.len();
         (0..self.dim)
             .flat_map(|d| (0..n).map(move |j| self.x[j * self.dim + d]))
@@ -239,7 +239,7 @@ impl GaussianProcess {
     /// The scaled squared distances of observation i to observations 0..i, into `out`
     /// (length i): each summed over the dimensions in order, as [`scaled_sq_dist`] does, and
     /// vectorised across the observations (`columns` from [`Self::inputs_by_dim`]).
-    pub fn sq_dists_to_earlier(&self, columns: &[f64], i: usize, out: &mut [f64]) {
+    pub(crate) fn sq_dists_to_earlier(&self, columns: &[f64], i: usize, out: &mut [f64]) {
         let n = self.len();
         let xi = self.input(i);
         out.fill(0.0);
@@ -380,7 +380,7 @@ impl GaussianProcess {
     /// Posterior means and variances from cross-covariances k(W, w*), one column of n = len()
     /// values per point, stored one after another (overwritten by L⁻¹k):
     /// μ = m + kᵀα, σ² = σ_f² − ‖L⁻¹k‖².
-    pub fn predict_from_k(&self, k: &mut [f64]) -> Vec<(f64, f64)> {
+    pub(crate) fn predict_from_k(&self, k: &mut [f64]) -> Vec<(f64, f64)> {
         let n = self.len();
         if n == 0 {
             let points = k.len().max(1);

@@ -79,9 +79,9 @@ pub struct BoConfig {
     /// One length-scale per weight (ARD) or one for all.
     pub ard: bool,
     /// Prior mean. The paper's GP has a zero mean; the default here is the average reward
-    /// (as limbo's `mean::Data`): with rewards near 15–25 m/s, a zero prior mean makes every
-    /// step away from the data look like a crash, and the search creeps (Forza, 50 kernels,
-    /// 300 laps: 16.9 m/s with a zero mean, 19.2 m/s with the data mean).
+    /// (as limbo's `mean::Data`): with rewards far above 0, a zero prior mean makes every
+    /// step away from the data look like a crash, and the search creeps (measured in
+    /// docs/results/design.md).
     pub mean: Mean,
     /// Observation noise variance (the paper: 0).
     pub noise_var: f64,

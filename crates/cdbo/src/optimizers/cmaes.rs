@@ -150,7 +150,7 @@ pub struct CmaesState {
     /// Rewards told in total.
     pub evaluations: usize,
     /// The best (weights, reward) told.
-    pub best: Best,
+    pub(crate) best: Best,
     /// IPOP restarts so far (the population is λ·2^restarts).
     pub restarts: u32,
 }

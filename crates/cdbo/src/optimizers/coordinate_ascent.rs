@@ -6,8 +6,8 @@
 //! candidate costs O(n) kernel values plus one triangular solve. Each axis gets a coarse scan of
 //! `scan` evenly spaced values (one batched solve), then a COBYLA polish from the best of them
 //! and the current value (the paper's per-axis optimiser), stopping at the evaluation budget.
-//! (Polishing only the axes whose scan improved saves 11 % of a suggestion's time but lost
-//! 2.3 m/s on Forza with 50 kernels, seed 0: kept.)
+//! Every axis is polished, not only those whose scan improved: skipping the others saves
+//! little time and loses lap speed (docs/results/design.md).
 
 use rand::seq::SliceRandom;
 

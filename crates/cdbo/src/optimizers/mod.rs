@@ -270,7 +270,7 @@ impl SearchBox {
 
 /// The best (weights, reward) told so far.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct Best(Option<(Vec<f64>, f64)>);
+pub(crate) struct Best(Option<(Vec<f64>, f64)>);
 
 impl Best {
     /// Records (weights, reward) if it beats the best; returns whether it did.
@@ -289,7 +289,7 @@ impl Best {
 }
 
 /// Checks a told (weights, reward) pair against the dimension.
-pub fn check_tell(dim: usize, weights: &[f64], reward: f64) -> Result<()> {
+pub(crate) fn check_tell(dim: usize, weights: &[f64], reward: f64) -> Result<()> {
     if weights.len() != dim {
         return Err(Error::dimension("weights", dim, weights.len()));
     }

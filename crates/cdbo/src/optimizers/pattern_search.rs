@@ -86,7 +86,7 @@ pub struct PatternSearchState {
     /// Rewards told.
     pub evaluations: usize,
     /// The best (weights, reward) told.
-    pub best: Best,
+    pub(crate) best: Best,
 }
 
 /// Pattern search with failure repair.

@@ -38,7 +38,7 @@ pub struct RandomState {
     /// Rewards told.
     pub evaluations: usize,
     /// The best (weights, reward) told.
-    pub best: Best,
+    pub(crate) best: Best,
 }
 
 /// Random search.

@@ -115,10 +115,8 @@ pub struct LapResult {
 /// Settings of a lap.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LapConfig {
-    /// Physics step (s): 4 ms. Over 180 perturbed learned policies on Forza and Ridgeway,
-    /// lap times at 4 ms differ from those at 0.5 ms by 0.07–0.20 % on average, about twice
-    /// as much as at TORCS's 2 ms (0.03–0.11 %), at 1.8 times its speed; whether the lap
-    /// completes agreed with 0.5 ms in 177 of 180 (2 ms: 178). The test
+    /// Physics step (s): 4 ms, twice TORCS's 2 ms: lap times stay close to those of a much
+    /// finer step at nearly twice the speed (measured in docs/results/design.md). The test
     /// `the_lap_time_converges_as_the_step_shrinks` checks the convergence.
     pub dt: f64,
     /// Physics steps per driver step: 5, i.e. the driver at 50 Hz.

@@ -60,8 +60,8 @@ pub struct LapRequest {
     pub timeout: Duration,
 }
 
-/// The default wall-clock time-out of one lap: the game runs some 300-500x real time, so a
-/// lap within its time limit (about 25 game minutes on Forza) takes a few seconds.
+/// The default wall-clock time-out of one lap: the game runs many times faster than real
+/// time, so a lap within its time limit takes seconds (docs/results/design.md).
 pub const DEFAULT_TIMEOUT: Duration = Duration::from_secs(120);
 
 /// Lap folders made by this process.
