@@ -17,6 +17,7 @@
 //! [`Study::open_read_only`], which writes nothing.
 
 pub mod claim;
+pub mod run;
 pub mod sqlite;
 pub mod storage;
 

@@ -2,17 +2,17 @@
 //! an interrupted run resumes where it stopped.
 
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Duration;
 
 use clap::Args;
 
 use super::CliResult;
 use super::study::InitialPolicy;
-use cdbo::evaluator::Evaluator;
 use cdbo::evaluator::command::CommandEvaluator;
-use cdbo::study::claim::{DEFAULT_LEASE, Worker, process_exists};
-use cdbo::study::{Next, Outcome, Study};
+use cdbo::study::claim::{DEFAULT_LEASE, Worker};
+use cdbo::study::run::Event;
+use cdbo::study::{Outcome, Study};
 
 #[derive(Debug, Args)]
 pub struct OptimizeArgs {
@@ -47,7 +47,6 @@ pub fn run(args: &OptimizeArgs) -> CliResult {
     if !created {
         args.initial.check_resume(&args.db, study.config())?;
     }
-    remove_leftover_policy_files(&args.db);
     let worker = Worker::this_process(Duration::from_secs_f64(args.lease));
     let told_before = study.told()?;
     let mut out = std::io::stdout().lock();
@@ -70,56 +69,12 @@ pub fn run(args: &OptimizeArgs) -> CliResult {
     let mut evaluator = CommandEvaluator {
         template: args.evaluator.clone(),
         timeout: Duration::from_secs_f64(args.timeout),
-        policy_file: PathBuf::new(),
+        files: args.db.clone(),
         lengthscale: study.config().lengthscale,
     };
-    let poll = worker
-        .heartbeat_interval()
-        .clamp(Duration::from_millis(100), Duration::from_secs(1));
-    let mut waiting = false;
-    loop {
-        let trial = match study.claim(&worker, Some(args.laps))? {
-            Next::Done => break,
-            Next::Wait => {
-                if !waiting {
-                    let _ = writeln!(
-                        out,
-                        "waiting: the remaining trials are out with other workers"
-                    );
-                    waiting = true;
-                }
-                std::thread::sleep(poll);
-                continue;
-            }
-            Next::Drive(t) => t,
-        };
-        waiting = false;
-        // One file per trial and process, so that no worker reads another's half-written file.
-        evaluator.policy_file = policy_file(&args.db, trial.id, std::process::id());
-        let outcome = with_heartbeat(&args.db, &worker, trial.id, || {
-            evaluator.evaluate(&trial.weights)
-        });
-        let _ = std::fs::remove_file(&evaluator.policy_file);
-        let outcome = outcome?;
-        let reward = match study.tell(trial.id, &outcome) {
-            Ok(r) => r,
-            // Another worker told this trial first (ours had lost its lease): go on.
-            Err(e @ cdbo::Error::Conflict { .. }) => {
-                eprintln!("note: {e}");
-                continue;
-            }
-            Err(e) => return Err(e.into()),
-        };
-        let note = match &outcome {
-            Outcome::Failed { reason, .. } => {
-                format!(" (failed: {})", reason.as_deref().unwrap_or("failed"))
-            }
-            _ => String::new(),
-        };
-        // Printed only once the result is committed: "saved" means durable.
-        let _ = writeln!(out, "trial {}: reward {reward} saved{note}", trial.id);
-        let _ = out.flush();
-    }
+    study.run(&mut evaluator, &worker, args.laps, &mut |event| {
+        print_event(&mut out, event)
+    })?;
     let best = study.best()?;
     let _ = writeln!(
         out,
@@ -135,74 +90,42 @@ pub fn run(args: &OptimizeArgs) -> CliResult {
     Ok(())
 }
 
-/// Where trial `id`'s policy is written for the evaluator, by process `pid`.
-fn policy_file(db: &Path, id: i64, pid: u32) -> PathBuf {
-    PathBuf::from(format!("{}.trial-{id}.pid-{pid}.json", db.display()))
-}
-
-/// Removes the policy files of processes that no longer exist (killed while driving); a live
-/// worker's file stays.
-fn remove_leftover_policy_files(db: &Path) {
-    let Some(name) = db.file_name().map(|n| n.to_string_lossy().into_owned()) else {
-        return;
-    };
-    let folder = match db.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_owned(),
-        _ => PathBuf::from("."),
-    };
-    let Ok(entries) = std::fs::read_dir(&folder) else {
-        return;
-    };
-    let prefix = format!("{name}.trial-");
-    for entry in entries.flatten() {
-        let file = entry.file_name().to_string_lossy().into_owned();
-        let Some(rest) = file
-            .strip_prefix(&prefix)
-            .and_then(|r| r.strip_suffix(".json"))
-        else {
-            continue;
-        };
-        let pid = rest
-            .split_once(".pid-")
-            .and_then(|(_, p)| p.parse::<u32>().ok());
-        if let Some(pid) = pid.filter(|p| *p != std::process::id() && !process_exists(*p)) {
-            if std::fs::remove_file(entry.path()).is_ok() {
-                eprintln!(
-                    "note: removed {}, left by process {pid} (killed while driving)",
-                    entry.path().display()
-                );
-            }
+/// Prints what the lap loop reports: told trials and waits on standard output, notes on
+/// standard error.
+fn print_event(out: &mut impl Write, event: Event<'_>) {
+    match event {
+        Event::Told {
+            trial,
+            outcome,
+            reward,
+            ..
+        } => {
+            let note = match outcome {
+                Outcome::Failed { reason, .. } => {
+                    format!(" (failed: {})", reason.as_deref().unwrap_or("failed"))
+                }
+                _ => String::new(),
+            };
+            // Reported only once the result is committed: "saved" means durable.
+            let _ = writeln!(out, "trial {}: reward {reward} saved{note}", trial.id);
+            let _ = out.flush();
         }
+        Event::Waiting => {
+            let _ = writeln!(
+                out,
+                "waiting: the remaining trials are out with other workers"
+            );
+        }
+        Event::Conflict { error, .. } => eprintln!("note: {error}"),
+        Event::ClaimLost { trial } => {
+            eprintln!("note: trial {trial}: the claim ran out and another worker took it over")
+        }
+        Event::HeartbeatFailed { trial, error } => {
+            eprintln!("note: trial {trial}: heartbeat failed: {error}")
+        }
+        Event::LeftoverRemoved { path, pid } => eprintln!(
+            "note: removed {}, left by process {pid} (killed while driving)",
+            path.display()
+        ),
     }
-}
-
-/// Runs `drive` while a thread renews the worker's claim on trial `id` every heartbeat
-/// interval, through its own connection to the study.
-fn with_heartbeat<T>(db: &Path, worker: &Worker, id: i64, drive: impl FnOnce() -> T) -> T {
-    let stop = std::sync::atomic::AtomicBool::new(false);
-    std::thread::scope(|scope| {
-        let beat = scope.spawn(|| {
-            let Ok(study) = Study::open(db) else { return };
-            loop {
-                std::thread::park_timeout(worker.heartbeat_interval());
-                if stop.load(std::sync::atomic::Ordering::Acquire) {
-                    return;
-                }
-                match study.heartbeat(id, worker) {
-                    Ok(true) => {}
-                    Ok(false) => {
-                        eprintln!(
-                            "note: trial {id}: the claim ran out and another worker took it over"
-                        );
-                        return;
-                    }
-                    Err(e) => eprintln!("note: trial {id}: heartbeat failed: {e}"),
-                }
-            }
-        });
-        let result = drive();
-        stop.store(true, std::sync::atomic::Ordering::Release);
-        beat.thread().unpark();
-        result
-    })
 }

@@ -7,13 +7,14 @@
 //! A non-zero exit, a timeout or output that parses as neither is a failed lap with the reason.
 
 use std::io::Read;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use super::{Evaluator, Outcome};
 use crate::error::{Error, Result};
 use crate::policy::RkhsPolicy;
+use crate::study::claim::process_exists;
 
 /// Points of the (x, a) table written with each policy.
 pub const TABLE_POINTS: usize = 1001;
@@ -25,10 +26,17 @@ pub struct CommandEvaluator {
     pub template: String,
     /// Longest a lap may take.
     pub timeout: Duration,
-    /// Where the policy file is written.
-    pub policy_file: PathBuf,
+    /// Where the policy files go: trial `id`'s is `FILES.trial-ID.pid-PID.json`
+    /// ([`policy_file`]), written before the lap and removed after it.
+    pub files: PathBuf,
     /// The policy kernels' length-scale.
     pub lengthscale: f64,
+}
+
+/// Where process `pid` writes trial `id`'s policy for the command: one file per trial and
+/// process, so that no worker reads another's half-written file.
+pub fn policy_file(files: &Path, id: i64, pid: u32) -> PathBuf {
+    PathBuf::from(format!("{}.trial-{id}.pid-{pid}.json", files.display()))
 }
 
 /// The policy file's content.
@@ -91,13 +99,61 @@ pub fn parse_output(stdout: &str) -> Outcome {
 }
 
 impl Evaluator for CommandEvaluator {
-    fn evaluate(&mut self, weights: &[f64]) -> Result<Outcome> {
+    fn evaluate(&mut self, trial: i64, weights: &[f64]) -> Result<Outcome> {
+        let file = policy_file(&self.files, trial, std::process::id());
+        let outcome = self.drive(&file, weights);
+        let _ = std::fs::remove_file(&file);
+        outcome
+    }
+
+    /// The policy files of processes that no longer exist (killed while driving); a live
+    /// worker's file stays.
+    fn remove_leftovers(&mut self) -> Vec<(PathBuf, u32)> {
+        let Some(name) = self
+            .files
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+        else {
+            return Vec::new();
+        };
+        let folder = match self.files.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_owned(),
+            _ => PathBuf::from("."),
+        };
+        let Ok(entries) = std::fs::read_dir(&folder) else {
+            return Vec::new();
+        };
+        let prefix = format!("{name}.trial-");
+        let mut removed = Vec::new();
+        for entry in entries.flatten() {
+            let file = entry.file_name().to_string_lossy().into_owned();
+            let Some(rest) = file
+                .strip_prefix(&prefix)
+                .and_then(|r| r.strip_suffix(".json"))
+            else {
+                continue;
+            };
+            let pid = rest
+                .split_once(".pid-")
+                .and_then(|(_, p)| p.parse::<u32>().ok());
+            if let Some(pid) = pid.filter(|p| *p != std::process::id() && !process_exists(*p)) {
+                if std::fs::remove_file(entry.path()).is_ok() {
+                    removed.push((entry.path(), pid));
+                }
+            }
+        }
+        removed
+    }
+}
+
+impl CommandEvaluator {
+    /// Writes the policy with `weights` to `file`, runs the command on it, reads the outcome.
+    fn drive(&self, file: &Path, weights: &[f64]) -> Result<Outcome> {
         let policy = RkhsPolicy::new(weights.to_vec(), self.lengthscale)?;
-        let file = &self.policy_file;
         let text = serde_json::to_string(&policy_json(&policy))
             .map_err(|e| Error::json(file.display().to_string(), e))?;
         std::fs::write(file, text).map_err(|e| Error::Io {
-            path: file.clone(),
+            path: file.to_owned(),
             source: e,
         })?;
         let line = self
@@ -203,18 +259,30 @@ mod tests {
         let mut e = CommandEvaluator {
             template: "test -s {policy} && echo 3.25".into(),
             timeout: Duration::from_secs(5),
-            policy_file: dir.join("p.json"),
+            files: dir.join("p"),
             lengthscale: 0.5,
         };
-        assert_eq!(e.evaluate(&[0.1, 0.2]).unwrap(), Outcome::Reward(3.25));
+        assert_eq!(e.evaluate(1, &[0.1, 0.2]).unwrap(), Outcome::Reward(3.25));
+        // The lap's policy file is gone after it; a killed process's is removed, a live one's
+        // kept.
+        assert!(!policy_file(&e.files, 1, std::process::id()).exists());
+        let mut child = Command::new("true").spawn().unwrap();
+        let dead = child.id();
+        child.wait().unwrap();
+        let left = policy_file(&e.files, 7, dead);
+        let live = policy_file(&e.files, 8, std::process::id());
+        std::fs::write(&left, "{}").unwrap();
+        std::fs::write(&live, "{}").unwrap();
+        assert_eq!(e.remove_leftovers(), vec![(left.clone(), dead)]);
+        assert!(!left.exists() && live.exists());
         e.template = "echo boom >&2; exit 3".into();
-        let Outcome::Failed { reason, .. } = e.evaluate(&[0.1, 0.2]).unwrap() else {
+        let Outcome::Failed { reason, .. } = e.evaluate(1, &[0.1, 0.2]).unwrap() else {
             panic!()
         };
         assert!(reason.unwrap().contains("boom"));
         e.template = "sleep 5".into();
         e.timeout = Duration::from_millis(100);
-        let Outcome::Failed { reason, .. } = e.evaluate(&[0.1, 0.2]).unwrap() else {
+        let Outcome::Failed { reason, .. } = e.evaluate(1, &[0.1, 0.2]).unwrap() else {
             panic!()
         };
         assert!(reason.unwrap().contains("timeout"));

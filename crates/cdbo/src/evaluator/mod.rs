@@ -9,12 +9,21 @@ pub mod torcs;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
+use crate::sim::LapResult;
 
 /// Drives one lap with given policy weights.
 pub trait Evaluator {
-    /// The outcome of a lap with `weights`. An error means no lap could be attempted (the
-    /// setup is broken), not that the lap failed: a failed lap is an [`Outcome::Failed`].
-    fn evaluate(&mut self, weights: &[f64]) -> Result<Outcome>;
+    /// The outcome of trial `trial`'s lap with `weights` (the trial's number names what the
+    /// evaluator keeps per lap, such as the command evaluator's policy file). An error means
+    /// no lap could be attempted (the setup is broken), not that the lap failed: a failed lap
+    /// is an [`Outcome::Failed`].
+    fn evaluate(&mut self, trial: i64, weights: &[f64]) -> Result<Outcome>;
+
+    /// Removes what laps of processes killed mid-lap left behind (files of theirs); returns
+    /// each file removed and its process. Called before a worker's first lap.
+    fn remove_leftovers(&mut self) -> Vec<(std::path::PathBuf, u32)> {
+        Vec::new()
+    }
 }
 
 /// What a lap produced, as told to a study.
@@ -39,6 +48,26 @@ pub enum Outcome {
 }
 
 impl Outcome {
+    /// The outcome of a lap driven on a track `length_m` long: its time, or where and why it
+    /// failed.
+    pub fn of_lap(lap: &LapResult, length_m: f64) -> Outcome {
+        match (lap.lap_time_s, lap.failure) {
+            (Some(time_s), None) => Outcome::Lap { time_s, length_m },
+            (_, failure) => Outcome::Failed {
+                at: failure.map(|f| f.x),
+                reason: failure.map(|f| f.reason.name().to_owned()),
+            },
+        }
+    }
+
+    /// Where a failed lap failed (lap fraction), if known.
+    pub fn failed_at(&self) -> Option<f64> {
+        match self {
+            Outcome::Failed { at, .. } => *at,
+            _ => None,
+        }
+    }
+
     /// The reward, after checking the numbers.
     pub fn reward(&self) -> Result<f64> {
         match self {

@@ -15,19 +15,10 @@ pub struct SimEvaluator {
 }
 
 impl Evaluator for SimEvaluator {
-    fn evaluate(&mut self, weights: &[f64]) -> Result<Outcome> {
+    fn evaluate(&mut self, _trial: i64, weights: &[f64]) -> Result<Outcome> {
         let policy = RkhsPolicy::new(weights.to_vec(), self.lengthscale)?;
         let lap = self.sim.lap(&mut policy.pedal());
-        Ok(match (lap.lap_time_s, lap.failure) {
-            (Some(t), None) => Outcome::Lap {
-                time_s: t,
-                length_m: self.sim.track.length,
-            },
-            (_, failure) => Outcome::Failed {
-                at: failure.map(|f| f.x),
-                reason: failure.map(|f| f.reason.name().to_owned()),
-            },
-        })
+        Ok(Outcome::of_lap(&lap, self.sim.track.length))
     }
 }
 
@@ -50,10 +41,10 @@ mod tests {
             lengthscale: policy.lengthscale,
         };
         let lap = sim.lap(&mut policy.pedal());
-        let outcome = e.evaluate(&policy.weights).unwrap();
+        let outcome = e.evaluate(1, &policy.weights).unwrap();
         assert_eq!(outcome.reward().unwrap(), lap.reward_mps);
         assert!(lap.reward_mps > 10.0);
-        let Outcome::Failed { at, reason } = e.evaluate(&[-1.0; 8]).unwrap() else {
+        let Outcome::Failed { at, reason } = e.evaluate(1, &[-1.0; 8]).unwrap() else {
             panic!("full braking completed a lap")
         };
         assert_eq!(reason.as_deref(), Some("stalled"));

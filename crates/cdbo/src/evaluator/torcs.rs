@@ -18,24 +18,19 @@ pub struct TorcsEvaluator {
 }
 
 impl Evaluator for TorcsEvaluator {
-    fn evaluate(&mut self, weights: &[f64]) -> Result<Outcome> {
+    fn evaluate(&mut self, _trial: i64, weights: &[f64]) -> Result<Outcome> {
         let policy = RkhsPolicy::new(weights.to_vec(), self.lengthscale)?;
         self.request.pedal = GamePedal::Rkhs(policy);
         Ok(match self.game.lap(&self.request)? {
-            Ok(lap) => match (lap.lap_time_s, lap.failure) {
-                (Some(t), None) => Outcome::Lap {
-                    time_s: t,
-                    length_m: lap.reward_mps * t,
-                },
-                (_, failure) => Outcome::Failed {
-                    at: failure.map(|f| f.x),
-                    reason: failure.map(|f| f.reason.name().to_owned()),
-                },
-            },
-            Err(reason) => Outcome::Failed {
-                at: None,
-                reason: Some(reason),
-            },
+            // The robot measures the reward; the lap's length follows from it and the time.
+            Ok(lap) => Outcome::of_lap(&lap, lap.reward_mps * lap.lap_time_s.unwrap_or(0.0)),
+            Err(reason) => {
+                eprintln!("warning: TORCS drove no lap: {reason}");
+                Outcome::Failed {
+                    at: None,
+                    reason: Some(reason),
+                }
+            }
         })
     }
 }

@@ -6,10 +6,13 @@ use serde::{Deserialize, Serialize};
 use crate::car::Car;
 use crate::drive::demo::SpeedHold;
 use crate::error::{Error, Result};
+use crate::evaluator::simulator::SimEvaluator;
+use crate::evaluator::{Evaluator, Outcome};
 use crate::limit::{Limit, limit_lap};
 use crate::policy::RkhsPolicy;
 use crate::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 use crate::sim::{FailureReason, LapResult, Simulator};
+use crate::study::run::{Event, InMemory, run};
 use crate::track::Track;
 
 /// Settings of a race.
@@ -98,7 +101,7 @@ pub fn demonstrate(sim: &Simulator, speed: f64) -> (LapResult, Vec<(f64, f64)>) 
     (lap, pairs)
 }
 
-/// Runs a race; `progress` is called after every lap.
+/// Runs a race in cdbo's simulator; `progress` is called after every lap.
 pub fn race(
     track: Track,
     car: &Car,
@@ -107,26 +110,26 @@ pub fn race(
 ) -> Result<RaceOutcome> {
     let limit = limit_lap(&track, car);
     let sim = Simulator::new(track, car);
-    let (demo, demo_pairs) = demonstrate(&sim, config.demo_speed);
-    race_with(
-        &sim.track.name,
-        (demo, demo_pairs),
-        limit,
-        config,
-        |policy| Ok(sim.lap(&mut policy.pedal())),
-        progress,
-    )
+    let demo = demonstrate(&sim, config.demo_speed);
+    let mut evaluator = SimEvaluator {
+        lengthscale: default_lengthscale(config.kernels),
+        sim,
+    };
+    let track_name = evaluator.sim.track.name.clone();
+    race_with(&track_name, demo, limit, config, &mut evaluator, progress)
 }
 
-/// Runs a race whose laps `drive` drives (cdbo's simulator, the game TORCS, ...), from a
-/// demonstration already driven there (its lap and (x, a) pairs); `progress` is called after
-/// every lap.
+/// Runs a race whose laps `evaluator` drives (cdbo's simulator, the game TORCS, ...) with
+/// policies of length-scale [`default_lengthscale`]`(config.kernels)`, from a demonstration
+/// already driven there (its lap and (x, a) pairs); `progress` is called after every lap.
+/// The laps go through the one lap loop ([`crate::study::run`]) with an in-memory trial
+/// source.
 pub fn race_with(
     track_name: &str,
     (demo, demo_pairs): (LapResult, Vec<(f64, f64)>),
     limit: Limit,
     config: &RaceConfig,
-    mut drive: impl FnMut(&RkhsPolicy) -> Result<LapResult>,
+    evaluator: &mut dyn Evaluator,
     mut progress: impl FnMut(&LapRecord),
 ) -> Result<RaceOutcome> {
     crate::sizes::KERNELS.checked(config.kernels)?;
@@ -157,44 +160,57 @@ pub fn race_with(
         }
         settings.sigma0 = sigma0;
     }
-    let mut optimizer =
-        crate::optimizers::by_name(&config.method, initial.weights.clone(), &settings)?;
+    let optimizer = crate::optimizers::by_name(&config.method, initial.weights.clone(), &settings)?;
     let mut laps = Vec::with_capacity(config.laps);
-    let mut best = (initial.clone(), 0.0);
-    for lap in 1..=config.laps {
-        let t0 = std::time::Instant::now();
-        let weights = optimizer.ask()?;
-        let optimizer_s = t0.elapsed().as_secs_f64();
-        let policy = RkhsPolicy::new(weights.clone(), lengthscale)?;
-        let t1 = std::time::Instant::now();
-        let result = drive(&policy)?;
-        let simulator_s = t1.elapsed().as_secs_f64();
-        let t2 = std::time::Instant::now();
-        optimizer.tell_lap(&weights, result.reward_mps, result.failure.map(|f| f.x))?;
-        let optimizer_s = optimizer_s + t2.elapsed().as_secs_f64();
-        if result.reward_mps > best.1 {
-            best = (policy, result.reward_mps);
+    let mut best = (initial.weights.clone(), 0.0);
+    let mut source = InMemory::new(optimizer, config.laps);
+    run(&mut source, evaluator, &mut |event| {
+        let Event::Told {
+            trial,
+            outcome,
+            reward,
+            timing,
+        } = event
+        else {
+            return;
+        };
+        if reward > best.1 {
+            best = (trial.weights.clone(), reward);
         }
         let record = LapRecord {
-            lap,
-            reward_mps: result.reward_mps,
+            lap: trial.id as usize,
+            reward_mps: reward,
             best_mps: best.1,
-            lap_time_s: result.lap_time_s,
-            failure: result.failure.map(|f| f.reason),
-            x_fail: result.failure.map(|f| f.x),
-            optimizer_s,
-            simulator_s,
+            lap_time_s: match outcome {
+                Outcome::Lap { time_s, .. } => Some(*time_s),
+                _ => None,
+            },
+            failure: match outcome {
+                Outcome::Failed { reason, .. } => Some(failure_reason(reason.as_deref())),
+                _ => None,
+            },
+            x_fail: outcome.failed_at(),
+            optimizer_s: timing.ask_s + timing.tell_s,
+            simulator_s: timing.evaluate_s,
         };
         progress(&record);
         laps.push(record);
-    }
+    })?;
     Ok(RaceOutcome {
         demo,
         demo_pairs,
         initial,
-        best: best.0,
+        best: RkhsPolicy::new(best.0, lengthscale)?,
         best_reward_mps: best.1,
         laps,
         limit,
     })
+}
+
+/// A failed lap's reason as the race records it: the simulator's (and the game robot's)
+/// reasons by name; any other (a game that drove no lap) counts as the time limit.
+fn failure_reason(reason: Option<&str>) -> FailureReason {
+    reason
+        .and_then(FailureReason::from_name)
+        .unwrap_or(FailureReason::TimeLimit)
 }

@@ -48,6 +48,19 @@ impl FailureReason {
             FailureReason::TimeLimit => "time_limit",
         }
     }
+
+    /// The reason named `name` ([`FailureReason::name`]), if it is one.
+    pub fn from_name(name: &str) -> Option<FailureReason> {
+        [
+            FailureReason::OffTrack,
+            FailureReason::Spun,
+            FailureReason::Backwards,
+            FailureReason::Stalled,
+            FailureReason::TimeLimit,
+        ]
+        .into_iter()
+        .find(|r| r.name() == name)
+    }
 }
 
 /// Where and when a lap failed.

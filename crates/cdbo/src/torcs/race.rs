@@ -1,10 +1,13 @@
 //! Learning to race in the game: the demonstration driven in TORCS, w₀ fitted to it, then
-//! every lap of the optimisation a lap in TORCS ([`crate::experiment::race::race_with`]).
+//! every lap of the optimisation a lap in TORCS driven by the [`TorcsEvaluator`]
+//! ([`crate::experiment::race::race_with`]).
 
 use super::{Game, GamePedal, LapRequest};
 use crate::error::Result;
+use crate::evaluator::torcs::TorcsEvaluator;
 use crate::experiment::race::{LapRecord, RaceConfig, RaceOutcome, race_with};
 use crate::limit::limit_lap;
+use crate::policy::rkhs::default_lengthscale;
 use crate::sim::lap::{Failure, FailureReason, LapResult};
 use crate::track::Track;
 
@@ -48,12 +51,17 @@ pub fn race(
     demo_req.record = true;
     let demo = drive(game, &demo_req, GamePedal::Demo(config.demo_speed))?;
     let pairs = demo.trace.iter().map(|p| (p.x, p.pedal)).collect();
+    let mut evaluator = TorcsEvaluator {
+        game: game.clone(),
+        request: req.clone(),
+        lengthscale: default_lengthscale(config.kernels),
+    };
     race_with(
         &track.name,
         (demo, pairs),
         limit,
         config,
-        |policy| drive(game, req, GamePedal::Rkhs(policy.clone())),
+        &mut evaluator,
         progress,
     )
 }
