@@ -51,6 +51,33 @@ pub struct Brake {
     pub pad_mu: f64,
 }
 
+/// A wing (TORCS `Front Wing` / `Rear Wing`): at speed v it pushes down with
+/// F_z = 4·1.23·A·sin α·v² and drags with F_x = 1.23·A·sin α·v² (simuv2's `aero.cpp`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Default)]
+pub struct Wing {
+    /// Area A (m²); 0 for no wing.
+    pub area: f64,
+    /// Angle of attack α (rad).
+    pub angle: f64,
+    /// Share of its downforce on the front axle, by the lever rule: (x_wing − x_rear) / L.
+    pub front_share: f64,
+}
+
+impl Wing {
+    /// Drag per v² (kg/m): 1.23·A·sin α.
+    pub fn drag_per_v2(&self) -> f64 {
+        WING_AIR_DENSITY * self.area * self.angle.sin()
+    }
+
+    /// Downforce per v² (kg/m): 4·1.23·A·sin α.
+    pub fn downforce_per_v2(&self) -> f64 {
+        4.0 * self.drag_per_v2()
+    }
+}
+
+/// The air density TORCS's wings use (kg/m³).
+const WING_AIR_DENSITY: f64 = 1.23;
+
 /// A car.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Car {
@@ -72,13 +99,22 @@ pub struct Car {
     pub front_area: f64,
     /// Lift coefficients of the front and rear axles (positive pushes down).
     pub clift: [f64; 2],
+    /// Front and rear wings.
+    pub wings: [Wing; 2],
     /// Engine torque curve: (engine speed rad/s, torque N·m), increasing speed.
     pub torque_curve: Vec<(f64, f64)>,
     /// Rev limiter (rad/s): no torque above it.
     pub rev_limiter: f64,
     /// Idle speed (rad/s): the clutch slips below it.
     pub tickover: f64,
-    /// Engine rotational inertia (kg·m²).
+    /// Highest engine speed (rad/s), TORCS `revs maxi`: where the engine brake is full.
+    pub revs_max: f64,
+    /// Engine brake coefficient c (TORCS `brake coefficient`): at throttle a and engine speed
+    /// ω the engine gives T(ω)·(a·(1 + K) − K), K = c·(ω − ω_idle)/(ω_max − ω_idle)
+    /// (simuv2's `engine.cpp`), so a closed throttle brakes harder the faster it turns.
+    pub engine_brake: f64,
+    /// Engine rotational inertia (kg·m²). TORCS's simuv2 does not load the wheels with it,
+    /// and neither does [`crate::sim::vehicle`].
     pub engine_inertia: f64,
     /// Forward gear ratios, first gear first.
     pub gears: Vec<f64>,
@@ -149,9 +185,12 @@ impl Car {
             cx: 0.32,
             front_area: 1.85,
             clift: [0.65, 0.61],
+            wings: [Wing::default(); 2],
             torque_curve: curve_rpm_nm.iter().map(|&(r, t)| (r * rpm, t)).collect(),
             rev_limiter: 8500.0 * rpm,
             tickover: 2000.0 * rpm,
+            revs_max: 10000.0 * rpm,
+            engine_brake: DEFAULT_ENGINE_BRAKE,
             engine_inertia: 0.15,
             gears: vec![3.66, 2.18, 1.4, 1.02, 0.85, 0.76],
             final_drive: 4.5,
@@ -199,6 +238,14 @@ impl Car {
         crate::interp::linear(&self.torque_curve, omega)
     }
 
+    /// Engine torque at throttle a ∈ [0, 1] and engine speed ω (N·m), the engine brake
+    /// included: T(ω)·(a·(1 + K) − K), K = c·(ω − ω_idle)/(ω_max − ω_idle); `full` is T(ω).
+    #[inline]
+    pub fn part_throttle_torque(&self, full: f64, throttle: f64, omega: f64) -> f64 {
+        let k = self.engine_brake * (omega - self.tickover) / (self.revs_max - self.tickover);
+        full * (throttle * (1.0 + k) - k)
+    }
+
     /// Largest full-throttle torque between idle and the rev limiter (N·m).
     pub fn peak_torque(&self) -> f64 {
         self.torque_curve
@@ -218,20 +265,32 @@ impl Car {
         self.brake_pressure * share * b.piston_area * b.pad_mu * b.disc_radius
     }
 
-    /// Aerodynamic drag force at speed v: F = 0.645·Cx·A·v² (N), 0.645 = ρ/2 with ρ = 1.29.
+    /// Aerodynamic drag force at speed v: F = 0.645·Cx·A·v² plus the wings' (N), 0.645 = ρ/2
+    /// with ρ = 1.29.
     pub fn drag(&self, v: f64) -> f64 {
-        AIR_HALF_RHO * self.cx * self.front_area * v * v
+        let wings: f64 = self.wings.iter().map(Wing::drag_per_v2).sum();
+        (AIR_HALF_RHO * self.cx * self.front_area + wings) * v * v
     }
 
-    /// Downforce on the front and rear axles at speed v: Fᵢ = 0.645·Clᵢ·A·v² (N).
+    /// Downforce on the front and rear axles at speed v: Fᵢ = 0.645·Clᵢ·A·v² plus the wings',
+    /// each shared between the axles by its position (N).
     pub fn downforce(&self, v: f64) -> [f64; 2] {
         let q = AIR_HALF_RHO * self.front_area * v * v;
-        [q * self.clift[0], q * self.clift[1]]
+        let mut f = [q * self.clift[0], q * self.clift[1]];
+        for w in &self.wings {
+            let d = w.downforce_per_v2() * v * v;
+            f[0] += d * w.front_share;
+            f[1] += d * (1.0 - w.front_share);
+        }
+        f
     }
 }
 
 /// Half the air density, ρ/2 (kg/m³), the 0.645 of TORCS's aerodynamics.
 pub const AIR_HALF_RHO: f64 = 0.645;
+
+/// Engine brake coefficient when a car file does not give one (simuv2's default).
+pub const DEFAULT_ENGINE_BRAKE: f64 = 0.33;
 
 /// Pad friction when a brake does not give one (TORCS's default).
 pub const DEFAULT_PAD_MU: f64 = 0.30;

@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::{Brake, Car, DEFAULT_PAD_MU, Drive, Tyre};
+use super::{Brake, Car, DEFAULT_ENGINE_BRAKE, DEFAULT_PAD_MU, Drive, Tyre, Wing};
 use crate::error::{Error, Result};
 use crate::params::{Params, Section};
 
@@ -54,6 +54,9 @@ fn find_category(car: &Path, cat: &str) -> Option<PathBuf> {
     .map(|d| d.join(&file))
     .find(|p| p.is_file())
 }
+
+/// Rolling resistance of TORCS's asphalt surfaces (`data/tracks/surfaces.xml`).
+const ASPHALT_ROLLING_RESISTANCE: f64 = 0.001;
 
 /// Builds a car from (merged) parameters.
 pub fn from_params(p: &Params) -> Result<Car> {
@@ -111,6 +114,26 @@ pub fn from_params(p: &Params) -> Result<Car> {
         aero.num_or(f, "rear Clift", 0.0)?,
     ];
 
+    // Wings: the lever rule between the axles' positions shares their downforce.
+    let rear_x = ra.num_or(f, "xpos", -1.4)?;
+    let wing = |name: &str| -> Result<Wing> {
+        let w = sec(name);
+        let area = w.num_or(f, "area", 0.0)?;
+        if !(area >= 0.0 && area.is_finite()) {
+            return Err(p.error(
+                &format!("{}/area", w.path),
+                Some(w.line_of("area")),
+                format!("must be non-negative, got {area}"),
+            ));
+        }
+        Ok(Wing {
+            area,
+            angle: w.num_or(f, "angle", 0.0)?,
+            front_share: (w.num_or(f, "xpos", rear_x)? - rear_x) / wheelbase,
+        })
+    };
+    let wings = [wing("Front Wing")?, wing("Rear Wing")?];
+
     let engine = p.require_section("Engine")?;
     let points = engine.section("data points").ok_or_else(|| {
         p.error(
@@ -147,6 +170,22 @@ pub fn from_params(p: &Params) -> Result<Car> {
         engine.num_or(f, "revs limiter", engine.num_or(f, "revs maxi", 800.0)?)?,
     )?;
     let tickover = engine.num_or(f, "tickover", 100.0)?;
+    let revs_max = engine.num_or(f, "revs maxi", 1000.0)?;
+    if !(revs_max > tickover && revs_max.is_finite()) {
+        return Err(p.error(
+            &format!("{}/revs maxi", engine.path),
+            Some(engine.line_of("revs maxi")),
+            format!("must be above the tickover ({tickover} rad/s), got {revs_max} rad/s"),
+        ));
+    }
+    let engine_brake = engine.num_or(f, "brake coefficient", DEFAULT_ENGINE_BRAKE)?;
+    if !(engine_brake >= 0.0 && engine_brake.is_finite()) {
+        return Err(p.error(
+            &format!("{}/brake coefficient", engine.path),
+            Some(engine.line_of("brake coefficient")),
+            format!("must be non-negative, got {engine_brake}"),
+        ));
+    }
     let engine_inertia = positive(engine, "inertia", engine.num_or(f, "inertia", 0.2)?)?;
 
     let gearbox = p.require_section("Gearbox")?;
@@ -204,7 +243,9 @@ pub fn from_params(p: &Params) -> Result<Car> {
             )?,
             elasticity: w.num_or(f, "elasticity factor", 0.7)?,
             operating_load: positive(w, "operating load", w.num_or(f, "operating load", 5000.0)?)?,
-            rolling_resistance: w.num_or(f, "rolling resistance", 0.02)?,
+            // TORCS's simuv2 takes rolling resistance from the road's surface, not the tyre:
+            // a car file without one rolls like the game's asphalt (0.001).
+            rolling_resistance: w.num_or(f, "rolling resistance", ASPHALT_ROLLING_RESISTANCE)?,
             inertia: w.num_or(f, "inertia", 1.5)? + brake.num_or(f, "inertia", 0.13)?,
         })
     };
@@ -227,9 +268,12 @@ pub fn from_params(p: &Params) -> Result<Car> {
         cx,
         front_area,
         clift,
+        wings,
         torque_curve,
         rev_limiter,
         tickover,
+        revs_max,
+        engine_brake,
         engine_inertia,
         gears,
         final_drive: positive(sec(differential), "ratio", final_drive)?,

@@ -1,8 +1,11 @@
 //! Engine, clutch and automatic gearbox.
 //!
-//! Wheel torque at full throttle in gear i: T_w = T_e(ω_e)·gᵢ·g_f with engine speed
-//! ω_e = ω_wheel·gᵢ·g_f (efficiency 1, as the Spirit 300's file gives). Below idle the clutch
-//! slips and the engine delivers T_e(ω_idle). The gearbox shifts up when the next gear gives
+//! Wheel torque at throttle a in gear i: T_w = T_e(ω_e)·(a·(1 + K) − K)·gᵢ·g_f with engine
+//! speed ω_e = ω_wheel·gᵢ·g_f (efficiency 1, as TORCS's simuv2 drives the wheels) and the
+//! engine brake K = c·(ω_e − ω_idle)/(ω_max − ω_idle) of simuv2's `engine.cpp`: at part
+//! throttle the engine's net torque falls with its speed and turns negative, and a closed
+//! throttle brakes. Below idle the clutch slips and the engine delivers a·T_e(ω_idle); above
+//! the rev limiter it delivers nothing. The gearbox shifts up when the next gear gives
 //! more wheel torque at the same road speed (or at the rev limiter) and down when the lower
 //! gear would still be below its own up-shift speed; each shift cuts the drive for the car's
 //! `shift time`.
@@ -134,7 +137,8 @@ impl Gearbox {
         car.gears[self.gear] * car.final_drive
     }
 
-    /// Drive torque at the driven wheels (N·m) for a throttle in [0, 1], and the engine speed.
+    /// Drive torque at the driven wheels (N·m) for a throttle in [0, 1], the engine brake
+    /// included, and the engine speed.
     #[inline]
     pub fn wheel_torque(
         &self,
@@ -148,7 +152,8 @@ impl Gearbox {
         if self.shifting > 0.0 {
             return (0.0, engine);
         }
-        (throttle * engine_map.torque(engine) * ratio, engine)
+        let torque = car.part_throttle_torque(engine_map.torque(engine), throttle, engine);
+        (torque * ratio, engine)
     }
 }
 

@@ -10,8 +10,9 @@
 //!   s_y = −v_l/max(|v_t|, v₀) with v₀ = [`SLIP_SPEED_FLOOR`]; the tyre ([`super::tyre`])
 //!   gives (Fₓ, F_y).
 //! - Wheels: I·dω/dt = T_drive − T_brake·sgn ω − R·Fₓ(ω), integrated implicitly in ω (Fₓ
-//!   linearised), so that the stiff slip dynamics stay stable at the 4 ms step. When the clutch is
-//!   engaged the engine inertia adds I_e·(gᵢg_f)² to the driven axle.
+//!   linearised), so that the stiff slip dynamics stay stable at the 4 ms step. As in TORCS's
+//!   simuv2 (whose differential takes its output inertia from the gear alone at each shift),
+//!   the engine's inertia does not load the wheels: the engine speed follows them.
 //! - Body: m(v̇ₓ − v_y r) = F_xf cos δ − F_yf sin δ + F_xr − F_drag − F_roll − m g sin φ,
 //!   m(v̇_y + vₓ r) = F_xf sin δ + F_yf cos δ + F_yr − m g sin β,
 //!   I_z ṙ = a(F_xf sin δ + F_yf cos δ) − b F_yr, with β the banking.
@@ -264,11 +265,6 @@ impl Vehicle {
             s.gearbox
                 .wheel_torque(car, &self.engine_map, throttle, self.driven_omega(s));
         s.engine_speed = engine_speed;
-        let engine_inertia = if s.gearbox.shifting > 0.0 {
-            0.0
-        } else {
-            car.engine_inertia * s.gearbox.ratio(car).powi(2)
-        };
         s.gearbox.shifting = (s.gearbox.shifting - dt).max(0.0);
 
         let mut fx = [0.0; 2];
@@ -289,7 +285,7 @@ impl Vehicle {
             let f = tyre.forces(sx, sy, fmax);
             // Implicit step of I·dω/dt = T − T_b·sgn ω − R·Fₓ(ω), with Fₓ linear in ω.
             let dfx_domega = f.dfx_dsx * r * inv_denom;
-            let inertia = self.wheel_inertia[k] + self.driven[k] * engine_inertia;
+            let inertia = self.wheel_inertia[k];
             let torque = self.driven[k] * drive_torque - r * f.fx;
             let free = torque - brake * s.omega[k].signum() * f64::from(s.omega[k] != 0.0);
             let mut new_omega = s.omega[k] + dt * free / (inertia + dt * r * dfx_domega.max(0.0));
