@@ -168,4 +168,15 @@ fn spirit_300_from_its_files_equals_the_builtin_car() {
     assert_eq!(catalog::find("sc-spirit-300", &data).unwrap().mass, 1440.0);
     let trb1 = catalog::find("car1-trb1", &data).unwrap();
     assert!(trb1.mass > 500.0 && !trb1.gears.is_empty());
+    // Its wings (front 0.25 m² at 6°, rear 0.7 m² at 14°) add 1.23·A·sin α to the drag and four
+    // times that to the downforce; the engine brakes with simuv2's default coefficient.
+    let wings = 1.23 * (0.25 * 6f64.to_radians().sin() + 0.7 * 14f64.to_radians().sin());
+    let body = 0.645 * 0.35 * 1.92;
+    assert!((trb1.drag(1.0) - body - wings).abs() < 1e-9, "{}", trb1.drag(1.0));
+    let [front, rear] = trb1.downforce(1.0);
+    let lift = 0.645 * 1.92 * (0.69 + 0.7);
+    assert!((front + rear - lift - 4.0 * wings).abs() < 1e-9);
+    assert!(rear > front, "the rear wing loads the rear axle");
+    assert_eq!(trb1.engine_brake, 0.33);
+    assert!((trb1.revs_max - 10_000.0 * std::f64::consts::PI / 30.0).abs() < 1e-9);
 }

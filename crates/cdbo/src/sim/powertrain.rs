@@ -190,6 +190,31 @@ mod tests {
     }
 
     #[test]
+    fn the_engine_brakes_as_simuv2s_does() {
+        let car = Car::spirit_300();
+        let full = 300.0;
+        // At idle K = 0: the throttle scales the curve.
+        let idle = car.part_throttle_torque(full, 0.4, car.tickover);
+        assert!((idle - 0.4 * full).abs() < 1e-12);
+        // At the highest speed K = c: a closed throttle brakes with c·T.
+        let closed = car.part_throttle_torque(full, 0.0, car.revs_max);
+        assert!((closed + car.engine_brake * full).abs() < 1e-12);
+        // Halfway, K = c/2, and the net torque vanishes at a = K/(1 + K).
+        let w = 0.5 * (car.tickover + car.revs_max);
+        let k = 0.5 * car.engine_brake;
+        assert!(car.part_throttle_torque(full, k / (1.0 + k), w).abs() < 1e-9);
+        assert!(car.part_throttle_torque(full, 1.0, w) == full);
+        // The wheels feel it through the gearbox, past the rev limiter nothing.
+        let (map, g) = (EngineMap::new(&car), Gearbox::new());
+        let ratio = g.ratio(&car);
+        let (t, e) = g.wheel_torque(&car, &map, 0.0, w / ratio);
+        assert!((e - w).abs() < 1e-9);
+        assert!((t + k * map.torque(w) * ratio).abs() < 1e-9, "{t}");
+        let (t, _) = g.wheel_torque(&car, &map, 0.0, 1.01 * car.rev_limiter / ratio);
+        assert_eq!(t, 0.0);
+    }
+
+    #[test]
     fn the_engine_map_equals_the_curve() {
         let car = Car::spirit_300();
         let map = EngineMap::new(&car);
