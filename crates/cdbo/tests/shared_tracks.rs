@@ -172,7 +172,11 @@ fn spirit_300_from_its_files_equals_the_builtin_car() {
     // times that to the downforce; the engine brakes with simuv2's default coefficient.
     let wings = 1.23 * (0.25 * 6f64.to_radians().sin() + 0.7 * 14f64.to_radians().sin());
     let body = 0.645 * 0.35 * 1.92;
-    assert!((trb1.drag(1.0) - body - wings).abs() < 1e-9, "{}", trb1.drag(1.0));
+    assert!(
+        (trb1.drag(1.0) - body - wings).abs() < 1e-9,
+        "{}",
+        trb1.drag(1.0)
+    );
     let [front, rear] = trb1.downforce(1.0);
     let lift = 0.645 * 1.92 * (0.69 + 0.7);
     assert!((front + rear - lift - 4.0 * wings).abs() < 1e-9);
