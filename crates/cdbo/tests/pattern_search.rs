@@ -61,6 +61,8 @@ fn pattern_search_beats_random_search_next_to_a_cliff() {
 fn a_failed_lap_is_repaired_before_where_it_failed() {
     let config = PatternSearchConfig {
         sigma0: 0.1,
+        block: 1,
+        repairs: 1,
         ..PatternSearchConfig::default()
     };
     for seed in 0..8 {
@@ -89,6 +91,83 @@ fn a_failed_lap_is_repaired_before_where_it_failed() {
             assert!(next[moved] == 0.0, "seed {seed}: {next:?}");
         }
     }
+}
+
+/// A repaired lap that fails again at or past its give-back is given back there too, the same
+/// kernel twice braking twice as hard, up to `repairs` give-backs; then the step is dropped.
+#[test]
+fn a_repair_that_fails_again_is_repaired_again() {
+    let config = PatternSearchConfig {
+        sigma0: 0.1,
+        block: 1,
+        repairs: 3,
+        ..PatternSearchConfig::default()
+    };
+    let mut checked = 0;
+    for seed in 0..8 {
+        let mut ps = PatternSearch::new(
+            vec![0.0; 10],
+            PatternSearchConfig {
+                seed,
+                ..config.clone()
+            },
+        )
+        .unwrap();
+        let start = ps.ask().unwrap();
+        ps.tell_lap(&start, 1.0, None).unwrap();
+        let w = ps.ask().unwrap();
+        let moved = w.iter().position(|&v| v != 0.0).unwrap();
+        if moved >= 6 {
+            continue;
+        }
+        checked += 1;
+        // Kernel 7's span (x = 7/9): kernel 6 gives the step back.
+        ps.tell_lap(&w, 0.0, Some(7.0 / 9.0)).unwrap();
+        let mut expected = w.clone();
+        expected[6] -= 0.1;
+        assert_eq!(ps.ask().unwrap(), expected, "seed {seed}");
+        // Failed again further on (x = 1): kernel 8 gives it back too.
+        ps.tell_lap(&expected, 0.0, Some(1.0)).unwrap();
+        expected[8] -= 0.1;
+        assert_eq!(ps.ask().unwrap(), expected, "seed {seed}");
+        // And again at the same place: kernel 8 brakes twice as hard.
+        ps.tell_lap(&expected, 0.0, Some(1.0)).unwrap();
+        expected[8] -= 0.1;
+        assert_eq!(ps.ask().unwrap(), expected, "seed {seed}");
+        // A fourth failure drops the step: the next trial leaves the moved weight alone.
+        ps.tell_lap(&expected, 0.0, Some(1.0)).unwrap();
+        let next = ps.ask().unwrap();
+        assert_eq!(next[moved], 0.0, "seed {seed}: {next:?}");
+        assert_eq!(next.iter().filter(|&&v| v != 0.0).count(), 1, "{next:?}");
+    }
+    assert!(checked > 0, "no seed moved a weight before kernel 6 first");
+}
+
+/// The first sweep moves blocks of `block` adjacent weights together, the next ones half as
+/// wide, down to single weights.
+#[test]
+fn sweeps_narrow_their_blocks() {
+    let mut ps = PatternSearch::new(
+        vec![0.0; 16],
+        PatternSearchConfig {
+            sigma0: 0.1,
+            block: 4,
+            ..PatternSearchConfig::default()
+        },
+    )
+    .unwrap();
+    let start = ps.ask().unwrap();
+    ps.tell_lap(&start, 1.0, None).unwrap();
+    // Every trial slower: each block is tried once per sweep, 4 + 8 + 16 trials.
+    let mut widths = Vec::new();
+    for _ in 0..28 {
+        let w = ps.ask().unwrap();
+        let moved: Vec<usize> = (0..16).filter(|&k| w[k] != 0.0).collect();
+        assert!(moved.windows(2).all(|p| p[1] == p[0] + 1), "{moved:?}");
+        widths.push(moved.len());
+        ps.tell_lap(&w, 0.5, None).unwrap();
+    }
+    assert_eq!(widths, [[4; 4].as_slice(), &[2; 8], &[1; 16]].concat());
 }
 
 /// Same seed, same laps; a search saved mid-run (failure places told) resumes bit for bit.

@@ -12,7 +12,8 @@ use cdbo::sim::Simulator;
 pub enum BenchCommand {
     /// Laps of the 15 m/s demonstrator on one thread: simulated time over wall time.
     Sim(SimArgs),
-    /// Time of one CDBO suggestion on a GP with N observations in D dimensions.
+    /// Time of one CDBO suggestion on a GP with N observations in D dimensions, and of the
+    /// pattern search's after as many laps.
     Suggest(SuggestArgs),
     /// Every method on a test problem: mean ± standard error of the best value, and time.
     Optimizers(OptimizersArgs),
@@ -88,6 +89,8 @@ struct SuggestBench {
     p90_ms: f64,
     af_evals_per_suggest: f64,
     refit_ms: f64,
+    /// The pattern search's suggestion after as many laps in as many weights.
+    pattern_search_median_ms: f64,
 }
 
 #[derive(Debug, Args)]
@@ -199,6 +202,13 @@ fn suggest(args: &SuggestArgs) -> CliResult {
         maximiser: Maximiser::CoordinateAscent(search),
         ..BoConfig::default()
     };
+    let reward = |w: &[f64]| {
+        30.0 - w
+            .iter()
+            .enumerate()
+            .map(|(i, v)| (v - 0.1 * (i % 5) as f64).powi(2))
+            .sum::<f64>()
+    };
     let mut opt = Bo::new(vec![0.0; args.dims], config)?;
     let mut rng = cdbo::optimizers::rng_for(7, 0);
     let normal = rand_distr::Normal::new(0.0, 0.3)?;
@@ -206,12 +216,7 @@ fn suggest(args: &SuggestArgs) -> CliResult {
         let w: Vec<f64> = (0..args.dims)
             .map(|_| rand_distr::Distribution::sample(&normal, &mut rng))
             .collect();
-        let reward = 30.0
-            - w.iter()
-                .enumerate()
-                .map(|(i, v)| (v - 0.1 * (i % 5) as f64).powi(2))
-                .sum::<f64>();
-        opt.tell(&w, reward)?;
+        opt.tell(&w, reward(&w))?;
     }
     let start = std::time::Instant::now();
     opt.fit_hyperparameters()?;
@@ -227,6 +232,21 @@ fn suggest(args: &SuggestArgs) -> CliResult {
     }
     times.sort_by(f64::total_cmp);
     let pick = |q: f64| times[((times.len() - 1) as f64 * q).round() as usize];
+    let settings = cdbo::optimizers::Settings::race(7, 1.0);
+    let mut ps = cdbo::optimizers::by_name("pattern-search", vec![0.0; args.dims], &settings)?;
+    for _ in 0..args.observations {
+        let w = ps.ask()?;
+        ps.tell(&w, reward(&w))?;
+    }
+    let mut ps_times: Vec<f64> = (0..args.repeats)
+        .map(|_| {
+            let t = std::time::Instant::now();
+            let w = ps.ask();
+            let elapsed = t.elapsed().as_secs_f64() * 1e3;
+            std::hint::black_box(w).map(|_| elapsed)
+        })
+        .collect::<Result<_, _>>()?;
+    ps_times.sort_by(f64::total_cmp);
     let b = SuggestBench {
         observations: args.observations,
         dims: args.dims,
@@ -235,6 +255,7 @@ fn suggest(args: &SuggestArgs) -> CliResult {
         p90_ms: pick(0.9),
         af_evals_per_suggest: evals as f64 / args.repeats as f64,
         refit_ms,
+        pattern_search_median_ms: ps_times[ps_times.len() / 2],
     };
     if args.json {
         return print_json(&b);
@@ -242,6 +263,11 @@ fn suggest(args: &SuggestArgs) -> CliResult {
     println!(
         "CDBO suggestion, {} observations in {} dimensions: median {:.2} ms, p90 {:.2} ms, {:.0} acquisition evaluations; hyperparameter fit {:.0} ms",
         b.observations, b.dims, b.median_ms, b.p90_ms, b.af_evals_per_suggest, b.refit_ms
+    );
+    println!(
+        "pattern-search suggestion after as many laps: median {:.4} ms ({:.5}× CDBO's)",
+        b.pattern_search_median_ms,
+        b.pattern_search_median_ms / b.median_ms
     );
     Ok(())
 }

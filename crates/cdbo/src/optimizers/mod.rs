@@ -226,6 +226,7 @@ pub fn by_name(name: &str, w0: Vec<f64>, settings: &Settings) -> Result<Box<dyn 
                 sigma0,
                 box_radius,
                 repair: true,
+                ..pattern_search::PatternSearchConfig::default()
             },
         )?),
         other => return Err(unknown_method(other)),

@@ -1,19 +1,23 @@
 //! Pattern search with failure repair: an adaptive coordinate search around the best lap that
-//! reads where a failed lap failed.
+//! reads where a failed lap failed, on blocks of weights that narrow sweep by sweep.
 //!
 //! The weights are a policy's kernels in lap order (weight i acts around x̂ᵢ = i/(M − 1)), and
-//! a lap is causal: the pedal at x changes nothing before x. Each weight i has a signed step
-//! sᵢ, first +σ₀ (more pedal). A trial moves one weight from the best point w*:
-//! w = clamp(w* + sᵢeᵢ) (Rosenbrock's method on the coordinate axes):
-//! - a faster lap is accepted and the step grows, sᵢ ← 2sᵢ, on the same weight;
-//! - a lap that **fails at x_f past the moved kernel** was too fast for what follows: the
-//!   **repair** w* + sᵢeᵢ − sᵢeⱼ gives the step back at the kernel j = ⌊x_f(M − 1)⌋ − 1 just
-//!   before the failure (brake earlier for the corner the car could not take); if it is
-//!   faster, both are accepted and sᵢ doubles;
-//! - otherwise (slower, or failed again) the step reverses and halves, sᵢ ← −sᵢ/2, and the
-//!   search moves to the next weight.
+//! a lap is causal: the pedal at x changes nothing before x. Sweep k moves blocks of
+//! b_k = max(1, ⌊b₀/2ᵏ⁻¹⌋) adjacent weights together (b₀ = 8: first whole stretches of the lap,
+//! then single kernels); block B starting at weight i has a signed step sᵢ, first +σ₀ (more
+//! pedal), reset to +σ₀ when the width changes. A trial moves one block from the best point
+//! w*: w = clamp(w* + sᵢΣ_{k∈B} eₖ) (Rosenbrock's method on the blocks):
+//! - a faster lap is accepted and the step grows, sᵢ ← 2sᵢ, on the same block;
+//! - a lap that **fails at x_f past the moved block** was too fast for what follows: the
+//!   **repair** gives the step back at the kernel j = ⌊x_f(M − 1)⌋ − 1 just before the
+//!   failure, w* + sᵢΣ_{k∈B} eₖ − sᵢeⱼ (brake earlier for the corner the car could not take);
+//!   a repaired lap that fails again at or past j is repaired again there (up to 3 give-backs,
+//!   the same kernel twice brakes twice as hard); if a repaired lap is faster, it is accepted
+//!   and sᵢ doubles;
+//! - otherwise (slower, or failed before the repair could reach) the step reverses and
+//!   halves, sᵢ ← −sᵢ/2, and the search moves to the next block.
 //!
-//! The weights are visited in a fresh random order each sweep; a step that has shrunk below
+//! The blocks are visited in a fresh random order each sweep; a step that has shrunk below
 //! σ₀/16 starts the next sweep at ±σ₀ again. Only the lap's reward and where it failed are
 //! used: what a car's lap timer gives.
 
@@ -34,6 +38,17 @@ pub struct PatternSearchConfig {
     pub box_radius: f64,
     /// Repair failed laps where they failed.
     pub repair: bool,
+    /// Width b₀ of the first sweep's blocks of adjacent weights, halved each sweep down to 1.
+    #[serde(default = "single_weight")]
+    pub block: usize,
+    /// Give-backs at most on one step (a repaired lap that fails again is repaired again).
+    #[serde(default = "single_weight")]
+    pub repairs: usize,
+}
+
+/// Blocks of one weight and one repair: the settings of a search saved before they existed.
+fn single_weight() -> usize {
+    1
 }
 
 impl Default for PatternSearchConfig {
@@ -43,26 +58,28 @@ impl Default for PatternSearchConfig {
             sigma0: 0.03,
             box_radius: super::DEFAULT_BOX_RADIUS,
             repair: true,
+            block: 8,
+            repairs: 3,
         }
     }
 }
 
 /// What the pending trial is.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum Trial {
     /// The start point.
     Start,
-    /// w* + sᵢeᵢ.
+    /// w* + sᵢ·Σ_{k∈B(i)} eₖ, B(i) the block of weights starting at i.
     Step {
-        /// The moved weight i.
+        /// The first moved weight i.
         weight: usize,
     },
-    /// w* + sᵢeᵢ − sᵢeⱼ.
+    /// The step with sᵢ given back at the weights before the failures, w* + sᵢΣeₖ − sᵢΣⱼeⱼ.
     Repair {
-        /// The moved weight i.
+        /// The first moved weight i.
         weight: usize,
-        /// The weight j before the failure.
-        before: usize,
+        /// The weights j before the failures.
+        before: Vec<usize>,
     },
 }
 
@@ -75,7 +92,7 @@ pub struct PatternSearchState {
     pub start: Vec<f64>,
     /// The signed step of every weight.
     pub steps: Vec<f64>,
-    /// This sweep's order of the weights.
+    /// This sweep's order of the blocks (their first weights).
     pub order: Vec<usize>,
     /// Position in `order`.
     pub cursor: usize,
@@ -142,39 +159,65 @@ impl PatternSearch {
         })
     }
 
-    /// The weight the search is on, beginning a new sweep when the last one is done.
-    fn current_weight(&mut self) -> usize {
-        let s = &mut self.state;
-        if s.cursor >= s.order.len() {
-            s.order = (0..s.start.len()).collect();
-            s.order.shuffle(&mut rng_for(s.config.seed, s.sweeps));
-            s.sweeps += 1;
-            s.cursor = 0;
-            let floor = s.config.sigma0 / 16.0;
-            for step in &mut s.steps {
-                if step.abs() < floor {
-                    *step = s.config.sigma0.copysign(*step);
-                }
-            }
-        }
-        s.order[s.cursor]
+    /// This sweep's block width: the first sweep's halved each sweep, down to 1.
+    fn width(&self) -> usize {
+        let shift = self.state.sweeps.saturating_sub(1).min(63);
+        (self.state.config.block >> shift).max(1)
     }
 
-    /// The kernel just before a failure at lap fraction `at`, if it lies past `weight`.
-    fn before_failure(&self, weight: usize, at: f64) -> Option<usize> {
+    /// The centre of the trials: the best point, or the start before any lap.
+    fn centre(&self) -> &[f64] {
+        self.state.best.get().map_or(&self.state.start[..], |b| b.0)
+    }
+
+    /// Begins a new sweep: a fresh order of the blocks, steps shrunk below σ₀/16 back at σ₀.
+    fn begin_sweep(&mut self) {
+        let old_width = self.width();
+        self.state.sweeps += 1;
+        let width = self.width();
+        let n = self.state.start.len();
+        let sigma0 = self.state.config.sigma0;
+        let s = &mut self.state;
+        s.order = (0..n).step_by(width).collect();
+        s.order.shuffle(&mut rng_for(s.config.seed, s.sweeps - 1));
+        s.cursor = 0;
+        if width != old_width {
+            s.steps.iter_mut().for_each(|v| *v = sigma0);
+        }
+        for step in &mut s.steps {
+            if step.abs() < sigma0 / 16.0 {
+                *step = sigma0.copysign(*step);
+            }
+        }
+        s.next = Trial::Step { weight: s.order[0] };
+    }
+
+    /// The next block of the sweep, or a new sweep when it is done.
+    fn advance(&mut self) {
+        self.state.cursor += 1;
+        match self.state.order.get(self.state.cursor) {
+            Some(&weight) => self.state.next = Trial::Step { weight },
+            None => self.begin_sweep(),
+        }
+    }
+
+    /// The weights moved by the block starting at `weight`.
+    fn block(&self, weight: usize) -> std::ops::Range<usize> {
+        weight..(weight + self.width()).min(self.state.start.len())
+    }
+
+    /// The kernel just before a failure at lap fraction `at`, if it lies at or past `after`.
+    fn before_failure(&self, after: usize, at: f64) -> Option<usize> {
         let last = self.state.start.len() - 1;
         let at_kernel = (at.clamp(0.0, 1.0) * last as f64).floor() as usize;
         let j = at_kernel.checked_sub(1)?;
-        (j > weight).then_some(j)
+        (j >= after).then_some(j)
     }
 
-    /// The step on `weight` failed: reverse and halve it, move to the next weight.
+    /// The step on `weight` failed: reverse and halve it, move to the next block.
     fn give_up(&mut self, weight: usize) {
         self.state.steps[weight] *= -0.5;
-        self.state.cursor += 1;
-        self.state.next = Trial::Step {
-            weight: self.current_weight(),
-        };
+        self.advance();
     }
 }
 
@@ -189,14 +232,22 @@ impl Optimizer for PatternSearch {
 
     fn ask(&mut self) -> Result<Vec<f64>> {
         let s = &self.state;
-        let centre = s.best.get().map_or(&s.start[..], |b| b.0);
+        let centre = self.centre();
         let mut w = centre.to_vec();
-        match s.next {
+        match &s.next {
             Trial::Start => return Ok(s.start.clone()),
-            Trial::Step { weight } => w[weight] += s.steps[weight],
+            Trial::Step { weight } => {
+                for k in self.block(*weight) {
+                    w[k] += s.steps[*weight];
+                }
+            }
             Trial::Repair { weight, before } => {
-                w[weight] += s.steps[weight];
-                w[before] -= s.steps[weight];
+                for k in self.block(*weight) {
+                    w[k] += s.steps[*weight];
+                }
+                for &j in before {
+                    w[j] -= s.steps[*weight];
+                }
             }
         }
         self.bounds.clamp(&mut w);
@@ -223,25 +274,41 @@ impl Optimizer for PatternSearch {
         }
         self.state.evaluations += 1;
         let better = self.state.best.offer(weights, reward);
-        match self.state.next {
-            Trial::Start => {
-                let weight = self.current_weight();
-                self.state.next = Trial::Step { weight };
-            }
+        let repair = self.state.config.repair;
+        match self.state.next.clone() {
+            Trial::Start => self.begin_sweep(),
             Trial::Step { weight } | Trial::Repair { weight, .. } if better => {
                 self.state.steps[weight] *= 2.0;
                 self.state.next = Trial::Step { weight };
             }
             Trial::Step { weight } => {
-                let repair = failed_at
-                    .filter(|_| self.state.config.repair)
-                    .and_then(|at| self.before_failure(weight, at));
-                match repair {
-                    Some(before) => self.state.next = Trial::Repair { weight, before },
+                let past = self.block(weight).end;
+                match failed_at
+                    .filter(|_| repair)
+                    .and_then(|at| self.before_failure(past, at))
+                {
+                    Some(j) => {
+                        self.state.next = Trial::Repair {
+                            weight,
+                            before: vec![j],
+                        }
+                    }
                     None => self.give_up(weight),
                 }
             }
-            Trial::Repair { weight, .. } => self.give_up(weight),
+            Trial::Repair { weight, mut before } => {
+                let last = before.last().copied().unwrap_or(weight);
+                match failed_at
+                    .filter(|_| before.len() < self.state.config.repairs)
+                    .and_then(|at| self.before_failure(last, at))
+                {
+                    Some(j) => {
+                        before.push(j);
+                        self.state.next = Trial::Repair { weight, before };
+                    }
+                    None => self.give_up(weight),
+                }
+            }
         }
         Ok(())
     }
