@@ -265,7 +265,7 @@ fn suggest(args: &SuggestArgs) -> CliResult {
         b.observations, b.dims, b.median_ms, b.p90_ms, b.af_evals_per_suggest, b.refit_ms
     );
     println!(
-        "pattern-search suggestion after as many laps: median {:.4} ms ({:.5}× CDBO's)",
+        "pattern-search suggestion after as many laps: median {:.1e} ms ({:.1e} × CDBO's)",
         b.pattern_search_median_ms,
         b.pattern_search_median_ms / b.median_ms
     );
