@@ -2,8 +2,8 @@
 //!
 //! With K = k(W, W) + (σ_n² + jitter)·I = LLᵀ and α = K⁻¹(z − m):
 //! μ(w*) = m + k(w*, W)·α and σ²(w*) = k(w*, w*) − vᵀv with v = L⁻¹k(W, w*).
-//! Observations are added in O(n²) by extending L with one row (no refactorisation); the
-//! jitter is the smallest of 0, 1e-10, 1e-9, … that keeps L finite, raised only when needed
+//! Observations are added in O(n²) by extending L with one row, in place (no refactorisation,
+//! no copy of L); the jitter is the smallest of 0, 1e-10, 1e-9, … that keeps L finite, raised only when needed
 //! and reported by [`GaussianProcess::jitter`].
 
 pub(crate) mod fit_in_flight;
@@ -64,9 +64,13 @@ pub struct GaussianProcess {
     x: Vec<f64>,
     y: Vec<f64>,
     mean: f64,
-    /// Lower Cholesky factor of K.
+    /// Lower Cholesky factor of K, by columns, for faer's blocked solves (several points, α,
+    /// the likelihood). Its capacity doubles as it fills, so a new observation writes one row
+    /// in place.
     chol: Mat<f64>,
-    /// The same factor by rows, for one-point solves; a new observation appends a row.
+    /// The same factor by rows, for one-point solves (the coordinate ascent's inner loop); a
+    /// new observation appends a row. Both layouts are kept: L by rows alone makes a
+    /// suggestion slower and changes faer's order of summation for α (docs/results/design.md).
     rows: TriangularRows,
     alpha: Vec<f64>,
     jitter: f64,
@@ -176,15 +180,13 @@ impl GaussianProcess {
         self.y.push(z);
         if d2 > 1e-12 * self.hyper.signal_var && d2.is_finite() {
             let d = d2.sqrt();
-            let mut chol = Mat::zeros(n + 1, n + 1);
-            chol.as_mut()
-                .submatrix_mut(0, 0, n, n)
-                .copy_from(self.chol.as_ref());
+            let capacity = (n + 1).next_power_of_two();
+            self.chol.reserve(capacity, capacity);
+            self.chol.resize_with(n + 1, n + 1, |_, _| 0.0);
             for (j, lj) in l.iter().enumerate() {
-                chol[(n, j)] = *lj;
+                self.chol[(n, j)] = *lj;
             }
-            chol[(n, n)] = d;
-            self.chol = chol;
+            self.chol[(n, n)] = d;
             l.push(d);
             self.rows.push_row(&l);
             self.update_alpha();
