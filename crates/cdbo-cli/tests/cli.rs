@@ -11,8 +11,13 @@ fn cdbo(args: &[&str]) -> Output {
         .expect("runs")
 }
 
+/// The test data beside the repository, through the one helper of the library's tests.
+#[path = "../../cdbo/tests/common/shared.rs"]
+#[allow(dead_code)]
+mod shared_data;
+
 fn shared() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared")
+    shared_data::shared("")
 }
 
 /// Runs and expects success.

@@ -5,6 +5,8 @@ use cdbo::optimizers::bo::{Bo, BoConfig};
 use cdbo::optimizers::{Optimizer, SearchBox, rng_for};
 use rand_distr::{Distribution, Normal};
 
+mod common;
+
 /// Runs `evals` evaluations of `f` and returns the best value.
 fn run(opt: &mut dyn Optimizer, f: &dyn Fn(&[f64]) -> f64, evals: usize) -> f64 {
     for _ in 0..evals {
@@ -250,8 +252,7 @@ mod cmaes {
 /// ascents that end on an observation were rerun with the observations excluded.
 #[test]
 fn cdbo_never_re_drives_a_lap() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/torcs/tracks/road/forza/forza.xml");
+    let path = common::shared("torcs/tracks/road/forza/forza.xml");
     let track = cdbo::track::torcs::read(&path, cdbo::track::Ends::MustMeet)
         .unwrap_or_else(|e| panic!("{e}"));
     let config = cdbo::experiment::race::RaceConfig {

@@ -1,15 +1,9 @@
 //! The paper's real tracks, read from ../shared (the TORCS / Speed Dreams data, never copied).
 
-use std::path::PathBuf;
+mod common;
 
 use cdbo::track::{Ends, Track, torcs};
-
-/// `../shared` beside the repository root.
-pub fn shared(rel: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared")
-        .join(rel)
-}
+use common::shared;
 
 fn load(rel: &str) -> Track {
     let t = torcs::read(&shared(rel), Ends::MustMeet).unwrap_or_else(|e| panic!("{e}"));
@@ -183,4 +177,23 @@ fn spirit_300_from_its_files_equals_the_builtin_car() {
     assert!(rear > front, "the rear wing loads the rear axle");
     assert_eq!(trb1.engine_brake, 0.33);
     assert!((trb1.revs_max - 10_000.0 * std::f64::consts::PI / 30.0).abs() < 1e-9);
+}
+
+/// A file missing from ../shared fails its test with its name and where to get it.
+#[test]
+fn a_missing_shared_file_is_named_with_where_to_get_it() {
+    for (rel, source) in [
+        ("torcs/tracks/road/nowhere/nowhere.xml", "torcs-data"),
+        (
+            "speed-dreams/tracks/road/nowhere/nowhere.xml",
+            "Speed Dreams",
+        ),
+    ] {
+        let panic = std::panic::catch_unwind(|| shared(rel)).unwrap_err();
+        let message = panic.downcast_ref::<String>().unwrap();
+        assert!(
+            message.contains(&format!("../shared/{rel}")) && message.contains(source),
+            "{message}"
+        );
+    }
 }

@@ -22,10 +22,9 @@ fn game() -> Option<&'static Game> {
     static GAME: OnceLock<Result<Game, String>> = OnceLock::new();
     let game = GAME.get_or_init(|| {
         let install = Install::find().map_err(|e| e.to_string())?;
-        let sdk = common::shared("torcs-sdk");
-        if !sdk.join("include/robot.h").is_file() {
-            return Err(format!("no robot headers at {}", sdk.display()));
-        }
+        let sdk = common::shared_if_present("torcs-sdk")
+            .filter(|sdk| sdk.join("include/robot.h").is_file())
+            .ok_or("no TORCS robot headers at ../shared/torcs-sdk/include/robot.h")?;
         let cache = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("torcs-cache");
         torcs::setup(&install, &sdk, &cache).map_err(|e| format!("setup failed: {e}"))
     });

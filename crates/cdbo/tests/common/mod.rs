@@ -1,17 +1,12 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
-use std::path::PathBuf;
+mod shared;
 
 use cdbo::data_path::DataPath;
 use cdbo::track::Track;
 
-/// `../shared` beside the repository root.
-pub fn shared(rel: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared")
-        .join(rel)
-}
+pub use shared::{shared, shared_if_present};
 
 /// A track from ../shared, found by name.
 pub fn shared_track(name: &str) -> Track {
