@@ -1,6 +1,7 @@
 //! `cdbo`: learn a fast racing policy in few laps with Coordinate Descent Bayesian Optimisation.
 
 mod commands;
+mod figures;
 
 use std::path::PathBuf;
 use std::process::ExitCode;

@@ -100,6 +100,12 @@ pub enum Error {
         /// What had already happened.
         reason: String,
     },
+    /// An experiment folder that already holds a different grid.
+    #[error("{}: this folder holds a different grid", path.display())]
+    DifferentGrid {
+        /// The folder's grid file.
+        path: PathBuf,
+    },
     /// A value out of its domain.
     #[error("{what} must be {expected}, got {value}")]
     InvalidValue {

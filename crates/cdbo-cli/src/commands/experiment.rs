@@ -12,6 +12,7 @@ use rayon::prelude::*;
 use super::{CliResult, from_flag, load_track};
 use cdbo::car::catalog as cars;
 use cdbo::data_path::DataPath;
+use cdbo::experiment::folder::{self, Session};
 use cdbo::experiment::grid::{ExperimentConfig, PRESETS, Shard};
 use cdbo::experiment::record::{RunRecord, run};
 use cdbo::track::Track;
@@ -72,22 +73,10 @@ pub fn run_grid(args: &ExperimentArgs, data: &DataPath) -> CliResult {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("runs").join(format!("experiment-{name}")));
-    std::fs::create_dir_all(&out).map_err(|e| format!("{}: {e}", out.display()))?;
-    let grid_file = out.join("experiment.toml");
-    let grid_text = toml::to_string(&config)?;
-    match std::fs::read_to_string(&grid_file) {
-        Ok(old)
-            if ExperimentConfig::from_toml(&old, &grid_file.display().to_string())? != config =>
-        {
-            return Err(format!(
-                "{}: this folder holds a different grid; choose another --out",
-                grid_file.display()
-            )
-            .into());
-        }
-        Ok(_) => {}
-        Err(_) => std::fs::write(&grid_file, grid_text)?,
-    }
+    folder::claim(&out, &config).map_err(|e| match e {
+        cdbo::Error::DifferentGrid { .. } => format!("{e}; choose another --out"),
+        e => e.to_string(),
+    })?;
     let largest = config.tracks.iter().flat_map(|t| t.kernels.iter()).max();
     if let Some(w) = largest.and_then(|&k| cdbo::sizes::slow_race_warning(k, config.laps)) {
         eprintln!("warning: {name}: each of its largest runs: {w}");
@@ -168,18 +157,14 @@ pub fn run_grid(args: &ExperimentArgs, data: &DataPath) -> CliResult {
     bar.finish_and_clear();
     let wall_s = start.elapsed().as_secs_f64();
     // One line per invocation, so that the report can say how long the grid took.
-    let session = serde_json::json!({
-        "runs": runs.len(),
-        "skipped": skipped,
-        "jobs": jobs,
-        "shard": args.shard,
-        "wall_s": wall_s,
-    });
-    let mut log = std::fs::OpenOptions::new()
-        .create(true)
-        .append(true)
-        .open(out.join("sessions.jsonl"))?;
-    std::io::Write::write_all(&mut log, format!("{session}\n").as_bytes())?;
+    let session = Session {
+        runs: runs.len(),
+        skipped,
+        jobs,
+        shard: args.shard.clone(),
+        wall_s,
+    };
+    session.append(&out)?;
     println!(
         "{} runs done in {wall_s:.1} s; figures and tables: cdbo report {}",
         runs.len(),

@@ -117,7 +117,7 @@ pub fn run(args: &LapArgs, data: &DataPath, simulator: Simulator) -> CliResult {
         write_trace(path, &lap.trace)?;
     }
     if let Some(path) = &args.plot {
-        super::plot::lap_speed(path, &sim.track, &lap, &limit)?;
+        crate::figures::lap_speed(path, &sim.track, &lap, &limit)?;
     }
     sim.config.trace = false;
     let (_, ceiling_mps) = cdbo::ceiling::tracked_profile(&sim, &limit)?;

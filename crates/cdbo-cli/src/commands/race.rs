@@ -275,7 +275,7 @@ fn write_plots(
     o: &RaceOutcome,
     drive: &dyn Fn(&RkhsPolicy) -> Result<cdbo::sim::LapResult, cdbo::Error>,
 ) -> CliResult {
-    use super::plot::{LineChart, draw, speed_chart, speed_map};
+    use crate::figures::{LineChart, draw, speed_chart, speed_map};
     use plotters::style::{BLACK, BLUE, GREEN, RED};
     let initial_lap = drive(&o.initial)?;
     let best_lap = drive(&o.best)?;

@@ -9,13 +9,14 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use plotters::style::{BLACK, BLUE, CYAN, GREEN, MAGENTA, RED, RGBColor};
 
-use super::plot::{LineChart, Panels, draw, speed_chart};
 use super::{CliResult, load_track};
+use crate::figures::{LineChart, Panels, draw, speed_chart};
 use cdbo::car::catalog as cars;
 use cdbo::data_path::DataPath;
+use cdbo::experiment::folder::Session;
 use cdbo::experiment::race::demonstrate;
 use cdbo::experiment::record::RunRecord;
-use cdbo::experiment::summary::{Curve, claims, curves, times};
+use cdbo::experiment::summary::{Curve, cell_means, claims, curves, times};
 use cdbo::policy::RkhsPolicy;
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 
@@ -112,7 +113,7 @@ pub fn run(args: &ReportArgs, data: &DataPath) -> CliResult {
     }
     let table = table1(&records);
     std::fs::write(out.join("table1.md"), &table)?;
-    let sessions = sessions(&args.dirs);
+    let sessions = Session::load_all(&args.dirs)?;
     let results = results_md(&records, &curves, &figures, &table, &sessions);
     std::fs::write(out.join("results.md"), results)?;
     println!(
@@ -318,31 +319,12 @@ fn table1(records: &[RunRecord]) -> String {
     s
 }
 
-/// The `cdbo experiment` invocations logged in the folders: (runs, jobs, wall seconds).
-fn sessions(dirs: &[PathBuf]) -> Vec<(u64, u64, f64)> {
-    dirs.iter()
-        .filter_map(|d| std::fs::read_to_string(d.join("sessions.jsonl")).ok())
-        .flat_map(|text| {
-            text.lines()
-                .filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
-                .map(|v| {
-                    (
-                        v["runs"].as_u64().unwrap_or(0),
-                        v["jobs"].as_u64().unwrap_or(0),
-                        v["wall_s"].as_f64().unwrap_or(0.0),
-                    )
-                })
-                .collect::<Vec<_>>()
-        })
-        .collect()
-}
-
 fn results_md(
     records: &[RunRecord],
     curves: &std::collections::BTreeMap<(String, usize, String), Curve>,
     figures: &[(String, String)],
     table: &str,
-    sessions: &[(u64, u64, f64)],
+    sessions: &[Session],
 ) -> String {
     let mut s = String::from("# Results\n\n");
     let wall: f64 = records.iter().map(|r| r.wall_s).sum();
@@ -352,11 +334,13 @@ fn results_md(
         records.len(),
         wall
     );
-    for (runs, jobs, t) in sessions.iter().filter(|s| s.0 > 0) {
+    for session in sessions.iter().filter(|s| s.runs > 0) {
         let _ = writeln!(
             s,
-            "`cdbo experiment` ran {runs} of them in {:.1} min of wall clock with {jobs} parallel jobs.",
-            t / 60.0
+            "`cdbo experiment` ran {} of them in {:.1} min of wall clock with {} parallel jobs.",
+            session.runs,
+            session.wall_s / 60.0,
+            session.jobs
         );
     }
     s += "\n";
@@ -370,13 +354,11 @@ fn results_md(
         let _ = writeln!(s, "- {}: {verdict}. {}", c.statement, c.evidence);
     }
     s += "\n## Final best reward (m/s), mean ± standard error\n\n| track | kernels | method | runs | best | × demonstration | % of limit |\n|---|---:|---|---:|---:|---:|---:|\n";
-    for ((t, m, method), curve) in curves {
-        let runs: Vec<&RunRecord> = records
-            .iter()
-            .filter(|r| &r.spec.track == t && r.spec.kernels == *m && &r.spec.method == method)
-            .collect();
-        let demo = runs.iter().map(|r| r.demo_reward_mps).sum::<f64>() / runs.len() as f64;
-        let limit = runs.iter().map(|r| r.limit_reward_mps).sum::<f64>() / runs.len() as f64;
+    let demos = cell_means(records, |r| r.demo_reward_mps);
+    let limits = cell_means(records, |r| r.limit_reward_mps);
+    for (cell, curve) in curves {
+        let (t, m, method) = cell;
+        let (demo, limit) = (demos[cell], limits[cell]);
         let (mean, se) = curve.last();
         let _ = writeln!(
             s,

@@ -374,7 +374,7 @@ fn history_csv(h: &[Trial]) -> String {
 }
 
 fn export(s: &Study, out: &Path) -> CliResult {
-    use super::plot::{LineChart, draw};
+    use crate::figures::{LineChart, draw};
     std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
     let h = s.history()?;
     std::fs::write(out.join("history.csv"), history_csv(&h))?;

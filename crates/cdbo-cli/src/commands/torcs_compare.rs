@@ -256,7 +256,7 @@ fn compare_track(
     sim.config.trace = true;
     let ours_best = sim.lap(&mut best.pedal());
     let theirs_best = in_game(GamePedal::Rkhs(best.clone()), true)?;
-    let chart = super::plot::speed_chart(
+    let chart = crate::figures::speed_chart(
         &track,
         &[
             ("cdbo's simulator", BLUE, &ours_best),
@@ -265,7 +265,7 @@ fn compare_track(
         &learned.limit,
     );
     for ext in ["png", "svg"] {
-        super::plot::draw(&args.out.join(format!("speed_{name}.{ext}")), &chart)?;
+        crate::figures::draw(&args.out.join(format!("speed_{name}.{ext}")), &chart)?;
     }
     let robot = game.robot_laps(&args.robot, name, &args.car);
     if let Err(e) = &robot {

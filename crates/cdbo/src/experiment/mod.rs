@@ -1,7 +1,9 @@
 //! Experiments that join the simulator, the policy and the optimisers: [`race`] learns to race
 //! one track with one method; [`grid`] lists the runs of the paper's experiment, [`record`]
-//! runs and saves one, and [`summary`] aggregates them into the paper's figures and claims.
+//! runs and saves one, [`folder`] keeps a grid's folder (its grid and sessions), and
+//! [`summary`] aggregates the runs into the paper's figures and claims.
 
+pub mod folder;
 pub mod grid;
 pub mod race;
 pub mod record;

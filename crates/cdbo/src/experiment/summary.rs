@@ -75,17 +75,28 @@ pub fn curves(records: &[RunRecord]) -> BTreeMap<Cell, Curve> {
         .collect()
 }
 
+/// The mean of `value` over some runs, summed in their order.
+fn average(runs: &[&RunRecord], value: impl Fn(&RunRecord) -> f64) -> f64 {
+    runs.iter().map(|r| value(r)).sum::<f64>() / runs.len() as f64
+}
+
+/// The mean of `value` over each cell's runs (a cell's demonstration or limit reward, ...).
+pub fn cell_means(records: &[RunRecord], value: impl Fn(&RunRecord) -> f64) -> BTreeMap<Cell, f64> {
+    cells(records)
+        .into_iter()
+        .map(|(cell, runs)| (cell, average(&runs, &value)))
+        .collect()
+}
+
 /// Average seconds per run of a cell: (wall, optimiser, simulator, runs).
 pub fn times(records: &[RunRecord]) -> BTreeMap<Cell, (f64, f64, f64, usize)> {
     cells(records)
         .into_iter()
         .map(|(cell, runs)| {
-            let n = runs.len() as f64;
-            let avg = |f: &dyn Fn(&RunRecord) -> f64| runs.iter().map(|r| f(r)).sum::<f64>() / n;
             let t = (
-                avg(&|r| r.wall_s),
-                avg(&|r| r.optimizer_s()),
-                avg(&|r| r.simulator_s()),
+                average(&runs, |r| r.wall_s),
+                average(&runs, RunRecord::optimizer_s),
+                average(&runs, RunRecord::simulator_s),
                 runs.len(),
             );
             (cell, t)
