@@ -2,25 +2,10 @@
 //! the grid and merge, resuming by skipping finished runs, and clear errors.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn cdbo(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_cdbo"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("runs")
-}
+mod common;
 
-fn ok(dir: &Path, args: &[&str]) -> String {
-    let out = cdbo(dir, args);
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).unwrap()
-}
+use common::{cdbo, fresh_dir, ok};
 
 const GRID: &str = r#"
 laps = 8
@@ -33,9 +18,7 @@ kernels = [6]
 "#;
 
 fn setup(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("cdbo-exp-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = fresh_dir(name);
     std::fs::write(dir.join("grid.toml"), GRID).unwrap();
     dir
 }

@@ -3,26 +3,13 @@
 //! workers on one study, cut run records. Each case gives one clear error line (exit 2) or the
 //! documented behaviour, and never a panic (exit 101).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-const CDBO: &str = env!("CARGO_BIN_EXE_cdbo");
+mod common;
 
-fn cdbo(dir: &Path, args: &[&str]) -> Output {
-    Command::new(CDBO)
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("runs")
-}
-
-fn fresh_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("cdbo-rel-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use common::{CDBO, cdbo, demo, fresh_dir, history, ok};
 
 /// Expects exit status 2 and exactly one line on stderr, `error: …` containing every needle.
 fn refused(dir: &Path, args: &[&str], needles: &[&str]) {
@@ -230,24 +217,6 @@ fn a_legal_but_slow_race_says_so_first() {
     );
 }
 
-fn ok(dir: &Path, args: &[&str]) -> String {
-    let out = cdbo(dir, args);
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).unwrap()
-}
-
-/// A demonstration recorded on the built-in track.
-fn demo(dir: &Path) {
-    ok(
-        dir,
-        &["lap", "--demo", "15", "--trace", "demo.csv", "--json"],
-    );
-}
-
 /// `cdbo optimize` on study `db` to `laps` told trials, every lap driven appended to
 /// `driven.log`.
 fn optimize(db: &str, laps: &str) -> Command {
@@ -270,11 +239,6 @@ fn optimize(db: &str, laps: &str) -> Command {
         "2",
     ]);
     c
-}
-
-fn history(dir: &Path, db: &str) -> Vec<serde_json::Value> {
-    let text = ok(dir, &["study", "history", "s", "--db", db, "--json"]);
-    serde_json::from_str(&text).unwrap()
 }
 
 /// Every trial told once, with weights of its own.

@@ -2,29 +2,13 @@
 //! safety under SIGKILL, and the simulator as a JSON-lines service.
 
 use std::io::{BufRead, BufReader, Write};
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::path::Path;
+use std::process::{Command, Stdio};
 use std::time::Duration;
 
-const CDBO: &str = env!("CARGO_BIN_EXE_cdbo");
+mod common;
 
-fn cdbo(dir: &Path, args: &[&str]) -> Output {
-    Command::new(CDBO)
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("runs")
-}
-
-fn ok(dir: &Path, args: &[&str]) -> String {
-    let out = cdbo(dir, args);
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).unwrap()
-}
+use common::{CDBO, cdbo, demo, fresh_dir, history, ok};
 
 /// Expects failure with one clear error line containing `needle`.
 fn fails(dir: &Path, args: &[&str], needle: &str) {
@@ -35,26 +19,6 @@ fn fails(dir: &Path, args: &[&str], needle: &str) {
     let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("error:")).collect();
     assert_eq!(lines.len(), 1, "{err}");
     assert!(lines[0].contains(needle), "{:?} lacks {needle:?}", lines[0]);
-}
-
-fn fresh_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("cdbo-study-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-/// A demonstration recorded on the built-in track.
-fn demo(dir: &Path) {
-    ok(
-        dir,
-        &["lap", "--demo", "15", "--trace", "demo.csv", "--json"],
-    );
-}
-
-fn history(dir: &Path, db: &str) -> Vec<serde_json::Value> {
-    let text = ok(dir, &["study", "history", "s", "--db", db, "--json"]);
-    serde_json::from_str::<Vec<serde_json::Value>>(&text).unwrap()
 }
 
 const EVALUATOR: &str = "{cdbo} lap --policy {policy} --json";

@@ -23,70 +23,70 @@ pub struct Size {
 }
 
 /// Policy kernels M (and the dimension of every optimiser's search).
-pub const KERNELS: Size = Size {
-    name: "kernels",
-    min: 2,
-    max: 1000,
-    why: "one kernel per 50 Hz driver step of a one-minute lap; the paper uses 10 to 100",
-};
+pub const KERNELS: Size = Size::new(
+    "kernels",
+    2,
+    1000,
+    "one kernel per 50 Hz driver step of a one-minute lap; the paper uses 10 to 100",
+);
 
 /// Laps of a race or a study (GP observations).
-pub const LAPS: Size = Size {
-    name: "laps",
-    min: 1,
-    max: 10_000,
-    why: "a GP over 10,000 laps holds an 800 MB covariance and refits in O(n³)",
-};
+pub const LAPS: Size = Size::new(
+    "laps",
+    1,
+    10_000,
+    "a GP over 10,000 laps holds an 800 MB covariance and refits in O(n³)",
+);
 
 /// Points of a policy table.
-pub const POINTS: Size = Size {
-    name: "points",
-    min: 2,
-    max: 1_000_000,
-    why: "a table finer than a millionth of the lap adds nothing",
-};
+pub const POINTS: Size = Size::new(
+    "points",
+    2,
+    1_000_000,
+    "a table finer than a millionth of the lap adds nothing",
+);
 
 /// Parallel jobs.
-pub const JOBS: Size = Size {
-    name: "jobs",
-    min: 1,
-    max: 1024,
-    why: "one thread per run; more threads than that only share the same cores",
-};
+pub const JOBS: Size = Size::new(
+    "jobs",
+    1,
+    1024,
+    "one thread per run; more threads than that only share the same cores",
+);
 
-/// Dimensions of a benchmark problem.
-pub const DIMS: Size = Size {
-    name: "dims",
-    min: 1,
-    max: 1000,
-    why: "the same bound as --kernels",
-};
+/// Dimensions of a benchmark problem: the bounds of [`KERNELS`].
+pub const DIMS: Size = KERNELS.alias("dims", "the same bound as --kernels");
 
-/// Evaluations of a benchmark run.
-pub const EVALUATIONS: Size = Size {
-    name: "evals",
-    min: 1,
-    max: 10_000,
-    why: "the same bound as --laps",
-};
+/// Evaluations of a benchmark run: the bounds of [`LAPS`].
+pub const EVALUATIONS: Size = LAPS.alias("evals", "the same bound as --laps");
 
-/// Observations of a GP benchmark.
-pub const OBSERVATIONS: Size = Size {
-    name: "observations",
-    min: 1,
-    max: 10_000,
-    why: "the same bound as --laps",
-};
+/// Observations of a GP benchmark: the bounds of [`LAPS`].
+pub const OBSERVATIONS: Size = LAPS.alias("observations", "the same bound as --laps");
 
 /// Repeats (runs per cell, seeds, timed suggestions, scan points).
-pub const REPEATS: Size = Size {
-    name: "repeats",
-    min: 1,
-    max: 10_000,
-    why: "beyond that a repeat adds no precision worth its time",
-};
+pub const REPEATS: Size = Size::new(
+    "repeats",
+    1,
+    10_000,
+    "beyond that a repeat adds no precision worth its time",
+);
 
 impl Size {
+    /// A size counting `name`, legal from `min` to `max` because of `why`.
+    pub const fn new(name: &'static str, min: usize, max: usize, why: &'static str) -> Size {
+        Size {
+            name,
+            min,
+            max,
+            why,
+        }
+    }
+
+    /// Another size with the same bounds, counting `name`.
+    const fn alias(self, name: &'static str, why: &'static str) -> Size {
+        Size { name, why, ..self }
+    }
+
     /// `value` if it is within the bounds, else the bound it breaks (the caller names the
     /// flag and the value: clap does, and so does [`Size::checked`]).
     pub fn check(&self, value: usize) -> std::result::Result<usize, String> {

@@ -21,7 +21,7 @@ use faer::{Mat, Side};
 use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
 
-use super::{Best, Optimizer, SearchBox, check_tell, rng_for};
+use super::{Best, Optimizer, SearchBox, check_tell, check_tell_lap, rng_for};
 use crate::error::{Error, Result};
 
 /// Settings of a CMA-ES run.
@@ -487,18 +487,8 @@ impl Optimizer for Cmaes {
     /// f = −reward < 0): when a whole generation fails, a fitness of zeros everywhere steers
     /// nothing, while the failure places still point the mean towards laps that got further.
     fn tell_lap(&mut self, weights: &[f64], reward: f64, failed_at: Option<f64>) -> Result<()> {
-        check_tell(self.dim(), weights, reward)?;
-        let fitness = match failed_at {
-            Some(x) if !(x.is_finite() && (0.0..=1.0).contains(&x)) => {
-                return Err(Error::invalid_value(
-                    "the failure place",
-                    x,
-                    "a lap fraction in [0, 1]",
-                ));
-            }
-            Some(x) => 1.0 - x,
-            None => -reward,
-        };
+        check_tell_lap(self.dim(), weights, reward, failed_at)?;
+        let fitness = failed_at.map_or(-reward, |x| 1.0 - x);
         self.tell_ranked(weights, reward, fitness)
     }
 

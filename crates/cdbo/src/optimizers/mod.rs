@@ -311,6 +311,24 @@ pub(crate) fn check_tell(dim: usize, weights: &[f64], reward: f64) -> Result<()>
     Ok(())
 }
 
+/// [`check_tell`] with the place a failed lap failed at, a lap fraction in [0, 1] when known.
+pub(crate) fn check_tell_lap(
+    dim: usize,
+    weights: &[f64],
+    reward: f64,
+    failed_at: Option<f64>,
+) -> Result<()> {
+    check_tell(dim, weights, reward)?;
+    match failed_at {
+        Some(x) if !(x.is_finite() && (0.0..=1.0).contains(&x)) => Err(Error::invalid_value(
+            "the failure place",
+            x,
+            "a lap fraction in [0, 1]",
+        )),
+        _ => Ok(()),
+    }
+}
+
 /// A generator for draw number `stream` of a run seeded with `seed`: every random choice is a
 /// pure function of (seed, stream), so a resumed run makes the same choices.
 pub fn rng_for(seed: u64, stream: u64) -> rand_chacha::ChaCha8Rng {

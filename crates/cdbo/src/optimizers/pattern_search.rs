@@ -24,7 +24,7 @@
 use rand::seq::SliceRandom;
 use serde::{Deserialize, Serialize};
 
-use super::{Best, Optimizer, SearchBox, check_tell, rng_for};
+use super::{Best, Optimizer, SearchBox, check_tell_lap, rng_for};
 use crate::error::{Error, Result};
 
 /// Settings of a pattern search.
@@ -264,14 +264,7 @@ impl Optimizer for PatternSearch {
     }
 
     fn tell_lap(&mut self, weights: &[f64], reward: f64, failed_at: Option<f64>) -> Result<()> {
-        check_tell(self.dim(), weights, reward)?;
-        if let Some(at) = failed_at.filter(|x| !(x.is_finite() && (0.0..=1.0).contains(x))) {
-            return Err(Error::invalid_value(
-                "the failure place",
-                at,
-                "a lap fraction in [0, 1]",
-            ));
-        }
+        check_tell_lap(self.dim(), weights, reward, failed_at)?;
         self.state.evaluations += 1;
         let better = self.state.best.offer(weights, reward);
         let repair = self.state.config.repair;

@@ -1,0 +1,55 @@
+//! Helpers shared by the command-line tests: the binary run in a folder, fresh folders, a
+//! recorded demonstration, a study's history.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// The `cdbo` binary under test.
+pub const CDBO: &str = env!("CARGO_BIN_EXE_cdbo");
+
+/// Runs `cdbo ARGS` in `dir`.
+pub fn cdbo(dir: &Path, args: &[&str]) -> Output {
+    Command::new(CDBO)
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("runs")
+}
+
+/// Runs `cdbo ARGS` in `dir`, expects success and returns its standard output.
+pub fn ok(dir: &Path, args: &[&str]) -> String {
+    let out = cdbo(dir, args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+/// An empty scratch folder of its own for test `name` of this test file.
+pub fn fresh_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!(
+        "cdbo-{}-{}-{name}",
+        env!("CARGO_CRATE_NAME"),
+        std::process::id()
+    ));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// A demonstration recorded on the built-in track, `demo.csv` in `dir`.
+pub fn demo(dir: &Path) {
+    ok(
+        dir,
+        &["lap", "--demo", "15", "--trace", "demo.csv", "--json"],
+    );
+}
+
+/// The told trials of study `s` in `db`, as `cdbo study history --json` lists them.
+pub fn history(dir: &Path, db: &str) -> Vec<serde_json::Value> {
+    let text = ok(dir, &["study", "history", "s", "--db", db, "--json"]);
+    serde_json::from_str(&text).unwrap()
+}
