@@ -6,6 +6,7 @@ mod shared;
 use cdbo::data_path::DataPath;
 use cdbo::track::Track;
 
+#[allow(unused_imports)] // each test file uses some of them
 pub use shared::{shared, shared_if_present};
 
 /// A track from ../shared, found by name.
