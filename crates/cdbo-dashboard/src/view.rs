@@ -124,8 +124,8 @@ pub fn study(config: &StudyConfig, trials: &[Trial]) -> Result<View> {
         })
         .collect();
     let curves = vec![CurveView {
-        label: config.method.clone(),
-        method: config.method.clone(),
+        label: config.method.to_string(),
+        method: config.method.to_string(),
         runs: 1,
         lo: best_so_far.clone(),
         hi: best_so_far.clone(),

@@ -54,7 +54,7 @@ const LENGTHSCALE: f64 = 0.25;
 
 fn study_config() -> StudyConfig {
     StudyConfig {
-        method: "random".into(),
+        method: cdbo::optimizers::Method::Random,
         kernels: KERNELS,
         lengthscale: LENGTHSCALE,
         seed: 3,

@@ -105,7 +105,7 @@ pub fn race(
     let track = track_from(py, track, data_dir)?;
     let car = car_from(car, data_dir)?;
     let config = RaceConfig {
-        method: method.to_owned(),
+        method: method.parse::<cdbo::optimizers::Method>().py()?,
         kernels,
         laps,
         seed,

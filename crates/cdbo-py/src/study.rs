@@ -89,7 +89,7 @@ impl PyStudy {
     ) -> PyResult<Self> {
         let w0 = vector(w0, "w0")?;
         let config = StudyConfig {
-            method: method.to_owned(),
+            method: method.parse::<cdbo::optimizers::Method>().py()?,
             kernels: w0.len(),
             lengthscale: lengthscale.unwrap_or_else(|| default_lengthscale(w0.len())),
             seed,
@@ -175,7 +175,7 @@ impl PyStudy {
     fn config<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let c = lock(&self.study)?.config().clone();
         let d = PyDict::new(py);
-        d.set_item("method", c.method)?;
+        d.set_item("method", c.method.name())?;
         d.set_item("kernels", c.kernels)?;
         d.set_item("lengthscale", c.lengthscale)?;
         d.set_item("seed", c.seed)?;

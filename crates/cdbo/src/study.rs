@@ -28,7 +28,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 pub use crate::evaluator::Outcome;
-use crate::optimizers::{Optimizer, Saved, Settings, by_name};
+use crate::optimizers::{Method, Optimizer, Saved, Settings};
 use claim::{Handout, Worker};
 pub use sqlite::BUSY_TIMEOUT;
 pub use storage::Location;
@@ -54,7 +54,7 @@ pub enum Next {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct StudyConfig {
     /// Optimiser (`cdbo` by default).
-    pub method: String,
+    pub method: Method,
     /// Policy kernels M.
     pub kernels: usize,
     /// Policy kernel length-scale.
@@ -111,11 +111,9 @@ impl Study {
             ));
         }
         // Fails on a bad method or w₀ before anything is written.
-        let optimizer = by_name(
-            &config.method,
-            config.w0.clone(),
-            &Settings::race(config.seed, config.beta),
-        )?;
+        let optimizer = config
+            .method
+            .optimizer(config.w0.clone(), &Settings::race(config.seed, config.beta))?;
         let dump = Dump {
             config: serde_json::to_string(&config).map_err(|e| Error::json("study settings", e))?,
             optimizer: serde_json::to_string(&optimizer.save())
@@ -500,7 +498,7 @@ mod tests {
 
     pub(crate) fn config() -> StudyConfig {
         StudyConfig {
-            method: "cdbo".into(),
+            method: Method::Cdbo,
             kernels: 3,
             lengthscale: 0.5,
             seed: 1,

@@ -2,7 +2,7 @@
 //! results of the papers that introduced the peers (TuRBO, LineBO, REMBO).
 
 use cdbo::benchmarks::Problem;
-use cdbo::optimizers::{METHODS, Optimizer, Saved, Settings, by_name};
+use cdbo::optimizers::{Method, Optimizer, Saved, Settings, by_name};
 
 fn optimiser(method: &str, problem: &Problem, seed: u64) -> Box<dyn Optimizer + Send> {
     by_name(
@@ -44,7 +44,7 @@ fn drive(opt: &mut dyn Optimizer, problem: &Problem, evals: usize) -> Vec<Vec<f6
 #[test]
 fn every_method_is_deterministic_and_resumes_exactly() {
     let problem = Problem::by_name("ackley", 6).unwrap();
-    for &method in METHODS {
+    for method in Method::ALL.map(Method::name) {
         let mut a = optimiser(method, &problem, 11);
         let mut b = optimiser(method, &problem, 11);
         let first = drive(a.as_mut(), &problem, 23);
@@ -129,7 +129,7 @@ fn cdbo_keeps_its_initial_design_while_every_lap_fails() {
 #[test]
 fn every_method_refuses_bad_tells_and_keeps_its_state() {
     let problem = Problem::by_name("ackley", 4).unwrap();
-    for &method in METHODS {
+    for method in Method::ALL.map(Method::name) {
         let mut opt = optimiser(method, &problem, 3);
         drive(opt.as_mut(), &problem, 5);
         let before = serde_json::to_string(&opt.save()).unwrap();

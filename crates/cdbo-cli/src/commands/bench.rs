@@ -6,6 +6,7 @@ use serde::Serialize;
 use super::{CliResult, Setup, print_json};
 use cdbo::data_path::DataPath;
 use cdbo::drive::demo::{DEFAULT_TARGET_SPEED, SpeedHold};
+use cdbo::optimizers::Method;
 use cdbo::sim::Simulator;
 
 #[derive(Debug, Subcommand)]
@@ -34,8 +35,8 @@ pub struct OptimizersArgs {
     #[arg(long, default_value_t = 10, value_parser = super::value::seeds)]
     seeds: u64,
     /// Methods, comma-separated.
-    #[arg(long, value_delimiter = ',', default_values_t = cdbo::optimizers::METHODS.iter().map(|m| m.to_string()).collect::<Vec<_>>())]
-    methods: Vec<String>,
+    #[arg(long, value_delimiter = ',', default_values_t = Method::ALL)]
+    methods: Vec<Method>,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -43,7 +44,7 @@ pub struct OptimizersArgs {
 
 #[derive(Debug, Serialize)]
 struct MethodResult {
-    method: String,
+    method: Method,
     mean_best: f64,
     stderr_best: f64,
     mean_seconds: f64,
@@ -139,7 +140,7 @@ fn optimizers(args: &OptimizersArgs) -> CliResult {
         let (mut bests, mut seconds) = (Vec::new(), 0.0);
         for seed in 0..args.seeds {
             let settings = cdbo::optimizers::Settings::problem(seed, problem.radius);
-            let mut opt = cdbo::optimizers::by_name(method, problem.start.clone(), &settings)?;
+            let mut opt = method.optimizer(problem.start.clone(), &settings)?;
             let start = std::time::Instant::now();
             for _ in 0..args.evals {
                 let w = opt.ask()?;
@@ -152,7 +153,7 @@ fn optimizers(args: &OptimizersArgs) -> CliResult {
         let mean = bests.iter().sum::<f64>() / k;
         let var = bests.iter().map(|b| (b - mean).powi(2)).sum::<f64>() / (k - 1.0).max(1.0);
         results.push(MethodResult {
-            method: method.clone(),
+            method: *method,
             mean_best: mean,
             stderr_best: (var / k).sqrt(),
             mean_seconds: seconds / k,

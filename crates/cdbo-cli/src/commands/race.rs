@@ -10,6 +10,7 @@ use serde::Serialize;
 use super::{CliResult, Setup, Simulator, from_flag, print_json};
 use cdbo::data_path::DataPath;
 use cdbo::experiment::race::{RaceConfig, RaceOutcome, race};
+use cdbo::optimizers::Method;
 use cdbo::policy::RkhsPolicy;
 
 #[derive(Debug, Args)]
@@ -19,10 +20,9 @@ pub struct RaceArgs {
     /// Policy kernels M (the paper: 10 to 100).
     #[arg(long, default_value_t = 30, value_parser = super::value::kernels)]
     kernels: usize,
-    /// Optimiser: cdbo, cmaes, bo-cmaes, rembo-5d, rembo-10d, turbo, linebo, random,
-    /// pattern-search.
-    #[arg(long, default_value = "cdbo")]
-    method: String,
+    /// Optimiser.
+    #[arg(long, default_value_t = Method::Cdbo)]
+    method: Method,
     /// Laps (the paper: 300).
     #[arg(long, default_value_t = 300, value_parser = super::value::laps)]
     laps: usize,
@@ -49,7 +49,7 @@ pub struct RaceArgs {
 
 #[derive(Debug, Serialize)]
 struct Summary {
-    method: String,
+    method: Method,
     track: String,
     kernels: usize,
     laps: usize,
@@ -105,7 +105,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     });
     std::fs::create_dir_all(&out).map_err(|e| format!("{}: {e}", out.display()))?;
     let config = RaceConfig {
-        method: args.method.clone(),
+        method: args.method,
         kernels: args.kernels,
         laps: args.laps,
         seed: args.seed,
@@ -166,7 +166,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         .filter(|l| l.reward_mps == outcome.best_reward_mps)
         .find_map(|l| l.lap_time_s);
     let summary = Summary {
-        method: args.method.clone(),
+        method: args.method,
         track: track_name,
         kernels: args.kernels,
         laps: args.laps,

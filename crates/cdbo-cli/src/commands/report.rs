@@ -7,7 +7,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use plotters::style::{BLACK, BLUE, CYAN, GREEN, MAGENTA, RED, RGBColor};
+use plotters::style::{BLACK, BLUE, GREEN, RED, RGBColor};
 
 use super::{CliResult, load_track};
 use crate::figures::{LineChart, Panels, draw, speed_chart};
@@ -17,6 +17,7 @@ use cdbo::experiment::folder::Session;
 use cdbo::experiment::race::demonstrate;
 use cdbo::experiment::record::RunRecord;
 use cdbo::experiment::summary::{Curve, cell_means, claims, curves, times};
+use cdbo::optimizers::Method;
 use cdbo::policy::RkhsPolicy;
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 
@@ -33,18 +34,13 @@ pub struct ReportArgs {
     car: String,
 }
 
-/// A fixed colour per method, so that figures agree.
+/// The method's colour ([`Method::colour`]), the same in every figure; black for a name
+/// this version does not know.
 fn colour(method: &str) -> RGBColor {
-    match method {
-        "cdbo" => BLUE,
-        "cmaes" => RED,
-        "bo-cmaes" => GREEN,
-        "rembo-5d" => MAGENTA,
-        "rembo-10d" => RGBColor(150, 80, 0),
-        "turbo" => CYAN,
-        "linebo" => RGBColor(120, 120, 120),
-        _ => BLACK,
-    }
+    method.parse::<Method>().map_or(BLACK, |m| {
+        let (r, g, b) = m.colour();
+        RGBColor(r, g, b)
+    })
 }
 
 /// Figure name of a track's learning curves: the paper's Fig. 4 (Forza) and 5 (Allondaz).
@@ -177,7 +173,7 @@ fn learning_curves(
 fn best_cdbo_run<'a>(records: &'a [RunRecord], track: &str) -> Option<&'a RunRecord> {
     let cdbo: Vec<&RunRecord> = records
         .iter()
-        .filter(|r| r.spec.track == track && r.spec.method == "cdbo")
+        .filter(|r| r.spec.track == track && r.spec.method == Method::Cdbo.name())
         .collect();
     let mut sizes: Vec<usize> = cdbo.iter().map(|r| r.spec.kernels).collect();
     sizes.sort();

@@ -6,6 +6,7 @@ use clap::{Args, Subcommand, ValueEnum};
 
 use super::policy::{read_demo, read_policy};
 use super::{CliResult, from_flag, print_json};
+use cdbo::optimizers::Method;
 use cdbo::policy::RkhsPolicy;
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 use cdbo::study::{Outcome, Study, StudyConfig, Trial};
@@ -51,10 +52,9 @@ pub struct InitialPolicy {
     /// Policy length-scale (default 1/(M − 1)).
     #[arg(long, allow_negative_numbers = true, value_parser = super::value::positive)]
     lengthscale: Option<f64>,
-    /// Optimiser: cdbo (the default), cmaes, bo-cmaes, rembo-5d, rembo-10d, turbo, linebo,
-    /// random, pattern-search.
+    /// Optimiser (default cdbo).
     #[arg(long)]
-    method: Option<String>,
+    method: Option<Method>,
     /// Seed of every random choice (default 0).
     #[arg(long)]
     seed: Option<u64>,
@@ -88,7 +88,7 @@ impl InitialPolicy {
             .into());
         }
         Ok(StudyConfig {
-            method: self.method.clone().unwrap_or_else(|| "cdbo".into()),
+            method: self.method.unwrap_or(Method::Cdbo),
             kernels: self.kernels,
             lengthscale: policy.lengthscale,
             seed: self.seed.unwrap_or(0),
@@ -113,8 +113,8 @@ impl InitialPolicy {
                 stored.kernels.to_string(),
             );
         }
-        if let Some(m) = self.method.as_ref().filter(|m| **m != stored.method) {
-            return differs("--method", m.clone(), stored.method.clone());
+        if let Some(m) = self.method.filter(|m| *m != stored.method) {
+            return differs("--method", m.to_string(), stored.method.to_string());
         }
         if let Some(s) = self.seed.filter(|s| *s != stored.seed) {
             return differs("--seed", s.to_string(), stored.seed.to_string());

@@ -19,6 +19,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::optimizers::Method;
+
 use crate::error::{Error, Result};
 
 /// The policy sizes to race on one track.
@@ -45,14 +47,14 @@ pub struct ExperimentConfig {
     /// UCB β (the paper: within [0.5, 2]).
     #[serde(default = "default_beta")]
     pub beta: f64,
-    /// Optimisers, by their command-line names.
-    pub methods: Vec<String>,
+    /// Optimisers, by their names.
+    pub methods: Vec<Method>,
     /// Tracks and their policy sizes.
     pub tracks: Vec<TrackGrid>,
     /// A method's own σ₀ (its main knob, tuned on training tracks), by method name; the
     /// others get the race default, 0.03 (`[sigma0]` table: `random = 0.01`).
     #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
-    pub sigma0: std::collections::BTreeMap<String, f64>,
+    pub sigma0: std::collections::BTreeMap<Method, f64>,
 }
 
 fn default_demo_speed() -> f64 {
@@ -69,11 +71,11 @@ pub const PRESETS: &[&str] = &["paper", "paper-plus", "quick"];
 /// The main knobs tuned on the training tracks (ridgeway, forza, e-track-2; 30 kernels,
 /// seeds 100–101; docs/results/beyond): random search's σ, CMA-ES's σ₀, the pattern search's
 /// first step. `paper-plus` runs them; `paper` keeps every method at the race default 0.03.
-pub const TUNED_SIGMA0: [(&str, f64); 3] =
-    [("random", 0.01), ("cmaes", 0.01), ("pattern-search", 0.1)];
-
-/// The paper's baselines and CDBO.
-const PAPER_METHODS: [&str; 5] = ["cdbo", "cmaes", "bo-cmaes", "rembo-5d", "rembo-10d"];
+pub const TUNED_SIGMA0: [(Method, f64); 3] = [
+    (Method::Random, 0.01),
+    (Method::Cmaes, 0.01),
+    (Method::PatternSearch, 0.1),
+];
 
 impl ExperimentConfig {
     /// `paper`: Forza with 10/50/100 kernels and Allondaz with 10/30/50; CDBO, CMA-ES,
@@ -92,12 +94,8 @@ impl ExperimentConfig {
                 kernels: vec![10, 30, 50],
             },
         ];
-        let methods = |extra: &[&str]| -> Vec<String> {
-            PAPER_METHODS
-                .iter()
-                .chain(extra)
-                .map(|m| m.to_string())
-                .collect()
+        let methods = |extra: &[Method]| -> Vec<Method> {
+            Method::PAPER.iter().chain(extra).copied().collect()
         };
         Some(match name {
             "paper" => ExperimentConfig {
@@ -110,11 +108,13 @@ impl ExperimentConfig {
                 sigma0: Default::default(),
             },
             "paper-plus" => ExperimentConfig {
-                methods: methods(&["turbo", "linebo", "random", "pattern-search"]),
-                sigma0: TUNED_SIGMA0
-                    .iter()
-                    .map(|&(m, s)| (m.to_string(), s))
-                    .collect(),
+                methods: methods(&[
+                    Method::Turbo,
+                    Method::Linebo,
+                    Method::Random,
+                    Method::PatternSearch,
+                ]),
+                sigma0: TUNED_SIGMA0.into_iter().collect(),
                 ..ExperimentConfig::preset("paper")?
             },
             "quick" => ExperimentConfig {
@@ -122,9 +122,7 @@ impl ExperimentConfig {
                 repeats: 2,
                 demo_speed: default_demo_speed(),
                 beta: default_beta(),
-                methods: ["cdbo", "cmaes", "bo-cmaes", "random"]
-                    .map(String::from)
-                    .to_vec(),
+                methods: vec![Method::Cdbo, Method::Cmaes, Method::BoCmaes, Method::Random],
                 tracks: vec![TrackGrid {
                     track: crate::track::builtin::DEFAULT.into(),
                     kernels: vec![10, 20],
@@ -172,13 +170,6 @@ impl ExperimentConfig {
                 1,
             ));
         }
-        if let Some(m) = self
-            .methods
-            .iter()
-            .find(|m| !crate::optimizers::METHODS.contains(&m.as_str()))
-        {
-            return Err(crate::optimizers::unknown_method(m));
-        }
         for t in &self.tracks {
             if t.kernels.is_empty() {
                 return Err(Error::too_small(
@@ -215,7 +206,7 @@ impl ExperimentConfig {
             .find(|(m, v)| !(self.methods.contains(m) && v.is_finite() && **v > 0.0))
         {
             return Err(Error::invalid_value(
-                format!("sigma0 of {m:?}"),
+                format!("sigma0 of {:?}", m.name()),
                 v,
                 "a positive number, for a method of the grid",
             ));
@@ -243,7 +234,7 @@ impl ExperimentConfig {
                         runs.push(RunSpec {
                             track: t.track.clone(),
                             kernels,
-                            method: method.clone(),
+                            method: method.to_string(),
                             repeat,
                         });
                     }
@@ -334,7 +325,7 @@ mod tests {
         assert_eq!(paper.runs().len(), 6 * 5 * 4);
         let plus = ExperimentConfig::preset("paper-plus").unwrap();
         assert_eq!(plus.runs().len(), 6 * 9 * 4);
-        assert_eq!(plus.sigma0.get("random"), Some(&0.01));
+        assert_eq!(plus.sigma0.get(&Method::Random), Some(&0.01));
         for p in PRESETS {
             ExperimentConfig::preset(p).unwrap().check().unwrap();
         }

@@ -9,6 +9,7 @@ use crate::error::{Error, Result};
 use crate::evaluator::simulator::SimEvaluator;
 use crate::evaluator::{Evaluator, Outcome};
 use crate::limit::{Limit, limit_lap};
+use crate::optimizers::Method;
 use crate::policy::RkhsPolicy;
 use crate::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 use crate::sim::{FailureReason, LapResult, Simulator};
@@ -18,8 +19,8 @@ use crate::track::Track;
 /// Settings of a race.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RaceConfig {
-    /// Optimiser name (`cdbo`).
-    pub method: String,
+    /// Optimiser.
+    pub method: Method,
     /// Policy kernels M.
     pub kernels: usize,
     /// Laps (evaluations), the demonstration's fitted policy included.
@@ -41,7 +42,7 @@ pub struct RaceConfig {
 impl Default for RaceConfig {
     fn default() -> Self {
         RaceConfig {
-            method: "cdbo".into(),
+            method: Method::Cdbo,
             kernels: 30,
             laps: 300,
             seed: 0,
@@ -160,7 +161,9 @@ pub fn race_with(
         }
         settings.sigma0 = sigma0;
     }
-    let optimizer = crate::optimizers::by_name(&config.method, initial.weights.clone(), &settings)?;
+    let optimizer = config
+        .method
+        .optimizer(initial.weights.clone(), &settings)?;
     let mut laps = Vec::with_capacity(config.laps);
     let mut best = (initial.weights.clone(), 0.0);
     let mut source = InMemory::new(optimizer, config.laps);

@@ -124,14 +124,15 @@ pub fn run(
     progress: impl FnMut(&LapRecord),
 ) -> Result<RunRecord> {
     let start = std::time::Instant::now();
+    let method: crate::optimizers::Method = spec.method.parse()?;
     let config = RaceConfig {
-        method: spec.method.clone(),
+        method,
         kernels: spec.kernels,
         laps: grid.laps,
         seed: spec.seed(),
         beta: grid.beta,
         demo_speed: grid.demo_speed,
-        sigma0: grid.sigma0.get(&spec.method).copied(),
+        sigma0: grid.sigma0.get(&method).copied(),
     };
     let (track_name, length_m) = (track.name.clone(), track.length);
     let outcome = race(track, car, &config, progress)?;

@@ -2,6 +2,7 @@
 //! the best reward after each lap, paper Fig. 4–5), run times (Table 1) and the paper's claims
 //! checked against the numbers.
 
+use crate::optimizers::Method;
 use std::collections::BTreeMap;
 
 use super::record::RunRecord;
@@ -141,12 +142,12 @@ pub fn claims(records: &[RunRecord]) -> Vec<Claim> {
     // Stability of CDBO and degradation of CMA-ES across policy sizes, per track.
     for (method, statement, holds_if) in [
         (
-            "cdbo",
+            Method::Cdbo.name(),
             "CDBO stays stable as the dimension grows (best reward at the largest policy ≥ 90 % of that at the smallest)",
             (|small: f64, large: f64| large >= 0.9 * small) as fn(f64, f64) -> bool,
         ),
         (
-            "cmaes",
+            Method::Cmaes.name(),
             "CMA-ES degrades as the dimension grows (best reward lower at the largest policy than at the smallest)",
             |small: f64, large: f64| large < small,
         ),
@@ -176,10 +177,10 @@ pub fn claims(records: &[RunRecord]) -> Vec<Claim> {
     // BO-CMA-ES's optimiser time against CDBO's at the largest policy.
     let mut ratios = Vec::new();
     for t in &tracks {
-        if let Some(&m) = sizes(t, "bo-cmaes").last()
+        if let Some(&m) = sizes(t, Method::BoCmaes.name()).last()
             && let (Some(b), Some(c)) = (
-                times.get(&(t.clone(), m, "bo-cmaes".into())),
-                times.get(&(t.clone(), m, "cdbo".into())),
+                times.get(&(t.clone(), m, Method::BoCmaes.to_string())),
+                times.get(&(t.clone(), m, Method::Cdbo.to_string())),
             )
         {
             ratios.push((t.clone(), m, b.1, c.1));
@@ -236,17 +237,20 @@ pub fn claims(records: &[RunRecord]) -> Vec<Claim> {
             .map(|(c, curve)| (c.2.clone(), curve.last().0))
             .collect();
         ranked.sort_by(|a, b| b.1.total_cmp(&a.1));
-        if ranked.iter().any(|r| r.0 == "cdbo") && ranked.len() > 1 {
+        if ranked.iter().any(|r| r.0 == Method::Cdbo.name()) && ranked.len() > 1 {
             panels.push((t, m, ranked));
         }
     }
     out.push(Claim {
         statement: "CDBO has the best final reward in every panel".into(),
-        holds: (!panels.is_empty()).then(|| panels.iter().all(|p| p.2[0].0 == "cdbo")),
+        holds: (!panels.is_empty()).then(|| panels.iter().all(|p| p.2[0].0 == Method::Cdbo.name())),
         evidence: panels
             .iter()
             .map(|(t, m, ranked)| {
-                let cdbo = ranked.iter().position(|r| r.0 == "cdbo").unwrap_or(0);
+                let cdbo = ranked
+                    .iter()
+                    .position(|r| r.0 == Method::Cdbo.name())
+                    .unwrap_or(0);
                 format!(
                     "{t} {m}: best {} {:.2} m/s, CDBO {:.2} m/s (rank {})",
                     ranked[0].0,

@@ -435,8 +435,8 @@ impl Bo {
 impl Optimizer for Bo {
     fn name(&self) -> &'static str {
         match self.state.config.maximiser {
-            Maximiser::CoordinateAscent(_) => "cdbo",
-            Maximiser::Cmaes(_) => "bo-cmaes",
+            Maximiser::CoordinateAscent(_) => crate::optimizers::Method::Cdbo.name(),
+            Maximiser::Cmaes(_) => crate::optimizers::Method::BoCmaes.name(),
         }
     }
 

@@ -465,7 +465,7 @@ impl Cmaes {
 
 impl Optimizer for Cmaes {
     fn name(&self) -> &'static str {
-        "cmaes"
+        crate::optimizers::Method::Cmaes.name()
     }
 
     fn dim(&self) -> usize {

@@ -219,7 +219,7 @@ impl LineBo {
 
 impl Optimizer for LineBo {
     fn name(&self) -> &'static str {
-        "linebo"
+        crate::optimizers::Method::Linebo.name()
     }
 
     fn dim(&self) -> usize {

@@ -11,8 +11,11 @@ pub mod coordinate_ascent;
 pub mod linebo;
 pub mod pattern_search;
 pub mod random;
+pub mod registry;
 pub mod rembo;
 pub mod turbo;
+
+pub use registry::Method;
 
 use serde::{Deserialize, Serialize};
 
@@ -93,19 +96,6 @@ impl Saved {
     }
 }
 
-/// The methods [`by_name`] knows: the paper's CDBO, its baselines, and later peers.
-pub const METHODS: &[&str] = &[
-    "cdbo",
-    "cmaes",
-    "bo-cmaes",
-    "rembo-5d",
-    "rembo-10d",
-    "turbo",
-    "linebo",
-    "random",
-    "pattern-search",
-];
-
 /// What every method is told besides w₀.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Settings {
@@ -143,94 +133,91 @@ impl Settings {
     }
 }
 
-/// The error for a method name that is not in [`METHODS`].
-pub fn unknown_method(name: &str) -> Error {
-    Error::NotFound {
-        what: "method",
-        name: format!("{name:?}"),
-        detail: format!("available: {}", METHODS.join(", ")),
-    }
+/// An optimiser by its name ([`Method`]), from w₀ and the settings shared by every method.
+pub fn by_name(name: &str, w0: Vec<f64>, settings: &Settings) -> Result<Box<dyn Optimizer + Send>> {
+    name.parse::<Method>()?.optimizer(w0, settings)
 }
 
-/// An optimiser by its command-line name, from w₀ and the settings shared by every method.
-pub fn by_name(name: &str, w0: Vec<f64>, settings: &Settings) -> Result<Box<dyn Optimizer + Send>> {
-    let Settings {
-        seed,
-        beta,
-        box_radius,
-        sigma0,
-    } = *settings;
-    let bo = |maximiser| bo::BoConfig {
-        seed,
-        acquisition: crate::acquisition::Acquisition::Ucb { beta },
-        box_radius,
-        maximiser,
-        initial_sigma: sigma0,
-        ..bo::BoConfig::default()
-    };
-    let rembo = |embedding_dim| rembo::RemboConfig {
-        seed,
-        embedding_dim,
-        box_radius,
-        sigma0,
-    };
-    Ok(match name {
-        "cdbo" => Box::new(bo::Bo::new(
-            w0,
-            bo(bo::Maximiser::CoordinateAscent(Default::default())),
-        )?),
-        "bo-cmaes" => Box::new(bo::Bo::new(
-            w0,
-            bo(bo::Maximiser::Cmaes(Default::default())),
-        )?),
-        "cmaes" => {
-            let config = cmaes::CmaesConfig {
-                seed,
-                sigma0,
-                bounds: Some(SearchBox::around(&w0, box_radius)?),
-                ..cmaes::CmaesConfig::default()
-            };
-            Box::new(cmaes::Cmaes::new(w0, config)?)
-        }
-        "rembo-5d" => Box::new(rembo::Rembo::new(w0, rembo(5))?),
-        "rembo-10d" => Box::new(rembo::Rembo::new(w0, rembo(10))?),
-        "turbo" => Box::new(turbo::Turbo::new(
-            w0,
-            turbo::TurboConfig {
-                seed,
-                box_radius,
-                ..turbo::TurboConfig::default()
-            },
-        )?),
-        "linebo" => Box::new(linebo::LineBo::new(
-            w0,
-            linebo::LineBoConfig {
-                seed,
-                box_radius,
-                beta,
-                ..linebo::LineBoConfig::default()
-            },
-        )?),
-        "random" => Box::new(random::RandomSearch::new(
-            w0,
-            random::RandomConfig {
-                seed,
-                sigma: sigma0,
-                box_radius,
-            },
-        )?),
-        "pattern-search" => Box::new(pattern_search::PatternSearch::new(
-            w0,
-            pattern_search::PatternSearchConfig {
-                seed,
-                sigma0,
-                box_radius,
-                repair: true,
-                ..pattern_search::PatternSearchConfig::default()
-            },
-        )?),
-        other => return Err(unknown_method(other)),
-    })
+impl Method {
+    /// The method's optimiser, from w₀ and the settings shared by every method.
+    pub fn optimizer(self, w0: Vec<f64>, settings: &Settings) -> Result<Box<dyn Optimizer + Send>> {
+        let Settings {
+            seed,
+            beta,
+            box_radius,
+            sigma0,
+        } = *settings;
+        let bo = |maximiser| bo::BoConfig {
+            seed,
+            acquisition: crate::acquisition::Acquisition::Ucb { beta },
+            box_radius,
+            maximiser,
+            initial_sigma: sigma0,
+            ..bo::BoConfig::default()
+        };
+        let rembo = |embedding_dim| rembo::RemboConfig {
+            seed,
+            embedding_dim,
+            box_radius,
+            sigma0,
+        };
+        Ok(match self {
+            Method::Cdbo => Box::new(bo::Bo::new(
+                w0,
+                bo(bo::Maximiser::CoordinateAscent(Default::default())),
+            )?),
+            Method::BoCmaes => Box::new(bo::Bo::new(
+                w0,
+                bo(bo::Maximiser::Cmaes(Default::default())),
+            )?),
+            Method::Cmaes => {
+                let config = cmaes::CmaesConfig {
+                    seed,
+                    sigma0,
+                    bounds: Some(SearchBox::around(&w0, box_radius)?),
+                    ..cmaes::CmaesConfig::default()
+                };
+                Box::new(cmaes::Cmaes::new(w0, config)?)
+            }
+            Method::Rembo5d => Box::new(rembo::Rembo::new(w0, rembo(5))?),
+            Method::Rembo10d => Box::new(rembo::Rembo::new(w0, rembo(10))?),
+            Method::Turbo => Box::new(turbo::Turbo::new(
+                w0,
+                turbo::TurboConfig {
+                    seed,
+                    box_radius,
+                    ..turbo::TurboConfig::default()
+                },
+            )?),
+            Method::Linebo => Box::new(linebo::LineBo::new(
+                w0,
+                linebo::LineBoConfig {
+                    seed,
+                    box_radius,
+                    beta,
+                    ..linebo::LineBoConfig::default()
+                },
+            )?),
+            Method::Random => Box::new(random::RandomSearch::new(
+                w0,
+                random::RandomConfig {
+                    seed,
+                    sigma: sigma0,
+                    box_radius,
+                },
+            )?),
+            Method::PatternSearch => Box::new(pattern_search::PatternSearch::new(
+                w0,
+                pattern_search::PatternSearchConfig {
+                    seed,
+                    sigma0,
+                    box_radius,
+                    repair: true,
+                    ..pattern_search::PatternSearchConfig::default()
+                },
+            )?),
+        })
+    }
 }
 
 /// The box the weights are searched in: [w₀ − r, w₀ + r] in every coordinate.

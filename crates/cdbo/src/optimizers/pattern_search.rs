@@ -223,7 +223,7 @@ impl PatternSearch {
 
 impl Optimizer for PatternSearch {
     fn name(&self) -> &'static str {
-        "pattern-search"
+        crate::optimizers::Method::PatternSearch.name()
     }
 
     fn dim(&self) -> usize {

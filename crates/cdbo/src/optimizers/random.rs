@@ -87,7 +87,7 @@ impl RandomSearch {
 
 impl Optimizer for RandomSearch {
     fn name(&self) -> &'static str {
-        "random"
+        crate::optimizers::Method::Random.name()
     }
 
     fn dim(&self) -> usize {

@@ -167,8 +167,8 @@ impl Rembo {
 impl Optimizer for Rembo {
     fn name(&self) -> &'static str {
         match self.config.embedding_dim {
-            5 => "rembo-5d",
-            10 => "rembo-10d",
+            5 => crate::optimizers::Method::Rembo5d.name(),
+            10 => crate::optimizers::Method::Rembo10d.name(),
             _ => "rembo",
         }
     }

@@ -316,7 +316,7 @@ impl Turbo {
 
 impl Optimizer for Turbo {
     fn name(&self) -> &'static str {
-        "turbo"
+        crate::optimizers::Method::Turbo.name()
     }
 
     fn dim(&self) -> usize {
