@@ -178,7 +178,7 @@ fn ask_tell_workflow_and_bad_input() {
             "--method",
             "simplex",
         ],
-        "unknown method",
+        "invalid value 'simplex'",
     );
     assert!(
         !dir.join("w.cdbo.db").exists(),
