@@ -78,15 +78,15 @@ fn main() -> ExitCode {
         Err(e) => return usage_error(&e),
     };
     let data = cdbo::data_path::DataPath::new(&cli.data_dirs);
-    // Only `lap` and `race` drive laps in the game so far; anything else would silently drive
-    // cdbo's simulator instead.
+    // Only `lap`, `race` and `optimize` drive laps in the game so far; anything else would
+    // silently drive cdbo's simulator instead.
     let drives_torcs = matches!(
         cli.command,
-        Command::Lap(_) | Command::Race(_) | Command::Torcs(_)
+        Command::Lap(_) | Command::Race(_) | Command::Optimize(_) | Command::Torcs(_)
     );
     if cli.simulator == commands::Simulator::Torcs && !drives_torcs {
         eprintln!(
-            "error: --simulator torcs works with `lap` and `race` (and `cdbo torcs ...`); for `optimize` use --evaluator 'cdbo --simulator torcs lap --track T --policy {{policy}} --json'"
+            "error: --simulator torcs works with `lap`, `race` and `optimize --track T` (and `cdbo torcs ...`); `experiment` and `serve-sim` drive cdbo's simulator only"
         );
         return ExitCode::from(2);
     }
@@ -95,7 +95,7 @@ fn main() -> ExitCode {
         Command::Experiment(args) => commands::experiment::run_grid(&args, &data),
         Command::Report(args) => commands::report::run(&args, &data),
         Command::Study(cmd) => commands::study::run(&cmd),
-        Command::Optimize(args) => commands::optimize::run(&args),
+        Command::Optimize(args) => commands::optimize::run(&args, cli.simulator),
         Command::ServeSim(args) => commands::serve_sim::run(&args, &data),
         Command::Lap(args) => commands::lap::run(&args, &data, cli.simulator),
         Command::Limit(args) => commands::limit::run(&args, &data),

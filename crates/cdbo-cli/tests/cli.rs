@@ -417,14 +417,25 @@ fn bench_optimizers_compares_every_method() {
 /// A command that cannot drive the game says so instead of quietly driving cdbo's simulator.
 #[test]
 fn simulator_torcs_is_refused_where_it_is_not_supported() {
-    fails_with(
-        &["--simulator", "torcs", "experiment", "quick"],
-        &["--simulator torcs works with `lap` and `race`"],
-    );
+    let works = "--simulator torcs works with `lap`, `race` and `optimize --track T`";
+    fails_with(&["--simulator", "torcs", "experiment", "quick"], &[works]);
     fails_with(
         &["--simulator", "torcs", "serve-sim", "--kernels", "10"],
-        &["--simulator torcs works with `lap` and `race`"],
+        &[works],
     );
+    // optimize drives the game itself with --track, and refuses the mix-ups before any study
+    // file is made.
+    let db = scratch("torcs-opt.db", "");
+    std::fs::remove_file(&db).unwrap();
+    let db = db.to_str().unwrap();
+    let common = ["--laps", "3", "--db", db, "--kernels", "5"];
+    let mut game_no_track = vec!["--simulator", "torcs", "optimize", "--evaluator", "echo 1"];
+    game_no_track.extend(common);
+    fails_with(&game_no_track, &["name its --track"]);
+    let mut track_no_game = vec!["optimize", "--track", "forza"];
+    track_no_game.extend(common);
+    fails_with(&track_no_game, &["add --simulator torcs"]);
+    assert!(!std::path::Path::new(db).exists());
 }
 
 #[test]

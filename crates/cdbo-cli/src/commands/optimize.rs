@@ -7,19 +7,29 @@ use std::time::Duration;
 
 use clap::Args;
 
-use super::CliResult;
 use super::study::InitialPolicy;
+use super::{CliResult, Simulator};
+use cdbo::evaluator::Evaluator;
 use cdbo::evaluator::command::CommandEvaluator;
+use cdbo::evaluator::torcs::TorcsEvaluator;
 use cdbo::study::claim::{DEFAULT_LEASE, Worker};
 use cdbo::study::run::Event;
 use cdbo::study::{Outcome, Study};
+use cdbo::torcs::GamePedal;
 
 #[derive(Debug, Args)]
 pub struct OptimizeArgs {
     /// The lap command, run by `sh -c`, with {policy} where the policy file's path goes; it
-    /// prints the reward (a number or JSON with "reward").
-    #[arg(long, value_name = "CMD")]
-    evaluator: String,
+    /// prints the reward (a number or JSON with "reward"). Not with `--simulator torcs`,
+    /// which drives the game itself.
+    #[arg(long, value_name = "CMD", required_unless_present = "track")]
+    evaluator: Option<String>,
+    /// With `--simulator torcs`: the TORCS track each lap is driven on (forza, e-track-2, ...).
+    #[arg(long, conflicts_with = "evaluator")]
+    track: Option<String>,
+    /// With `--simulator torcs`: the TORCS car.
+    #[arg(long, default_value = cdbo::torcs::DEFAULT_CAR, requires = "track")]
+    car: String,
     /// Trials the study should have told when this run ends: a total, counting those already
     /// told (a study with 31 told trials and --laps 40 drives 9 more; with --laps 5, none).
     #[arg(long, value_parser = super::value::total_laps)]
@@ -38,7 +48,22 @@ pub struct OptimizeArgs {
     initial: InitialPolicy,
 }
 
-pub fn run(args: &OptimizeArgs) -> CliResult {
+pub fn run(args: &OptimizeArgs, simulator: Simulator) -> CliResult {
+    // The game is set up (or refused) before the study is touched: nothing half-made.
+    let game = match (simulator, &args.track) {
+        (Simulator::Torcs, Some(track)) => {
+            let game = cdbo::torcs::Game::ready()?;
+            let request = game.request(track, &args.car, GamePedal::Constant(0.0))?;
+            Some((game, request))
+        }
+        (Simulator::Torcs, None) => {
+            return Err("--simulator torcs optimize drives the game itself: name its --track (and --car), not an --evaluator".into());
+        }
+        (Simulator::Cdbo, Some(_)) => {
+            return Err("--track drives laps in the game: add --simulator torcs, or give an --evaluator command".into());
+        }
+        (Simulator::Cdbo, None) => None,
+    };
     let (mut study, created) = if args.db.exists() {
         (Study::open(&args.db)?, false)
     } else {
@@ -66,13 +91,27 @@ pub fn run(args: &OptimizeArgs) -> CliResult {
             args.laps
         );
     }
-    let mut evaluator = CommandEvaluator {
-        template: args.evaluator.clone(),
-        timeout: Duration::from_secs_f64(args.timeout),
-        files: args.db.clone(),
-        lengthscale: study.config().lengthscale,
+    let lengthscale = study.config().lengthscale;
+    let mut evaluator: Box<dyn Evaluator> = match (game, &args.evaluator) {
+        (Some((game, mut request)), _) => {
+            request.timeout = Duration::from_secs_f64(args.timeout);
+            Box::new(TorcsEvaluator {
+                game,
+                request,
+                lengthscale,
+            })
+        }
+        (None, Some(template)) => Box::new(CommandEvaluator {
+            template: template.clone(),
+            timeout: Duration::from_secs_f64(args.timeout),
+            files: args.db.clone(),
+            lengthscale,
+        }),
+        (None, None) => {
+            return Err("give an --evaluator command or --track (with --simulator torcs)".into());
+        }
     };
-    study.run(&mut evaluator, &worker, args.laps, &mut |event| {
+    study.run(evaluator.as_mut(), &worker, args.laps, &mut |event| {
         print_event(&mut out, event)
     })?;
     let best = study.best()?;
