@@ -55,6 +55,15 @@ pub enum Error {
         /// The SQLite error.
         source: rusqlite::Error,
     },
+    /// A PostgreSQL error on a study's database: unreachable, credentials refused, or a
+    /// statement that failed.
+    #[error("{}: {}", path.display(), postgres_message(source))]
+    Postgres {
+        /// The database URL (without its password) and study name.
+        path: PathBuf,
+        /// The client's error.
+        source: postgres::Error,
+    },
     /// Another process holds the study's write lock beyond the busy timeout
     /// (SQLite's `DatabaseBusy` / `DatabaseLocked`).
     #[error("{}: busy: another process is using the study; try again", path.display())]
@@ -259,3 +268,15 @@ impl Error {
 
 /// The library's result type.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// A PostgreSQL error on one line: the server's severity and message, or what failed on the
+/// way to it and why (the client's own `Display` leaves the cause out).
+fn postgres_message(e: &postgres::Error) -> String {
+    if let Some(db) = e.as_db_error() {
+        return format!("{}: {}", db.severity(), db.message());
+    }
+    match std::error::Error::source(e) {
+        Some(cause) => format!("{e}: {cause}"),
+        None => e.to_string(),
+    }
+}

@@ -1,7 +1,7 @@
 //! Persistent ask/tell studies for optimising a real car one lap at a time: every trial
 //! (asked weights, then the told outcome), the settings and the optimiser's [`Saved`] state
-//! after the last tell, kept in a [`storage::Storage`] — an SQLite file ([`sqlite`]), named
-//! by a [`Location`] — so
+//! after the last tell, kept in a [`storage::Storage`] — an SQLite file ([`sqlite`], the
+//! embedded default) or a PostgreSQL database ([`postgres`]), named by a [`Location`] — so
 //! that a told result is durable before `tell` returns, and a study survives crashes,
 //! `kill -9` and restarts, continuing with exactly the suggestion an uninterrupted run would
 //! make.
@@ -17,6 +17,7 @@
 //! [`Study::open_read_only`], which writes nothing.
 
 pub mod claim;
+pub mod postgres;
 pub mod run;
 pub mod sqlite;
 pub mod storage;
@@ -183,6 +184,10 @@ impl Study {
                 let (s, c) = sqlite::Sqlite::open(path, writable)?;
                 (Box::new(s), c)
             }
+            Location::Postgres { url, study } => {
+                let (s, c) = postgres::Postgres::open(url, study, &location.label(), writable)?;
+                (Box::new(s), c)
+            }
         };
         let label = storage.label().to_owned();
         let config: StudyConfig =
@@ -204,7 +209,7 @@ impl Study {
         &self.config
     }
 
-    /// Where the study lives, for messages.
+    /// Where the study lives, for messages: the file, or the database URL and study name.
     pub fn path(&self) -> &Path {
         &self.label
     }
@@ -395,6 +400,9 @@ impl Study {
 fn create_from(location: &Location, dump: &Dump) -> Result<()> {
     match location {
         Location::Sqlite(path) => sqlite::Sqlite::create(path, dump),
+        Location::Postgres { url, study } => {
+            postgres::Postgres::create(url, study, &location.label(), dump)
+        }
     }
 }
 

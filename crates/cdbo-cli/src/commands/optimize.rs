@@ -14,7 +14,7 @@ use cdbo::evaluator::command::CommandEvaluator;
 use cdbo::evaluator::torcs::TorcsEvaluator;
 use cdbo::study::claim::{DEFAULT_LEASE, Worker};
 use cdbo::study::run::Event;
-use cdbo::study::{Outcome, Study};
+use cdbo::study::{Location, Outcome, Study};
 use cdbo::torcs::GamePedal;
 
 #[derive(Debug, Args)]
@@ -34,9 +34,14 @@ pub struct OptimizeArgs {
     /// told (a study with 31 told trials and --laps 40 drives 9 more; with --laps 5, none).
     #[arg(long, value_parser = super::value::total_laps)]
     laps: usize,
-    /// Study file: created on the first run (with --demo or --weights), resumed afterwards.
-    #[arg(long, value_name = "FILE")]
-    db: PathBuf,
+    /// Where the study lives, created on the first run (with --demo or --weights) and resumed
+    /// afterwards: an SQLite file (FILE or sqlite://FILE) or a PostgreSQL database
+    /// (postgresql://USER@HOST[:PORT]/DB, the study named by --study).
+    #[arg(long, visible_alias = "db", value_name = "URL|FILE")]
+    storage: String,
+    /// The study's name in a database (or DB-URL#STUDY); a file holds one study.
+    #[arg(long, value_name = "NAME")]
+    study: Option<String>,
     /// Seconds a lap may take before it counts as failed.
     #[arg(long, default_value_t = 600.0, allow_negative_numbers = true, value_parser = super::value::positive)]
     timeout: f64,
@@ -64,13 +69,18 @@ pub fn run(args: &OptimizeArgs, simulator: Simulator) -> CliResult {
         }
         (Simulator::Cdbo, None) => None,
     };
-    let (mut study, created) = if args.db.exists() {
-        (Study::open(&args.db)?, false)
-    } else {
-        Study::open_or_create(&args.db, args.initial.config()?)?
+    let location = Location::parse(&args.storage, args.study.as_deref())?;
+    let (mut study, created) = match Study::open_at(&location) {
+        Err(cdbo::Error::NoStudy { .. }) => {
+            let mut config = args.initial.config()?;
+            // The game's track, recorded (the dashboard re-drives trials on it).
+            config.track = config.track.or_else(|| args.track.clone());
+            Study::open_or_create_at(&location, config)?
+        }
+        opened => (opened?, false),
     };
     if !created {
-        args.initial.check_resume(&args.db, study.config())?;
+        args.initial.check_resume(study.path(), study.config())?;
     }
     let worker = Worker::this_process(Duration::from_secs_f64(args.lease));
     let told_before = study.told()?;
@@ -79,14 +89,14 @@ pub fn run(args: &OptimizeArgs, simulator: Simulator) -> CliResult {
         let _ = writeln!(
             out,
             "{}: {told_before} trials told already, --laps {} is the total to reach: nothing to drive",
-            args.db.display(),
+            study.path().display(),
             args.laps
         );
     } else {
         let _ = writeln!(
             out,
             "{}: {told_before} trials told, driving up to {} more to reach --laps {}",
-            args.db.display(),
+            study.path().display(),
             args.laps - told_before,
             args.laps
         );
@@ -104,7 +114,7 @@ pub fn run(args: &OptimizeArgs, simulator: Simulator) -> CliResult {
         (None, Some(template)) => Box::new(CommandEvaluator {
             template: template.clone(),
             timeout: Duration::from_secs_f64(args.timeout),
-            files: args.db.clone(),
+            files: policy_files(&location),
             lengthscale,
         }),
         (None, None) => {
@@ -118,7 +128,7 @@ pub fn run(args: &OptimizeArgs, simulator: Simulator) -> CliResult {
     let _ = writeln!(
         out,
         "{}: {} trials told; best {}",
-        args.db.display(),
+        study.path().display(),
         study.told()?,
         best.map_or("none".into(), |t| format!(
             "{} (trial {})",
@@ -127,6 +137,21 @@ pub fn run(args: &OptimizeArgs, simulator: Simulator) -> CliResult {
         ))
     );
     Ok(())
+}
+
+/// The stem of the policy files written for the evaluator: beside a study file, or in the
+/// temporary folder for a study in a database.
+fn policy_files(location: &Location) -> PathBuf {
+    match location {
+        Location::Sqlite(path) => path.clone(),
+        Location::Postgres { study, .. } => {
+            let safe: String = study
+                .chars()
+                .map(|c| if c.is_alphanumeric() { c } else { '_' })
+                .collect();
+            std::env::temp_dir().join(format!("cdbo-study-{safe}"))
+        }
+    }
 }
 
 /// Prints what the lap loop reports: told trials and waits on standard output, notes on

@@ -9,23 +9,28 @@ use super::{CliResult, from_flag, print_json};
 use cdbo::optimizers::Method;
 use cdbo::policy::RkhsPolicy;
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
-use cdbo::study::{Outcome, Study, StudyConfig, Trial};
+use cdbo::study::{Location, Outcome, Study, StudyConfig, Trial};
 
-/// The study's file: `--db FILE`, or `NAME.cdbo.db` in the current folder.
+/// The study: `--storage URL|FILE`, or the file `NAME.cdbo.db` in the current folder.
 #[derive(Debug, Args, Clone)]
 pub struct StudyName {
-    /// Study name.
+    /// Study name (its name in a database; a file holds one study).
     name: String,
-    /// Study file (default: NAME.cdbo.db).
-    #[arg(long, value_name = "FILE")]
-    db: Option<PathBuf>,
+    /// Where the study lives: an SQLite file (FILE or sqlite://FILE; default NAME.cdbo.db)
+    /// or a PostgreSQL database (postgresql://USER@HOST[:PORT]/DB, the study named NAME).
+    #[arg(long, visible_alias = "db", value_name = "URL|FILE")]
+    storage: Option<String>,
 }
 
 impl StudyName {
-    pub fn path(&self) -> PathBuf {
-        self.db
-            .clone()
-            .unwrap_or_else(|| PathBuf::from(format!("{}.cdbo.db", self.name)))
+    pub fn location(&self) -> Result<Location, cdbo::Error> {
+        match &self.storage {
+            Some(s) => Location::parse(s, Some(&self.name)),
+            None => Ok(Location::Sqlite(PathBuf::from(format!(
+                "{}.cdbo.db",
+                self.name
+            )))),
+        }
     }
 }
 
@@ -99,11 +104,11 @@ impl InitialPolicy {
 
     /// Refuses to resume a study with settings other than its own: every flag given must
     /// match the stored value (a flag left out takes the stored one).
-    pub fn check_resume(&self, path: &Path, stored: &StudyConfig) -> Result<(), String> {
+    pub fn check_resume(&self, study: &Path, stored: &StudyConfig) -> Result<(), String> {
         let differs = |flag: &str, given: String, kept: String| {
             Err(format!(
-                "{}: the study was created with {flag} {kept}, not {given}; resume it with {flag} {kept} (or leave the flag out), or start a new study with another --db",
-                path.display()
+                "{}: the study was created with {flag} {kept}, not {given}; resume it with {flag} {kept} (or leave the flag out), or start a new study elsewhere",
+                study.display()
             ))
         };
         if self.kernels != stored.kernels {
@@ -203,6 +208,16 @@ pub enum StudyCommand {
         #[arg(long)]
         json: bool,
     },
+    /// Copy a study to a new place, row for row (e.g. a file into a PostgreSQL database).
+    Copy {
+        /// The study to copy: FILE, sqlite://FILE or postgresql://USER@HOST/DB#STUDY.
+        from: String,
+        /// Where the copy goes (must not hold the study yet), as FROM.
+        to: String,
+        /// The study's name in a database URL without a #STUDY.
+        #[arg(long)]
+        name: Option<String>,
+    },
     /// Write the history (CSV, JSON), the best policy (JSON, CSV) and the learning curve (PNG,
     /// SVG) to a folder.
     Export {
@@ -218,7 +233,7 @@ pub fn run(cmd: &StudyCommand) -> CliResult {
     match cmd {
         StudyCommand::Create { study, initial } => {
             let config = initial.config()?;
-            let s = Study::create(&study.path(), config)?;
+            let s = Study::create_at(&study.location()?, config)?;
             println!(
                 "created study {} in {} ({} kernels, {})",
                 study.name,
@@ -229,7 +244,7 @@ pub fn run(cmd: &StudyCommand) -> CliResult {
             Ok(())
         }
         StudyCommand::Ask { study, format } => {
-            let mut s = Study::open(&study.path())?;
+            let mut s = Study::open_at(&study.location()?)?;
             let trial = s.ask()?;
             print_policy(&s, &trial, *format)
         }
@@ -260,23 +275,23 @@ pub fn run(cmd: &StudyCommand) -> CliResult {
                 Outcome::Failed { .. } => "--at",
             };
             outcome.reward().map_err(from_flag(flag))?;
-            let mut s = Study::open(&study.path())?;
+            let mut s = Study::open_at(&study.location()?)?;
             let r = s.tell(*trial, &outcome)?;
             println!("trial {trial}: reward {r} saved");
             Ok(())
         }
         StudyCommand::Status { study, json } => {
-            status(&Study::open_read_only(&study.path())?, *json)
+            status(&Study::open_read_only_at(&study.location()?)?, *json)
         }
         StudyCommand::Best { study, format } => {
-            let s = Study::open_read_only(&study.path())?;
+            let s = Study::open_read_only_at(&study.location()?)?;
             match s.best()? {
                 Some(t) => print_policy(&s, &t, *format),
                 None => Err(format!("{}: no trial has been told yet", s.path().display()).into()),
             }
         }
         StudyCommand::History { study, json } => {
-            let s = Study::open_read_only(&study.path())?;
+            let s = Study::open_read_only_at(&study.location()?)?;
             let h = s.history()?;
             if *json {
                 return print_json(&h);
@@ -284,8 +299,20 @@ pub fn run(cmd: &StudyCommand) -> CliResult {
             print!("{}", history_csv(&h));
             Ok(())
         }
+        StudyCommand::Copy { from, to, name } => {
+            let from = Location::parse(from, name.as_deref())?;
+            let to = Location::parse(to, name.as_deref())?;
+            let copy = Study::copy(&from, &to)?;
+            println!(
+                "copied {} ({} trials) to {}",
+                from.label().display(),
+                copy.history()?.len(),
+                copy.path().display()
+            );
+            Ok(())
+        }
         StudyCommand::Export { study, out } => {
-            let s = Study::open_read_only(&study.path())?;
+            let s = Study::open_read_only_at(&study.location()?)?;
             let out = out
                 .clone()
                 .unwrap_or_else(|| PathBuf::from(format!("{}-export", study.name)));

@@ -1,7 +1,8 @@
-//! Where a study lives: the [`Storage`] trait that every back end implements (an SQLite file,
-//! [`super::sqlite`]), and the [`Location`] a user names one by. The back ends store rows and hold a study's write lock; what to store —
+//! Where a study lives: the [`Storage`] trait that both back ends implement (an SQLite file,
+//! [`super::sqlite`]; a PostgreSQL database, [`super::postgres`]), and the [`Location`] a
+//! user names one by. The back ends store rows and hold a study's write lock; what to store —
 //! asking, claiming, telling the optimiser — is [`super::Study`]'s and [`super::claim`]'s,
-//! the same for every back end.
+//! the same for both.
 
 use std::path::{Path, PathBuf};
 
@@ -11,24 +12,52 @@ use super::Trial;
 use super::claim::Claim;
 
 /// A study's place, parsed from what a user types: a file path or `sqlite://PATH` is an
-/// SQLite file (one study per file).
+/// SQLite file (one study per file); `postgresql://USER@HOST[:PORT]/DB#STUDY` (or
+/// `postgres://`) is study `STUDY` of a PostgreSQL database, which holds any number.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Location {
     /// An SQLite file.
     Sqlite(PathBuf),
+    /// Study `study` in a PostgreSQL database.
+    Postgres {
+        /// The connection URL, without the `#STUDY` (a password in it is never shown).
+        url: String,
+        /// The study's name in the database.
+        study: String,
+    },
 }
 
 /// The URL schemes [`Location::parse`] knows, for its error message.
-const SCHEMES: &str = "a file path or sqlite://PATH";
+const SCHEMES: &str = "a file path, sqlite://PATH or postgresql://USER@HOST[:PORT]/DB";
 
 impl Location {
-    /// The location `storage` names; an unknown `scheme://` is refused.
-    pub fn parse(storage: &str) -> Result<Location> {
+    /// The location `storage` names. A database URL names its study after a `#`, or else
+    /// takes `study` (a database without a study name is an error). An unknown `scheme://`
+    /// is refused.
+    pub fn parse(storage: &str, study: Option<&str>) -> Result<Location> {
         let Some((scheme, rest)) = storage.split_once("://") else {
             return Ok(Location::Sqlite(PathBuf::from(storage)));
         };
         match scheme {
             "sqlite" if !rest.is_empty() => Ok(Location::Sqlite(PathBuf::from(rest))),
+            "postgresql" | "postgres" => {
+                let (url, named) = match storage.split_once('#') {
+                    Some((url, name)) => (url, Some(name)),
+                    None => (storage, study),
+                };
+                let study = named
+                    .filter(|s| !s.is_empty())
+                    .ok_or_else(|| Error::InvalidValue {
+                        what: format!("the study name of {}", redact(url)),
+                        value: "none".into(),
+                        expected: "given (DATABASE-URL#STUDY): a database holds many studies"
+                            .into(),
+                    })?;
+                Ok(Location::Postgres {
+                    url: url.to_owned(),
+                    study: study.to_owned(),
+                })
+            }
             _ => Err(Error::InvalidValue {
                 what: "the storage".into(),
                 value: redact(storage),
@@ -37,10 +66,11 @@ impl Location {
         }
     }
 
-    /// How messages name it.
+    /// How messages name it: the file, or `URL#STUDY` with any password replaced by `***`.
     pub fn label(&self) -> PathBuf {
         match self {
             Location::Sqlite(path) => path.clone(),
+            Location::Postgres { url, study } => PathBuf::from(format!("{}#{study}", redact(url))),
         }
     }
 }
@@ -108,7 +138,7 @@ pub trait Storage: Send {
     /// Where the study lives, for messages (never with a password).
     fn label(&self) -> &Path;
     /// Starts a transaction holding the study's write lock (SQLite's `BEGIN IMMEDIATE`,
-    /// until it commits or is dropped
+    /// PostgreSQL's `SELECT … FOR UPDATE` of the study's row) until it commits or is dropped
     /// (rolled back).
     fn begin(&mut self) -> Result<Box<dyn Transaction + '_>>;
     /// Renews `owner`'s claim on pending trial `id` until `until`; false if the trial is
@@ -157,18 +187,34 @@ mod tests {
     #[test]
     fn locations_by_scheme() {
         assert_eq!(
-            Location::parse("a/s.db").unwrap(),
+            Location::parse("a/s.db", None).unwrap(),
             Location::Sqlite("a/s.db".into())
         );
         assert_eq!(
-            Location::parse("sqlite:///tmp/s.db").unwrap(),
+            Location::parse("sqlite:///tmp/s.db", None).unwrap(),
             Location::Sqlite("/tmp/s.db".into())
         );
-        let e = Location::parse("mysql://u:pw@h/db")
+        let pg = Location::parse("postgresql://me:secret@db.lan:5433/laps", Some("kart")).unwrap();
+        assert_eq!(
+            pg.label(),
+            PathBuf::from("postgresql://me:***@db.lan:5433/laps#kart")
+        );
+        assert_eq!(
+            Location::parse("postgres://me@h/db#lap", Some("other")).unwrap(),
+            Location::Postgres {
+                url: "postgres://me@h/db".into(),
+                study: "lap".into()
+            }
+        );
+        let e = Location::parse("postgres://me@h/db", None)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("study name"), "{e}");
+        let e = Location::parse("mysql://u:pw@h/db", Some("s"))
             .unwrap_err()
             .to_string();
         assert!(
-            e.contains("mysql://u:***@h/db") && e.contains("sqlite://"),
+            e.contains("mysql://u:***@h/db") && e.contains("postgresql://"),
             "{e}"
         );
         assert!(!e.contains("pw"), "{e}");
