@@ -213,9 +213,9 @@ fn fresh_dir(name: &str) -> PathBuf {
     dir
 }
 
-/// `cdbo optimize` on `storage` to `laps` told trials, every lap driven appended to
-/// `driven.log`.
-fn optimize(storage: &str, laps: usize) -> Command {
+/// `cdbo optimize` with `method` on `storage` to `laps` told trials, every lap driven appended
+/// to `driven.log`.
+fn optimize(storage: &str, laps: usize, method: &str) -> Command {
     let evaluator = format!("echo {{policy}} >> driven.log; {CDBO} lap --policy {{policy}} --json");
     let mut c = Command::new(CDBO);
     c.args([
@@ -232,6 +232,8 @@ fn optimize(storage: &str, laps: usize) -> Command {
         "demo.csv",
         "--seed",
         "3",
+        "--method",
+        method,
         "--lease",
         "2",
     ]);
@@ -250,11 +252,11 @@ fn driven(dir: &Path) -> usize {
     std::fs::read_to_string(dir.join("driven.log")).map_or(0, |t| t.lines().count())
 }
 
-/// Three workers on one PostgreSQL study, started at once before it exists; one is killed
-/// with SIGKILL half-way. Every trial is told once with weights of its own, and the laps
-/// driven are the trials told plus at most the killed worker's lap in flight (and one per
-/// worker whose lease ran out while it drove).
-fn three_workers(trials: usize) {
+/// Three workers of `method` on one PostgreSQL study, started at once before it exists; one
+/// is killed with SIGKILL half-way. Every trial is told once with weights of its own, and the
+/// laps driven are the trials told plus at most the killed worker's lap in flight (and one
+/// per worker whose lease ran out while it drove).
+fn three_workers(trials: usize, method: &str) {
     let Some(server) = Server::start(&format!("workers{trials}")) else {
         return;
     };
@@ -262,7 +264,7 @@ fn three_workers(trials: usize) {
     let storage = format!("{}#workers", server.url());
     let start = Instant::now();
     let spawn = || {
-        optimize(&storage, trials)
+        optimize(&storage, trials, method)
             .current_dir(&dir)
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())
@@ -300,7 +302,7 @@ fn three_workers(trials: usize) {
     }
     let laps = driven(&dir);
     eprintln!(
-        "3 workers, one killed at {}: {laps} laps driven, {} trials told, {:.1} s",
+        "3 {method} workers, one killed at {}: {laps} laps driven, {} trials told, {:.1} s",
         trials / 2,
         h.len(),
         start.elapsed().as_secs_f64()
@@ -313,14 +315,15 @@ fn three_workers(trials: usize) {
 
 #[test]
 fn three_workers_one_killed_tell_each_trial_once() {
-    three_workers(24);
+    three_workers(24, "cdbo");
 }
 
-/// The acceptance run: 300 laps.
+/// The acceptance run: 300 laps, of random search so that the laps (a process each) and the
+/// database, not the GP, take the time.
 #[test]
 #[ignore = "slow: 300 laps of three workers (run by .ci/run)"]
 fn three_workers_one_killed_300_laps() {
-    three_workers(300);
+    three_workers(300, "random");
 }
 
 /// One worker on SQLite and one on PostgreSQL, the same seed: the same trials bit for bit
@@ -334,7 +337,10 @@ fn sqlite_and_postgres_agree_bit_for_bit() {
     let pg = format!("{}#same", server.url());
     let laps = 12;
     for storage in ["a.db", pg.as_str()] {
-        let out = optimize(storage, laps).current_dir(&dir).output().unwrap();
+        let out = optimize(storage, laps, "cdbo")
+            .current_dir(&dir)
+            .output()
+            .unwrap();
         assert!(
             out.status.success(),
             "{storage}: {}",
@@ -403,7 +409,7 @@ fn sqlite_and_postgres_agree_bit_for_bit() {
     }
     // The copy goes on as the original would: one more lap each, the same trial.
     for storage in ["a.db".to_owned(), format!("{}#copied", server.url())] {
-        let out = optimize(&storage, laps + 1)
+        let out = optimize(&storage, laps + 1, "cdbo")
             .current_dir(&dir)
             .output()
             .unwrap();

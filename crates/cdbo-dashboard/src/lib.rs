@@ -43,7 +43,7 @@ pub struct Dashboard {
     pub sources: Vec<Source>,
     /// Where they are read from.
     pub store: Box<dyn Store>,
-    /// The track the studies' laps are driven on, if known (experiments name their own).
+    /// The track of the studies that record none (experiments name their own).
     pub study_track: Option<String>,
     /// The car re-driven on the map.
     pub car: String,
@@ -140,13 +140,17 @@ impl Dashboard {
         let source = self.source(id)?;
         let (track, weights, lengthscale) = match source.kind {
             Kind::Study => {
-                let track = self.study_track.clone().ok_or_else(|| {
-                    ApiError::Missing(
-                        "the study's track is not known: start the dashboard with --track"
-                            .to_owned(),
-                    )
-                })?;
                 let (config, trials) = self.store.study(source)?;
+                let track = config
+                    .track
+                    .clone()
+                    .or_else(|| self.study_track.clone())
+                    .ok_or_else(|| {
+                        ApiError::Missing(
+                            "the study records no track: start the dashboard with --track"
+                                .to_owned(),
+                        )
+                    })?;
                 let trial = trials
                     .into_iter()
                     .find(|t| t.id.to_string() == key)

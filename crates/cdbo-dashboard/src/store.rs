@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use cdbo::experiment::record::RunRecord;
-use cdbo::study::{Study, StudyConfig, Trial};
+use cdbo::study::{Location, Study, StudyConfig, Trial};
 use cdbo::{Error, Result};
 use serde::Serialize;
 
@@ -23,8 +23,11 @@ pub enum Kind {
 pub struct Source {
     /// Study or experiment.
     pub kind: Kind,
-    /// Where it lives (a file, a folder, a URL).
+    /// Where it lives, as shown (a file, a folder, a URL without its password).
     pub location: String,
+    /// A study's place, to open it (never sent to the page: a URL may hold a password).
+    #[serde(skip)]
+    pub study: Option<Location>,
 }
 
 /// Read access to studies and experiments.
@@ -35,17 +38,24 @@ pub trait Store: Send + Sync {
     fn runs(&self, source: &Source) -> Result<Vec<RunRecord>>;
 }
 
-/// Studies in SQLite files and experiments in folders (`DIR/runs/ID.json`).
+/// Studies wherever they live (SQLite files, PostgreSQL databases) and experiments in folders
+/// (`DIR/runs/ID.json`).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Files;
 
 impl Files {
-    /// Checks that `path` is a study, opening it read-only.
+    /// Checks that `path` is a study file, opening it read-only.
     pub fn study_source(path: &Path) -> Result<Source> {
-        Study::open_read_only(path)?;
+        Files::study_at(Location::Sqlite(path.to_owned()))
+    }
+
+    /// Checks that there is a study at `location`, opening it read-only.
+    pub fn study_at(location: Location) -> Result<Source> {
+        let study = Study::open_read_only_at(&location)?;
         Ok(Source {
             kind: Kind::Study,
-            location: path.display().to_string(),
+            location: study.path().display().to_string(),
+            study: Some(location),
         })
     }
 
@@ -69,13 +79,17 @@ impl Files {
         Ok(Source {
             kind: Kind::Experiment,
             location: dir.display().to_string(),
+            study: None,
         })
     }
 }
 
 impl Store for Files {
     fn study(&self, source: &Source) -> Result<(StudyConfig, Vec<Trial>)> {
-        let study = Study::open_read_only(Path::new(&source.location))?;
+        let study = match &source.study {
+            Some(location) => Study::open_read_only_at(location)?,
+            None => Study::open_read_only(Path::new(&source.location))?,
+        };
         Ok((study.config().clone(), study.history()?))
     }
 

@@ -80,6 +80,9 @@ pub struct View {
     pub policies: Vec<PolicyView>,
     /// The runs of an experiment (empty for a study).
     pub runs: Vec<RunView>,
+    /// The track a study's laps are driven on, if it recorded one (each run of an experiment
+    /// names its own).
+    pub track: Option<String>,
 }
 
 fn curve_of(pedal: &RkhsPolicy) -> Vec<f64> {
@@ -155,6 +158,7 @@ pub fn study(config: &StudyConfig, trials: &[Trial]) -> Result<View> {
         laps,
         policies,
         runs: Vec::new(),
+        track: config.track.clone(),
     })
 }
 
@@ -204,6 +208,7 @@ pub fn experiment(records: &[RunRecord], chosen: Option<&str>) -> Result<View> {
         }
     }
     Ok(View {
+        track: shown.map(|r| r.spec.track.clone()),
         laps_total: records.iter().map(|r| r.laps.len()).sum(),
         curves,
         laps,

@@ -95,6 +95,7 @@ impl PyStudy {
             seed,
             beta,
             w0,
+            track: None,
         };
         let study = py.detach(|| Study::create(&path, config)).py()?;
         Ok(PyStudy {

@@ -66,6 +66,10 @@ pub struct StudyConfig {
     pub beta: f64,
     /// The initial weights w₀.
     pub w0: Vec<f64>,
+    /// The track the laps are driven on, where the user or the evaluator named it (absent
+    /// in studies made before it was recorded, and left out of the stored settings then).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub track: Option<String>,
 }
 
 /// One trial of a study.
@@ -512,6 +516,7 @@ mod tests {
             seed: 1,
             beta: 1.0,
             w0: vec![0.1, 0.2, 0.3],
+            track: None,
         }
     }
 

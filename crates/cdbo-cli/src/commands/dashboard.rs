@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use cdbo::car::catalog as cars;
 use cdbo::data_path::DataPath;
+use cdbo::study::Location;
 use cdbo_dashboard::store::Files;
 use cdbo_dashboard::{DEFAULT_BIND, Dashboard};
 use clap::Args;
@@ -14,16 +15,17 @@ use super::CliResult;
 /// Arguments of `cdbo dashboard`.
 #[derive(Debug, Args)]
 pub struct DashboardArgs {
-    /// A study file to show (repeatable); opened read-only.
-    #[arg(long = "db", value_name = "STUDY")]
-    studies: Vec<PathBuf>,
+    /// A study to show (repeatable), opened read-only: an SQLite file (FILE or sqlite://FILE)
+    /// or a study in PostgreSQL (postgresql://USER@HOST[:PORT]/DB#STUDY).
+    #[arg(long = "storage", visible_alias = "db", value_name = "URL|FILE")]
+    studies: Vec<String>,
     /// An experiment output folder to show (repeatable); runs appear as they finish.
     #[arg(long = "experiment", value_name = "DIR")]
     experiments: Vec<PathBuf>,
     /// Address and port to serve on (this machine only by default).
     #[arg(long, default_value = DEFAULT_BIND)]
     bind: String,
-    /// The track the studies' laps are driven on, to re-drive their trials on the map.
+    /// The track of the studies that record none, to re-drive their trials on the map.
     #[arg(long)]
     track: Option<String>,
     /// The car re-driven on the map.
@@ -34,11 +36,11 @@ pub struct DashboardArgs {
 /// Serves the dashboard until interrupted.
 pub fn run(args: &DashboardArgs, data: &DataPath) -> CliResult {
     if args.studies.is_empty() && args.experiments.is_empty() {
-        return Err("nothing to show: give --db STUDY and/or --experiment DIR".into());
+        return Err("nothing to show: give --storage STUDY and/or --experiment DIR".into());
     }
     let mut sources = Vec::new();
-    for path in &args.studies {
-        sources.push(Files::study_source(path)?);
+    for study in &args.studies {
+        sources.push(Files::study_at(Location::parse(study, None)?)?);
     }
     for dir in &args.experiments {
         sources.push(Files::experiment_source(dir)?);

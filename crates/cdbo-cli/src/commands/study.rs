@@ -66,6 +66,10 @@ pub struct InitialPolicy {
     /// UCB exploration weight β (default 1).
     #[arg(long, allow_negative_numbers = true, value_parser = super::value::non_negative)]
     beta: Option<f64>,
+    /// The track the laps are driven on, recorded in the study (the dashboard re-drives its
+    /// trials there).
+    #[arg(long, value_name = "NAME")]
+    track: Option<String>,
 }
 
 impl InitialPolicy {
@@ -99,6 +103,7 @@ impl InitialPolicy {
             seed: self.seed.unwrap_or(0),
             beta: self.beta.unwrap_or(cdbo::acquisition::ucb::DEFAULT_BETA),
             w0: policy.weights,
+            track: self.track.clone(),
         })
     }
 
@@ -126,6 +131,17 @@ impl InitialPolicy {
         }
         if let Some(b) = self.beta.filter(|b| *b != stored.beta) {
             return differs("--beta", b.to_string(), stored.beta.to_string());
+        }
+        if let Some(t) = self
+            .track
+            .as_ref()
+            .filter(|t| Some(*t) != stored.track.as_ref())
+        {
+            let kept = stored
+                .track
+                .clone()
+                .unwrap_or_else(|| "(none recorded)".into());
+            return differs("--track", t.clone(), kept);
         }
         if let Some(l) = self.lengthscale.filter(|l| *l != stored.lengthscale) {
             return differs(
