@@ -4,10 +4,12 @@
 //! not installed, the tests say so and pass: `.ci/run` installs it when `CI` is set.
 
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
+use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-const CDBO: &str = env!("CARGO_BIN_EXE_cdbo");
+mod common;
+
+use common::{CDBO, demo, fresh_dir, ok, refused};
 
 /// The password of the test server's superuser `cdbo`.
 const PASSWORD: &str = "lap-secret";
@@ -171,45 +173,10 @@ impl Drop for Server {
     }
 }
 
-fn cdbo(dir: &Path, args: &[&str]) -> Output {
-    Command::new(CDBO)
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("runs")
-}
-
-fn ok(dir: &Path, args: &[&str]) -> String {
-    let out = cdbo(dir, args);
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).unwrap()
-}
-
-/// Expects exit status 2 and exactly one line on stderr, `error: …` containing every needle.
-fn refused(dir: &Path, args: &[&str], needles: &[&str]) {
-    let out = cdbo(dir, args);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
-    let lines: Vec<&str> = err.lines().collect();
-    assert_eq!(lines.len(), 1, "{args:?}: not one line: {err}");
-    assert!(lines[0].starts_with("error: "), "{args:?}: {err}");
-    for n in needles {
-        assert!(lines[0].contains(n), "{args:?}: {:?} lacks {n:?}", lines[0]);
-    }
-}
-
-fn fresh_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("cdbo-pgt-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    ok(
-        &dir,
-        &["lap", "--demo", "15", "--trace", "demo.csv", "--json"],
-    );
+/// A fresh folder with a demonstration recorded on the built-in track.
+fn fresh_dir_with_demo(name: &str) -> PathBuf {
+    let dir = fresh_dir(name);
+    demo(&dir);
     dir
 }
 
@@ -260,7 +227,7 @@ fn three_workers(trials: usize, method: &str) {
     let Some(server) = Server::start(&format!("workers{trials}")) else {
         return;
     };
-    let dir = fresh_dir(&format!("workers{trials}"));
+    let dir = fresh_dir_with_demo(&format!("workers{trials}"));
     let storage = format!("{}#workers", server.url());
     let start = Instant::now();
     let spawn = || {
@@ -333,7 +300,7 @@ fn sqlite_and_postgres_agree_bit_for_bit() {
     let Some(server) = Server::start("same") else {
         return;
     };
-    let dir = fresh_dir("same");
+    let dir = fresh_dir_with_demo("same");
     let pg = format!("{}#same", server.url());
     let laps = 12;
     for storage in ["a.db", pg.as_str()] {
@@ -431,7 +398,7 @@ fn a_trial_told_twice_is_refused() {
     let Some(server) = Server::start("twice") else {
         return;
     };
-    let dir = fresh_dir("twice");
+    let dir = fresh_dir_with_demo("twice");
     let url = server.url();
     let study = ["--storage", url.as_str()];
     ok(
@@ -483,7 +450,7 @@ fn bad_databases_are_one_line_and_write_nothing() {
     let Some(server) = Server::start("bad") else {
         return;
     };
-    let dir = fresh_dir("bad");
+    let dir = fresh_dir_with_demo("bad");
     let create = |storage: &str| -> Vec<String> {
         [
             "study",

@@ -3,26 +3,12 @@
 //! workers on one study, cut run records. Each case gives one clear error line (exit 2) or the
 //! documented behaviour, and never a panic (exit 101).
 
-use std::path::Path;
 use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 mod common;
 
-use common::{CDBO, cdbo, demo, fresh_dir, history, ok};
-
-/// Expects exit status 2 and exactly one line on stderr, `error: …` containing every needle.
-fn refused(dir: &Path, args: &[&str], needles: &[&str]) {
-    let out = cdbo(dir, args);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
-    let lines: Vec<&str> = err.lines().collect();
-    assert_eq!(lines.len(), 1, "{args:?}: not one line: {err}");
-    assert!(lines[0].starts_with("error: "), "{args:?}: {err}");
-    for n in needles {
-        assert!(lines[0].contains(n), "{args:?}: {:?} lacks {n:?}", lines[0]);
-    }
-}
+use common::{CDBO, cdbo, demo, fresh_dir, history, ok, refused};
 
 #[test]
 fn every_size_has_a_bound_and_every_number_a_domain() {

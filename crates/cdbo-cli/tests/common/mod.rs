@@ -40,6 +40,19 @@ pub fn fresh_dir(name: &str) -> PathBuf {
     dir
 }
 
+/// Expects exit status 2 and exactly one line on stderr, `error: …` containing every needle.
+pub fn refused(dir: &Path, args: &[&str], needles: &[&str]) {
+    let out = cdbo(dir, args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+    let lines: Vec<&str> = err.lines().collect();
+    assert_eq!(lines.len(), 1, "{args:?}: not one line: {err}");
+    assert!(lines[0].starts_with("error: "), "{args:?}: {err}");
+    for n in needles {
+        assert!(lines[0].contains(n), "{args:?}: {:?} lacks {n:?}", lines[0]);
+    }
+}
+
 /// A demonstration recorded on the built-in track, `demo.csv` in `dir`.
 pub fn demo(dir: &Path) {
     ok(
