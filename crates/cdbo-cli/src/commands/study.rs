@@ -66,10 +66,6 @@ pub struct InitialPolicy {
     /// UCB exploration weight β (default 1).
     #[arg(long, allow_negative_numbers = true, value_parser = super::value::non_negative)]
     beta: Option<f64>,
-    /// The track the laps are driven on, recorded in the study (the dashboard re-drives its
-    /// trials there).
-    #[arg(long, value_name = "NAME")]
-    track: Option<String>,
 }
 
 impl InitialPolicy {
@@ -103,7 +99,7 @@ impl InitialPolicy {
             seed: self.seed.unwrap_or(0),
             beta: self.beta.unwrap_or(cdbo::acquisition::ucb::DEFAULT_BETA),
             w0: policy.weights,
-            track: self.track.clone(),
+            track: None,
         })
     }
 
@@ -132,17 +128,6 @@ impl InitialPolicy {
         if let Some(b) = self.beta.filter(|b| *b != stored.beta) {
             return differs("--beta", b.to_string(), stored.beta.to_string());
         }
-        if let Some(t) = self
-            .track
-            .as_ref()
-            .filter(|t| Some(*t) != stored.track.as_ref())
-        {
-            let kept = stored
-                .track
-                .clone()
-                .unwrap_or_else(|| "(none recorded)".into());
-            return differs("--track", t.clone(), kept);
-        }
         if let Some(l) = self.lengthscale.filter(|l| *l != stored.lengthscale) {
             return differs(
                 "--lengthscale",
@@ -162,6 +147,10 @@ pub enum StudyCommand {
         study: StudyName,
         #[command(flatten)]
         initial: InitialPolicy,
+        /// The track the laps are driven on, recorded in the study (the dashboard re-drives
+        /// its trials there).
+        #[arg(long, value_name = "NAME")]
+        track: Option<String>,
     },
     /// The next policy to drive (the pending one until it is told).
     Ask {
@@ -247,8 +236,13 @@ pub enum StudyCommand {
 
 pub fn run(cmd: &StudyCommand) -> CliResult {
     match cmd {
-        StudyCommand::Create { study, initial } => {
-            let config = initial.config()?;
+        StudyCommand::Create {
+            study,
+            initial,
+            track,
+        } => {
+            let mut config = initial.config()?;
+            config.track = track.clone();
             let s = Study::create_at(&study.location()?, config)?;
             println!(
                 "created study {} in {} ({} kernels, {})",
