@@ -13,7 +13,8 @@
 //! - [`gp`], [`acquisition`], [`optimizers`]: the Gaussian process, UCB / EI and the ask/tell
 //!   optimisers, CDBO first.
 //! - [`experiment`]: learning to race a track end to end, and the paper's experiment grid.
-//! - [`study`]: persistent ask/tell studies for a real car; [`evaluator`]: sources of laps.
+//! - [`study`]: persistent ask/tell studies for a real car; [`evaluator`]: sources of laps;
+//!   [`serve`]: laps as a JSON-lines service.
 //! - [`torcs`]: the racing game TORCS as a source of laps (its robot, setup and lap runner).
 //! - [`benchmarks`]: standard test functions.
 //! - [`sizes`]: the bounds on every size a user gives, and the slow-size estimate.
@@ -33,6 +34,7 @@ pub mod limit;
 pub mod optimizers;
 pub mod params;
 pub mod policy;
+pub mod serve;
 pub mod sim;
 mod simd;
 pub mod sizes;

@@ -60,7 +60,6 @@ const ASPHALT_ROLLING_RESISTANCE: f64 = 0.001;
 
 /// Builds a car from (merged) parameters.
 pub fn from_params(p: &Params) -> Result<Car> {
-    let f = p.file.as_str();
     let empty = Section::default();
     let sec = |name: &str| p.section(name).unwrap_or(&empty);
     let car = p.require_section("Car")?;
@@ -68,155 +67,124 @@ pub fn from_params(p: &Params) -> Result<Car> {
         if v > 0.0 && v.is_finite() {
             Ok(v)
         } else {
-            Err(p.error(
-                &format!("{}/{name}", s.path),
-                Some(s.line_of(name)),
-                format!("must be positive, got {v}"),
-            ))
+            Err(s.value_error(name, format!("must be positive, got {v}")))
         }
     };
     let fraction = |s: &Section, name: &str, v: f64| -> Result<f64> {
         if (0.0..=1.0).contains(&v) {
             Ok(v)
         } else {
-            Err(p.error(
-                &format!("{}/{name}", s.path),
-                Some(s.line_of(name)),
-                format!("must be in [0, 1], got {v}"),
-            ))
+            Err(s.value_error(name, format!("must be in [0, 1], got {v}")))
         }
     };
 
-    let mass = positive(car, "mass", car.require_num(f, "mass")?)?;
-    let cg_height = positive(car, "GC height", car.num_or(f, "GC height", 0.3)?)?;
+    let mass = positive(car, "mass", car.require_num("mass")?)?;
+    let cg_height = positive(car, "GC height", car.num_or("GC height", 0.3)?)?;
     let front_weight = fraction(
         car,
         "front-rear weight repartition",
-        car.num_or(f, "front-rear weight repartition", 0.5)?,
+        car.num_or("front-rear weight repartition", 0.5)?,
     )?;
     let yaw_inertia_factor = positive(
         car,
         "mass repartition coefficient",
-        car.num_or(f, "mass repartition coefficient", 1.0)?,
+        car.num_or("mass repartition coefficient", 1.0)?,
     )?;
     let (fa, ra) = (sec("Front Axle"), sec("Rear Axle"));
     let wheelbase = positive(
         fa,
         "xpos",
-        fa.num_or(f, "xpos", 1.2)? - ra.num_or(f, "xpos", -1.4)?,
+        fa.num_or("xpos", 1.2)? - ra.num_or("xpos", -1.4)?,
     )?;
 
     let aero = sec("Aerodynamics");
-    let cx = positive(aero, "Cx", aero.num_or(f, "Cx", 0.4)?)?;
-    let front_area = positive(aero, "front area", aero.num_or(f, "front area", 2.0)?)?;
+    let cx = positive(aero, "Cx", aero.num_or("Cx", 0.4)?)?;
+    let front_area = positive(aero, "front area", aero.num_or("front area", 2.0)?)?;
     let clift = [
-        aero.num_or(f, "front Clift", 0.0)?,
-        aero.num_or(f, "rear Clift", 0.0)?,
+        aero.num_or("front Clift", 0.0)?,
+        aero.num_or("rear Clift", 0.0)?,
     ];
 
     // Wings: the lever rule between the axles' positions shares their downforce.
-    let rear_x = ra.num_or(f, "xpos", -1.4)?;
+    let rear_x = ra.num_or("xpos", -1.4)?;
     let wing = |name: &str| -> Result<Wing> {
         let w = sec(name);
-        let area = w.num_or(f, "area", 0.0)?;
+        let area = w.num_or("area", 0.0)?;
         if !(area >= 0.0 && area.is_finite()) {
-            return Err(p.error(
-                &format!("{}/area", w.path),
-                Some(w.line_of("area")),
-                format!("must be non-negative, got {area}"),
-            ));
+            return Err(w.value_error("area", format!("must be non-negative, got {area}")));
         }
         Ok(Wing {
             area,
-            angle: w.num_or(f, "angle", 0.0)?,
-            front_share: (w.num_or(f, "xpos", rear_x)? - rear_x) / wheelbase,
+            angle: w.num_or("angle", 0.0)?,
+            front_share: (w.num_or("xpos", rear_x)? - rear_x) / wheelbase,
         })
     };
     let wings = [wing("Front Wing")?, wing("Rear Wing")?];
 
     let engine = p.require_section("Engine")?;
-    let points = engine.section("data points").ok_or_else(|| {
-        p.error(
-            "Engine/data points",
-            Some(engine.line),
-            "missing torque curve",
-        )
-    })?;
+    let points = engine
+        .section("data points")
+        .ok_or_else(|| engine.error("Engine/data points", "missing torque curve"))?;
     let mut torque_curve = Vec::new();
     for pt in &points.sections {
-        let w = pt.require_num(f, "rpm")?;
-        let t = pt.require_num(f, "Tq")?;
+        let w = pt.require_num("rpm")?;
+        let t = pt.require_num("Tq")?;
         if let Some(&(w0, _)) = torque_curve.last()
             && w <= w0
         {
-            return Err(p.error(
-                &format!("{}/rpm", pt.path),
-                Some(pt.line_of("rpm")),
-                "engine speeds must increase",
-            ));
+            return Err(pt.value_error("rpm", "engine speeds must increase"));
         }
         torque_curve.push((w, t));
     }
     if torque_curve.len() < 2 {
-        return Err(p.error(
-            &points.path,
-            Some(points.line),
-            "the torque curve needs at least 2 points",
-        ));
+        return Err(points.error(&points.path, "the torque curve needs at least 2 points"));
     }
     let rev_limiter = positive(
         engine,
         "revs limiter",
-        engine.num_or(f, "revs limiter", engine.num_or(f, "revs maxi", 800.0)?)?,
+        engine.num_or("revs limiter", engine.num_or("revs maxi", 800.0)?)?,
     )?;
-    let tickover = engine.num_or(f, "tickover", 100.0)?;
-    let revs_max = engine.num_or(f, "revs maxi", 1000.0)?;
+    let tickover = engine.num_or("tickover", 100.0)?;
+    let revs_max = engine.num_or("revs maxi", 1000.0)?;
     if !(revs_max > tickover && revs_max.is_finite()) {
-        return Err(p.error(
-            &format!("{}/revs maxi", engine.path),
-            Some(engine.line_of("revs maxi")),
+        return Err(engine.value_error(
+            "revs maxi",
             format!("must be above the tickover ({tickover} rad/s), got {revs_max} rad/s"),
         ));
     }
-    let engine_brake = engine.num_or(f, "brake coefficient", DEFAULT_ENGINE_BRAKE)?;
+    let engine_brake = engine.num_or("brake coefficient", DEFAULT_ENGINE_BRAKE)?;
     if !(engine_brake >= 0.0 && engine_brake.is_finite()) {
-        return Err(p.error(
-            &format!("{}/brake coefficient", engine.path),
-            Some(engine.line_of("brake coefficient")),
+        return Err(engine.value_error(
+            "brake coefficient",
             format!("must be non-negative, got {engine_brake}"),
         ));
     }
-    let engine_inertia = positive(engine, "inertia", engine.num_or(f, "inertia", 0.2)?)?;
+    let engine_inertia = positive(engine, "inertia", engine.num_or("inertia", 0.2)?)?;
 
     let gearbox = p.require_section("Gearbox")?;
-    let shift_time = gearbox.num_or(f, "shift time", 0.2)?;
+    let shift_time = gearbox.num_or("shift time", 0.2)?;
     let mut gears = Vec::new();
     for i in 1..=10 {
         match gearbox.section(&format!("gears/{i}")) {
-            Some(g) => gears.push(positive(g, "ratio", g.require_num(f, "ratio")?)?),
+            Some(g) => gears.push(positive(g, "ratio", g.require_num("ratio")?)?),
             None => break,
         }
     }
     if gears.is_empty() {
-        return Err(p.error(
-            "Gearbox/gears",
-            Some(gearbox.line),
-            "no forward gears (sections 1, 2, ...)",
-        ));
+        return Err(gearbox.error("Gearbox/gears", "no forward gears (sections 1, 2, ...)"));
     }
     let drive = match sec("Drivetrain").str("type").unwrap_or("RWD") {
         "RWD" => Drive::Rear,
         "FWD" => Drive::Front,
         "4WD" => Drive::All,
         other => {
-            return Err(p.error(
-                "Drivetrain/type",
-                None,
+            return Err(sec("Drivetrain").value_error(
+                "type",
                 format!("unknown drivetrain {other:?} (RWD, FWD or 4WD)"),
             ));
         }
     };
-    let diff = |name: &str| sec(name).num_or(f, "ratio", 1.0);
+    let diff = |name: &str| sec(name).num_or("ratio", 1.0);
     let (final_drive, differential) = match drive {
         Drive::Rear => (diff("Rear Differential")?, "Rear Differential"),
         Drive::Front => (diff("Front Differential")?, "Front Differential"),
@@ -228,33 +196,29 @@ pub fn from_params(p: &Params) -> Result<Car> {
 
     let tyre = |name: &str| -> Result<Tyre> {
         let w = sec(name);
-        let rim = w.num_or(f, "rim diameter", 0.33)?;
-        let width = w.num_or(f, "tire width", 0.145)?;
-        let aspect = w.num_or(f, "tire height-width ratio", 0.75)?;
+        let rim = w.num_or("rim diameter", 0.33)?;
+        let width = w.num_or("tire width", 0.145)?;
+        let aspect = w.num_or("tire height-width ratio", 0.75)?;
         let brake = sec(&name.replace("Wheel", "Brake"));
         Ok(Tyre {
             radius: positive(w, "rim diameter", rim / 2.0 + width * aspect)?,
-            mu: positive(w, "mu", w.num_or(f, "mu", 1.0)?)?,
-            stiffness: positive(w, "stiffness", w.num_or(f, "stiffness", 30.0)?)?,
-            dynamic_friction: fraction(
-                w,
-                "dynamic friction",
-                w.num_or(f, "dynamic friction", 0.8)?,
-            )?,
-            elasticity: w.num_or(f, "elasticity factor", 0.7)?,
-            operating_load: positive(w, "operating load", w.num_or(f, "operating load", 5000.0)?)?,
+            mu: positive(w, "mu", w.num_or("mu", 1.0)?)?,
+            stiffness: positive(w, "stiffness", w.num_or("stiffness", 30.0)?)?,
+            dynamic_friction: fraction(w, "dynamic friction", w.num_or("dynamic friction", 0.8)?)?,
+            elasticity: w.num_or("elasticity factor", 0.7)?,
+            operating_load: positive(w, "operating load", w.num_or("operating load", 5000.0)?)?,
             // TORCS's simuv2 takes rolling resistance from the road's surface, not the tyre:
             // a car file without one rolls like the game's asphalt (0.001).
-            rolling_resistance: w.num_or(f, "rolling resistance", ASPHALT_ROLLING_RESISTANCE)?,
-            inertia: w.num_or(f, "inertia", 1.5)? + brake.num_or(f, "inertia", 0.13)?,
+            rolling_resistance: w.num_or("rolling resistance", ASPHALT_ROLLING_RESISTANCE)?,
+            inertia: w.num_or("inertia", 1.5)? + brake.num_or("inertia", 0.13)?,
         })
     };
     let brake = |name: &str| -> Result<Brake> {
         let b = sec(name);
         Ok(Brake {
-            disc_radius: positive(b, "disk diameter", b.num_or(f, "disk diameter", 0.2)? / 2.0)?,
-            piston_area: positive(b, "piston area", b.num_or(f, "piston area", 0.002)?)?,
-            pad_mu: positive(b, "mu", b.num_or(f, "mu", DEFAULT_PAD_MU)?)?,
+            disc_radius: positive(b, "disk diameter", b.num_or("disk diameter", 0.2)? / 2.0)?,
+            piston_area: positive(b, "piston area", b.num_or("piston area", 0.002)?)?,
+            pad_mu: positive(b, "mu", b.num_or("mu", DEFAULT_PAD_MU)?)?,
         })
     };
     let brakes = sec("Brake System");
@@ -284,19 +248,115 @@ pub fn from_params(p: &Params) -> Result<Car> {
         brake_pressure: positive(
             brakes,
             "max pressure",
-            brakes.num_or(f, "max pressure", 1.0e7)?,
+            brakes.num_or("max pressure", 1.0e7)?,
         )?,
         brake_front_share: fraction(
             brakes,
             "front-rear brake repartition",
-            brakes.num_or(f, "front-rear brake repartition", 0.5)?,
+            brakes.num_or("front-rear brake repartition", 0.5)?,
         )?,
         front_brake: brake("Front Right Brake")?,
         rear_brake: brake("Rear Right Brake")?,
         steer_lock: positive(
             sec("Steer"),
             "steer lock",
-            sec("Steer").num_or(f, "steer lock", 0.43)?,
+            sec("Steer").num_or("steer lock", 0.43)?,
         )?,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scratch() -> PathBuf {
+        std::env::temp_dir().join(format!("cdbo-car-category-{}", std::process::id()))
+    }
+
+    /// A category file (TORCS layout: `categories/CAT.xml`) with `category_extra` in its `Car`
+    /// section, and a car `cars/NAME/NAME.xml` over it with `car_extra` in its own.
+    fn car_over_category(tag: &str, category_extra: &str, car_extra: &str) -> (PathBuf, PathBuf) {
+        let dir = scratch().join(tag);
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(dir.join("categories")).unwrap();
+        std::fs::create_dir_all(dir.join("cars/test-car")).unwrap();
+        let category = dir.join("categories/test-cat.xml");
+        std::fs::write(
+            &category,
+            format!(
+                r#"<?xml version="1.0"?>
+<params name="test-cat">
+  <section name="Car">
+    <attnum name="mass" val="1000"/>
+    {category_extra}
+  </section>
+  <section name="Engine">
+    <section name="data points">
+      <section name="1"><attnum name="rpm" val="0"/><attnum name="Tq" val="100"/></section>
+      <section name="2"><attnum name="rpm" val="800"/><attnum name="Tq" val="200"/></section>
+    </section>
+  </section>
+  <section name="Gearbox"><section name="gears"><section name="1">
+    <attnum name="ratio" val="3"/>
+  </section></section></section>
+</params>
+"#
+            ),
+        )
+        .unwrap();
+        let car = dir.join("cars/test-car/test-car.xml");
+        std::fs::write(
+            &car,
+            format!(
+                r#"<?xml version="1.0"?>
+<params name="test-car">
+  <section name="Car">
+    <attstr name="category" val="test-cat"/>
+    {car_extra}
+  </section>
+</params>
+"#
+            ),
+        )
+        .unwrap();
+        (car, category)
+    }
+
+    /// A bad value names the file it is in, and its line there: the category file for a value
+    /// the car inherits from it, the car file for one the car sets.
+    #[test]
+    fn a_bad_value_names_the_file_it_came_from() {
+        let (car, _) = car_over_category("ok", "", "");
+        assert_eq!(read(&car, None).unwrap().mass, 1000.0);
+
+        let bad_number = r#"<attnum name="GC height" val="-0.3"/>"#;
+        let (car, _) = car_over_category("cat", bad_number, "");
+        let e = read(&car, None).unwrap_err().to_string();
+        let at_line_5 = "/categories/test-cat.xml:5: Car/GC height: must be positive, got -0.3";
+        assert!(e.ends_with(at_line_5) && !e.contains("test-car.xml"), "{e}");
+
+        let a_string = r#"<attstr name="front-rear weight repartition" val="half"/>"#;
+        let (car, _) = car_over_category("str", a_string, "");
+        let e = read(&car, None).unwrap_err().to_string();
+        let at_line_5 = "/categories/test-cat.xml:5: Car/front-rear weight repartition: expected a number (<attnum>), found the string \"half\"";
+        assert!(e.ends_with(at_line_5) && !e.contains("test-car.xml"), "{e}");
+
+        let (car, _) = car_over_category("car", "", r#"<attnum name="mass" val="0"/>"#);
+        let e = read(&car, None).unwrap_err().to_string();
+        let car_line_5 = format!("{}:5: Car/mass: must be positive, got 0", car.display());
+        assert!(e.starts_with(&car_line_5), "{e}");
+
+        // A value missing from both is reported at the car's own section.
+        let (car, category) = car_over_category("gone", "", "");
+        let text = std::fs::read_to_string(&category).unwrap();
+        std::fs::write(
+            &category,
+            text.replace(r#"<attnum name="mass" val="1000"/>"#, ""),
+        )
+        .unwrap();
+        let e = read(&car, None).unwrap_err().to_string();
+        let car_line_3 = format!("{}:3: Car/mass: missing required attribute", car.display());
+        assert!(e.starts_with(&car_line_3), "{e}");
+        let _ = std::fs::remove_dir_all(scratch());
+    }
 }

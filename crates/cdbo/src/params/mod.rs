@@ -15,6 +15,7 @@
 pub mod units;
 
 use std::path::Path;
+use std::sync::Arc;
 
 use crate::error::{Error, Result};
 
@@ -34,8 +35,10 @@ pub struct Attr {
     pub name: String,
     /// The value.
     pub value: Value,
-    /// 1-based line in the file.
+    /// 1-based line in its file.
     pub line: u32,
+    /// The file it was read from: after a [`Section::merge`], the car's or its category's.
+    pub file: Arc<str>,
 }
 
 /// One `<section>` (or the `<params>` root), with its attributes and sub-sections in file order.
@@ -45,8 +48,11 @@ pub struct Section {
     pub name: String,
     /// Slash-separated path from the root, used in error messages.
     pub path: String,
-    /// 1-based line in the file.
+    /// 1-based line in its file.
     pub line: u32,
+    /// The file it was read from (after a [`Section::merge`], the overlay's where it has the
+    /// section).
+    pub file: Arc<str>,
     /// Attributes in file order.
     pub attrs: Vec<Attr>,
     /// Sub-sections in file order.
@@ -91,7 +97,7 @@ impl Params {
             });
         }
         let lines = LineIndex::new(&expanded);
-        let root = read_section(&lines, root, "", file)?;
+        let root = read_section(&lines, root, "", &Arc::from(file))?;
         Ok(Params {
             file: file.to_owned(),
             root,
@@ -132,8 +138,12 @@ impl Section {
     }
 
     /// Overlays `over` on this section, as TORCS merges a car file over its category file:
-    /// attributes of `over` replace those of the same name, sub-sections merge by name.
+    /// attributes of `over` replace those of the same name, sub-sections merge by name. Each
+    /// attribute keeps the file and line it came from, so that an error about its value names
+    /// the right file; a section present in both points at `over`'s.
     pub fn merge(&mut self, over: &Section) {
+        self.file = over.file.clone();
+        self.line = over.line;
         for a in &over.attrs {
             match self.attrs.iter_mut().find(|b| b.name == a.name) {
                 Some(b) => *b = a.clone(),
@@ -154,46 +164,64 @@ impl Section {
         self.attr(name).map_or(self.line, |a| a.line)
     }
 
+    /// An error about the value of the attribute called `name` (or about the section, when it
+    /// has none), naming the file and line the value came from.
+    pub fn value_error(&self, name: &str, message: impl Into<String>) -> Error {
+        let (file, line) = self
+            .attr(name)
+            .map_or((&self.file, self.line), |a| (&a.file, a.line));
+        Error::Parse {
+            file: file.to_string(),
+            line: Some(line),
+            element: format!("{}/{}", self.path, name),
+            message: message.into(),
+        }
+    }
+
+    /// An error about this section (`element` names it or a part of it), at its own file and
+    /// line.
+    pub fn error(&self, element: &str, message: impl Into<String>) -> Error {
+        Error::Parse {
+            file: self.file.to_string(),
+            line: Some(self.line),
+            element: element.to_owned(),
+            message: message.into(),
+        }
+    }
+
     /// The attribute called `name`, if any.
     pub fn attr(&self, name: &str) -> Option<&Attr> {
         self.attrs.iter().find(|a| a.name == name)
     }
 
-    /// A number attribute in SI units, `Ok(None)` when absent, an error when it is a string.
-    pub fn num(&self, file: &str, name: &str) -> Result<Option<f64>> {
+    /// A number attribute in SI units, `Ok(None)` when absent, an error naming the attribute's
+    /// own file and line when it is a string.
+    pub fn num(&self, name: &str) -> Result<Option<f64>> {
         match self.attr(name) {
             None => Ok(None),
             Some(Attr {
                 value: Value::Num(v),
                 ..
             }) => Ok(Some(*v)),
-            Some(
-                a @ Attr {
-                    value: Value::Str(s),
-                    ..
-                },
-            ) => Err(Error::Parse {
-                file: file.to_owned(),
-                line: Some(a.line),
-                element: format!("{}/{}", self.path, name),
-                message: format!("expected a number (<attnum>), found the string {s:?}"),
-            }),
+            Some(Attr {
+                value: Value::Str(s),
+                ..
+            }) => Err(self.value_error(
+                name,
+                format!("expected a number (<attnum>), found the string {s:?}"),
+            )),
         }
     }
 
     /// A number attribute, or `default` when absent.
-    pub fn num_or(&self, file: &str, name: &str, default: f64) -> Result<f64> {
-        Ok(self.num(file, name)?.unwrap_or(default))
+    pub fn num_or(&self, name: &str, default: f64) -> Result<f64> {
+        Ok(self.num(name)?.unwrap_or(default))
     }
 
     /// A required number attribute.
-    pub fn require_num(&self, file: &str, name: &str) -> Result<f64> {
-        self.num(file, name)?.ok_or_else(|| Error::Parse {
-            file: file.to_owned(),
-            line: Some(self.line),
-            element: format!("{}/{}", self.path, name),
-            message: "missing required attribute".to_owned(),
-        })
+    pub fn require_num(&self, name: &str) -> Result<f64> {
+        self.num(name)?
+            .ok_or_else(|| self.value_error(name, "missing required attribute"))
     }
 
     /// A string attribute (a number attribute is not accepted).
@@ -212,7 +240,7 @@ fn read_section(
     lines: &LineIndex,
     node: roxmltree::Node,
     parent: &str,
-    file: &str,
+    file: &Arc<str>,
 ) -> Result<Section> {
     let line = lines.line(node.range().start);
     let name = node.attribute("name").unwrap_or_default().to_owned();
@@ -225,6 +253,7 @@ fn read_section(
         name,
         path,
         line,
+        file: file.clone(),
         ..Section::default()
     };
     for child in node.children().filter(|c| c.is_element()) {
@@ -238,7 +267,7 @@ fn read_section(
             }
         };
         let invalid = |element: String, message: String| Error::Parse {
-            file: file.to_owned(),
+            file: file.to_string(),
             line: Some(line),
             element,
             message,
@@ -276,6 +305,7 @@ fn read_section(
                     name: name.to_owned(),
                     value,
                     line,
+                    file: file.clone(),
                 });
             }
             _ => {} // unknown elements are ignored, as TORCS does
@@ -516,11 +546,11 @@ mod tests {
         let p = Params::parse(SAMPLE, "sample.xml", Some(Path::new("/nonexistent"))).unwrap();
         let a = p.section("A").unwrap();
         assert_eq!(a.line, 6);
-        assert!((a.num("f", "len").unwrap().unwrap() - 3.048).abs() < 1e-12);
+        assert!((a.num("len").unwrap().unwrap() - 3.048).abs() < 1e-12);
         assert_eq!(a.str("kind"), Some("str"));
         let b = p.section("A/B").unwrap();
         assert_eq!(b.path, "A/B");
-        assert!((b.require_num("f", "angle").unwrap() - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+        assert!((b.require_num("angle").unwrap() - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
         assert_eq!(p.warnings.len(), 1, "{:?}", p.warnings);
     }
 
@@ -592,7 +622,7 @@ mod tests {
         let p = Params::parse(SAMPLE, "sample.xml", None).unwrap();
         p.section("A")
             .unwrap()
-            .require_num(&p.file, "width")
+            .require_num("width")
             .unwrap_err()
             .to_string()
     }

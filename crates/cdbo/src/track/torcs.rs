@@ -36,7 +36,7 @@ pub fn from_params(params: &Params, source: &str, ends: Ends) -> Result<Track> {
     let file = params.file.as_str();
     let mut warnings = params.warnings.clone();
     let main = params.require_section("Main Track")?;
-    let width = main.num_or(file, "width", 15.0)?;
+    let width = main.num_or("width", 15.0)?;
     if width <= 0.0 {
         return Err(params.error(
             "Main Track/width",
@@ -44,7 +44,7 @@ pub fn from_params(params: &Params, source: &str, ends: Ends) -> Result<Track> {
             format!("width must be positive, got {width} m"),
         ));
     }
-    let global_step = main.num_or(file, "profil steps length", 0.0)?;
+    let global_step = main.num_or("profil steps length", 0.0)?;
     let layout = Layout::of(params)?;
     let segments = params.require_section(layout.segments())?;
     if segments.sections.is_empty() {
@@ -123,7 +123,7 @@ impl Layout {
 
     fn of(params: &Params) -> Result<Layout> {
         let header = params.section("Header");
-        match header.map(|h| h.num(&params.file, "version")).transpose()? {
+        match header.map(|h| h.num("version")).transpose()? {
             Some(Some(v)) if v < 4.0 => Ok(Layout::V3),
             Some(Some(_)) => Ok(Layout::V4),
             _ if params.section(Self::V4_SEGMENTS).is_none()
@@ -152,7 +152,7 @@ fn surface_friction(params: &Params, surface: &str, warnings: &mut Vec<String>) 
         .or_else(|| surfaces.and_then(|s| s.section("List")?.section(surface)));
     match found {
         Some(sec) => {
-            let f = sec.num_or(&params.file, "friction", 1.0)?;
+            let f = sec.num_or("friction", 1.0)?;
             if f <= 0.0 {
                 return Err(params.error(
                     &format!("{}/friction", sec.path),
@@ -209,7 +209,6 @@ fn segment_pieces(
     st: &mut ProfileState,
     out: &mut Vec<Piece>,
 ) -> Result<()> {
-    let file = params.file.as_str();
     let err = |field: &str, msg: String| {
         params.error(
             &format!("{}/{field}", seg.path),
@@ -222,13 +221,13 @@ fn segment_pieces(
         .ok_or_else(|| err("type", "missing segment type (str, lft or rgt)".into()))?;
     let (length, radius, radius_end, arc, sign) = match kind {
         "str" => {
-            let lg = seg.require_num(file, "lg")?;
+            let lg = seg.require_num("lg")?;
             (lg, 0.0, 0.0, 0.0, 0.0)
         }
         "lft" | "rgt" => {
-            let r = seg.require_num(file, "radius")?;
-            let r1 = seg.num_or(file, "end radius", r)?;
-            let arc = seg.require_num(file, "arc")?;
+            let r = seg.require_num("radius")?;
+            let r1 = seg.num_or("end radius", r)?;
+            let arc = seg.require_num("arc")?;
             if r <= 0.0 || r1 <= 0.0 {
                 return Err(err(
                     "radius",
@@ -264,14 +263,14 @@ fn segment_pieces(
     }
 
     // Elevation and banking (track4.cpp, "elevation and banking").
-    let mut zsl = seg.num_or(file, "z start left", st.zel)?;
-    let mut zsr = seg.num_or(file, "z start right", st.zer)?;
-    let mut zel = seg.num_or(file, "z end left", st.zel)?;
-    let mut zer = seg.num_or(file, "z end right", st.zer)?;
-    if let Some(g) = seg.num(file, "grade")? {
+    let mut zsl = seg.num_or("z start left", st.zel)?;
+    let mut zsr = seg.num_or("z start right", st.zer)?;
+    let mut zel = seg.num_or("z end left", st.zel)?;
+    let mut zer = seg.num_or("z end right", st.zer)?;
+    if let Some(g) = seg.num("grade")? {
         st.grade = Some(g);
     }
-    let zs = match seg.num(file, "z start")? {
+    let zs = match seg.num("z start")? {
         Some(z) => {
             if st.sides_follow_z {
                 (zsl, zsr) = (z, z);
@@ -280,7 +279,7 @@ fn segment_pieces(
         }
         None => 0.5 * (zsl + zsr),
     };
-    let ze = match (seg.num(file, "z end")?, st.grade) {
+    let ze = match (seg.num("z end")?, st.grade) {
         (Some(z), _) => {
             if st.sides_follow_z {
                 (zel, zer) = (z, z);
@@ -290,8 +289,8 @@ fn segment_pieces(
         (None, Some(g)) => zs + length * g,
         (None, None) => 0.5 * (zel + zer),
     };
-    let bank_s = seg.num_or(file, "banking start", (zsl - zsr).atan2(width))?;
-    let bank_e = seg.num_or(file, "banking end", (zel - zer).atan2(width))?;
+    let bank_s = seg.num_or("banking start", (zsl - zsr).atan2(width))?;
+    let bank_e = seg.num_or("banking end", (zel - zer).atan2(width))?;
     let dz = bank_s.tan() * width / 2.0;
     (zsl, zsr) = (zs + dz, zs - dz);
     let dz = bank_e.tan() * width / 2.0;
@@ -301,9 +300,9 @@ fn segment_pieces(
     let spline = seg.str("profil").unwrap_or("spline") == "spline";
     let (steps, stgtl, etgtl, stgtr, etgtr);
     if spline {
-        let mut n = seg.num_or(file, "profil steps", 1.0)? as usize;
+        let mut n = seg.num_or("profil steps", 1.0)? as usize;
         if n <= 1 {
-            let step_len = seg.num_or(file, "profil steps length", global_step)?;
+            let step_len = seg.num_or("profil steps length", global_step)?;
             n = if step_len > 0.0 {
                 (length / step_len) as usize + 1
             } else {
@@ -313,9 +312,9 @@ fn segment_pieces(
         steps = n.clamp(1, 100_000);
         // A common tangent overrides the left / right ones, which default to the previous end.
         let tangent = |common: &str, side: &str, carried: f64| -> Result<f64> {
-            match seg.num(file, common)? {
+            match seg.num(common)? {
                 Some(t) => Ok(t),
-                None => seg.num_or(file, &format!("{common} {side}"), carried),
+                None => seg.num_or(&format!("{common} {side}"), carried),
             }
         };
         stgtl = tangent("profil start tangent", "left", st.etgtl)?;
