@@ -203,6 +203,76 @@ fn a_legal_but_slow_race_says_so_first() {
     );
 }
 
+/// `optimize` and `study create` warn of a study whose optimiser will be slow, before anything
+/// is read or written (here a missing demonstration then ends each, and no study is created).
+#[test]
+fn a_legal_but_slow_study_says_so_first() {
+    let dir = fresh_dir("slow-study");
+    let cases: [(&[&str], &str); 2] = [
+        (
+            &[
+                "optimize",
+                "--laps",
+                "4000",
+                "--kernels",
+                "100",
+                "--db",
+                "s.db",
+                "--demo",
+                "gone.csv",
+                "--evaluator",
+                "echo 1",
+            ],
+            "warning: 100 kernels and 4000 laps: expect the optimiser to take about 2.1 h",
+        ),
+        (
+            &[
+                "study",
+                "create",
+                "s",
+                "--db",
+                "s.db",
+                "--kernels",
+                "1000",
+                "--demo",
+                "gone.csv",
+            ],
+            "warning: 1000 kernels and 300 laps: expect the optimiser to take about 3 min",
+        ),
+    ];
+    for (args, first) in cases {
+        let out = cdbo(&dir, args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        let mut lines = err.lines();
+        assert!(
+            lines.next().unwrap_or_default().starts_with(first),
+            "{args:?}: {err}"
+        );
+        assert!(
+            lines.next().unwrap_or_default().contains("gone.csv"),
+            "{err}"
+        );
+        assert!(!dir.join("s.db").exists());
+    }
+    // The paper's sizes say nothing.
+    let out = cdbo(
+        &dir,
+        &[
+            "study",
+            "create",
+            "s",
+            "--db",
+            "s.db",
+            "--kernels",
+            "30",
+            "--demo",
+            "gone.csv",
+        ],
+    );
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("warning"));
+}
+
 /// `cdbo optimize` on study `db` to `laps` told trials, every lap driven appended to
 /// `driven.log`.
 fn optimize(db: &str, laps: &str) -> Command {

@@ -134,22 +134,60 @@ pub fn race_bytes(kernels: usize, laps: usize) -> f64 {
     8.0 * (4.0 * n * n + 2.0 * n * m)
 }
 
+/// Seconds the optimiser of a study takes over `laps` suggestions with `kernels` weights on one
+/// free core, besides the laps themselves (an external evaluator's time is not cdbo's to
+/// know), roughly: one CDBO suggestion over n observations costs about 3 µs · M · n (the
+/// acquisition's coordinate scans), summed over the laps 1.5e-6 · M · n², and the GP's refits
+/// 8e-8 · n³ as in [`race_seconds`]. Calibrated on `cdbo bench suggest`: 300 observations in
+/// 30, 300 and 1000 dimensions ≈ 0.04, 0.3 and 0.9 s per suggestion.
+pub fn study_seconds(kernels: usize, laps: usize) -> f64 {
+    let (m, n) = (kernels as f64, laps as f64);
+    1.5e-6 * m * n * n + 8e-8 * n * n * n
+}
+
+/// The laps a study's warning assumes when none are given (`study create`): the paper's
+/// budget.
+pub const STUDY_LAPS_ASSUMED: usize = 300;
+
 /// A warning for a legal race that will be slow (over a minute) or large (over 1 GiB), with
 /// the estimate; `None` for an ordinary one.
 pub fn slow_race_warning(kernels: usize, laps: usize) -> Option<String> {
-    let (s, b) = (race_seconds(kernels, laps), race_bytes(kernels, laps));
-    if s < 60.0 && b < (1u64 << 30) as f64 {
+    slow_warning(
+        race_seconds(kernels, laps),
+        race_bytes(kernels, laps),
+        |time, mb| {
+            format!(
+                "{kernels} kernels and {laps} laps: expect about {time} on one free core and {mb} of memory (the GP's cost grows as laps³, the simulator's as kernels²)"
+            )
+        },
+    )
+}
+
+/// A warning for a legal study whose optimiser will be slow (over a minute, besides the laps)
+/// or large (over 1 GiB) over `laps` laps, with the estimate; `None` for an ordinary one.
+pub fn slow_study_warning(kernels: usize, laps: usize) -> Option<String> {
+    slow_warning(
+        study_seconds(kernels, laps),
+        race_bytes(kernels, laps),
+        |time, mb| {
+            format!(
+                "{kernels} kernels and {laps} laps: expect the optimiser to take about {time} on one free core besides the laps themselves, and {mb} of memory (the GP's cost grows as laps³, each suggestion's as kernels × laps)"
+            )
+        },
+    )
+}
+
+/// The warning `say(time, memory)` when `seconds` is over a minute or `bytes` over 1 GiB.
+fn slow_warning(seconds: f64, bytes: f64, say: impl Fn(&str, &str) -> String) -> Option<String> {
+    if seconds < 60.0 && bytes < (1u64 << 30) as f64 {
         return None;
     }
-    let time = if s < 3600.0 {
-        format!("{:.0} min", (s / 60.0).ceil())
+    let time = if seconds < 3600.0 {
+        format!("{:.0} min", (seconds / 60.0).ceil())
     } else {
-        format!("{:.1} h", s / 3600.0)
+        format!("{:.1} h", seconds / 3600.0)
     };
-    Some(format!(
-        "{kernels} kernels and {laps} laps: expect about {time} on one free core and {:.0} MB of memory (the GP's cost grows as laps³, the simulator's as kernels²)",
-        b / 1e6
-    ))
+    Some(say(&time, &format!("{:.0} MB", bytes / 1e6)))
 }
 
 #[cfg(test)]
@@ -172,5 +210,21 @@ mod tests {
         let w = slow_race_warning(100, 5000).unwrap();
         assert!(w.contains("5000 laps") && w.contains(" h "), "{w}");
         assert!(slow_race_warning(1000, 300).is_some());
+    }
+
+    /// A study's estimate counts only the optimiser: 30 kernels over the paper's 300 laps is
+    /// about 6 s, 1000 kernels about 2.3 min, 100 kernels over 4000 laps two hours.
+    #[test]
+    fn a_large_study_is_slow_in_the_optimiser_alone() {
+        assert!((study_seconds(30, 300) - 6.21).abs() < 1e-9);
+        assert_eq!(slow_study_warning(30, STUDY_LAPS_ASSUMED), None);
+        assert_eq!(slow_study_warning(300, STUDY_LAPS_ASSUMED), None);
+        let w = slow_study_warning(1000, STUDY_LAPS_ASSUMED).unwrap();
+        assert!(
+            w.starts_with("1000 kernels and 300 laps: expect the optimiser to take about 3 min"),
+            "{w}"
+        );
+        let w = slow_study_warning(100, 4000).unwrap();
+        assert!(w.contains("about 2.1 h") && w.contains("518 MB"), "{w}");
     }
 }

@@ -241,6 +241,10 @@ pub fn run(cmd: &StudyCommand) -> CliResult {
             initial,
             track,
         } => {
+            let laps = cdbo::sizes::STUDY_LAPS_ASSUMED;
+            if let Some(w) = cdbo::sizes::slow_study_warning(initial.kernels, laps) {
+                eprintln!("warning: {w}; {laps} laps assumed, the paper's budget");
+            }
             let mut config = initial.config()?;
             config.track = track.clone();
             let s = Study::create_at(&study.location()?, config)?;
