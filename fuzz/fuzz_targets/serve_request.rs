@@ -13,7 +13,7 @@ const DIM: usize = 3;
 struct Checked;
 
 impl Evaluator for Checked {
-    fn evaluate(&mut self, weights: &[f64]) -> cdbo::Result<Outcome> {
+    fn evaluate(&mut self, _trial: i64, weights: &[f64]) -> cdbo::Result<Outcome> {
         assert_eq!(weights.len(), DIM);
         assert!(weights.iter().all(|w| w.is_finite()));
         Ok(Outcome::Reward(weights.iter().sum::<f64>().clamp(-1e300, 1e300)))

@@ -245,7 +245,7 @@ impl<E: Evaluator> Server<E> {
         let reply = match request {
             Ok(None) => return None,
             Ok(Some(Request::Info)) => Ok(Reply::Info(self.info.clone())),
-            Ok(Some(Request::Lap { weights })) => self.lap(&weights),
+            Ok(Some(Request::Lap { weights })) => self.lap(k, &weights),
             Err(e) => Err(e.to_string()),
         };
         Some(reply.unwrap_or_else(|e| Reply::Error {
@@ -253,11 +253,13 @@ impl<E: Evaluator> Server<E> {
         }))
     }
 
-    /// One lap with `weights`, as replied.
-    fn lap(&mut self, weights: &[f64]) -> Result<Reply, String> {
+    /// One lap with `weights`, as replied; the evaluator's trial number is the request's line
+    /// number `k`.
+    fn lap(&mut self, k: u64, weights: &[f64]) -> Result<Reply, String> {
+        let trial = i64::try_from(k).unwrap_or(i64::MAX);
         let outcome = self
             .evaluator
-            .evaluate(weights)
+            .evaluate(trial, weights)
             .map_err(|e| e.to_string())?;
         let reward_mps = outcome.reward().map_err(|e| e.to_string())?;
         Ok(match outcome {
@@ -315,7 +317,7 @@ mod tests {
     struct Sign;
 
     impl Evaluator for Sign {
-        fn evaluate(&mut self, weights: &[f64]) -> Result<Outcome> {
+        fn evaluate(&mut self, _trial: i64, weights: &[f64]) -> Result<Outcome> {
             Ok(if weights[0] > 0.0 {
                 Outcome::Lap {
                     time_s: 50.0,

@@ -238,10 +238,16 @@ impl Storage for Sqlite {
 impl Sqlite {
     fn dump_rows(&self) -> Result<Vec<Row>> {
         let err = |e| sql_error(&self.path, e);
+        // A schema-1 study opened read-only is read as it is: it has no claim columns.
+        let claims = if user_version(&self.conn).map_err(err)? >= 2 {
+            "owner, lease_until_unix_s"
+        } else {
+            "NULL, NULL"
+        };
         let mut stmt = self
             .conn
             .prepare(&format!(
-                "SELECT {TRIAL_COLUMNS}, asked_unix_s, told_unix_s, owner, lease_until_unix_s FROM trials ORDER BY id"
+                "SELECT {TRIAL_COLUMNS}, asked_unix_s, told_unix_s, {claims} FROM trials ORDER BY id"
             ))
             .map_err(err)?;
         let rows = stmt
