@@ -17,7 +17,7 @@ fn scratch(name: &str) -> PathBuf {
 
 fn config() -> StudyConfig {
     StudyConfig {
-        method: "cdbo".into(),
+        method: cdbo::optimizers::Method::Cdbo,
         kernels: 4,
         lengthscale: 1.0 / 3.0,
         seed: 7,
