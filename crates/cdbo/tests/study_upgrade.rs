@@ -23,6 +23,7 @@ fn config() -> StudyConfig {
         seed: 7,
         beta: 1.0,
         w0: vec![0.1, -0.2, 0.3, 0.05],
+        track: None,
     }
 }
 
