@@ -89,21 +89,26 @@ impl Session {
                 Err(e) if e.kind() == std::io::ErrorKind::NotFound => continue,
                 Err(source) => return Err(Error::Io { path, source }),
             };
-            for (i, line) in text
-                .lines()
-                .enumerate()
-                .filter(|(_, l)| !l.trim().is_empty())
-            {
-                let session = serde_json::from_str(line).map_err(|e| Error::Parse {
-                    file: path.display().to_string(),
+            sessions.extend(Session::parse_log(&text, &path.display().to_string())?);
+        }
+        Ok(sessions)
+    }
+
+    /// The sessions of one log's text, one JSON object per line (blank lines skipped); `file`
+    /// names the log in the error, with the line.
+    pub fn parse_log(text: &str, file: &str) -> Result<Vec<Session>> {
+        text.lines()
+            .enumerate()
+            .filter(|(_, l)| !l.trim().is_empty())
+            .map(|(i, line)| {
+                serde_json::from_str(line).map_err(|e| Error::Parse {
+                    file: file.to_string(),
                     line: u32::try_from(i + 1).ok(),
                     element: "session".into(),
                     message: format!("not a session line: {e}"),
-                })?;
-                sessions.push(session);
-            }
-        }
-        Ok(sessions)
+                })
+            })
+            .collect()
     }
 }
 

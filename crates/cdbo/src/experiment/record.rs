@@ -81,8 +81,13 @@ impl RunRecord {
             path: path.to_owned(),
             source,
         })?;
-        serde_json::from_str(&text).map_err(|e| Error::Parse {
-            file: path.display().to_string(),
+        RunRecord::parse(&text, &path.display().to_string())
+    }
+
+    /// A run record from its JSON text; `file` names it in the error.
+    pub fn parse(text: &str, file: &str) -> Result<RunRecord> {
+        serde_json::from_str(text).map_err(|e| Error::Parse {
+            file: file.to_string(),
             line: u32::try_from(e.line()).ok().filter(|&l| l > 0),
             element: "run record".into(),
             message: format!("not a cdbo run record: {e}"),
