@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 mod common;
 
-use common::{CDBO, demo, fresh_dir, ok, refused};
+use common::{CDBO, demo, fresh_dir, kill_first_and_reap, ok, refused};
 
 /// The password of the test server's superuser `cdbo`.
 const PASSWORD: &str = "lap-secret";
@@ -238,7 +238,7 @@ fn three_workers(trials: usize, method: &str) {
             .spawn()
             .unwrap()
     };
-    let mut workers: Vec<Child> = (0..3).map(|_| spawn()).collect();
+    let workers: Vec<Child> = (0..3).map(|_| spawn()).collect();
     while driven(&dir) < trials / 2 {
         assert!(
             start.elapsed() < Duration::from_secs(600),
@@ -246,15 +246,7 @@ fn three_workers(trials: usize, method: &str) {
         );
         std::thread::sleep(Duration::from_millis(20));
     }
-    workers[0].kill().unwrap();
-    for (k, w) in workers.into_iter().enumerate() {
-        let out = w.wait_with_output().unwrap();
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert!(!err.contains("panicked"), "{err}");
-        if k > 0 {
-            assert!(out.status.success(), "worker {k}: {err}");
-        }
-    }
+    kill_first_and_reap(workers);
     let h = history(&dir, "workers", &server.url());
     assert_eq!(h.len(), trials, "{h:?}");
     assert!(h.iter().all(|t| t["reward"].is_number()), "{h:?}");

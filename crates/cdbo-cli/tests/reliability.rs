@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 
 mod common;
 
-use common::{CDBO, cdbo, demo, fresh_dir, history, ok, refused};
+use common::{CDBO, cdbo, demo, fresh_dir, history, kill_first_and_reap, ok, refused};
 
 #[test]
 fn every_size_has_a_bound_and_every_number_a_domain() {
@@ -328,22 +328,14 @@ fn three_workers_one_killed_drive_each_trial_once() {
             .spawn()
             .unwrap()
     };
-    let mut workers: Vec<Child> = (0..3).map(|_| spawn()).collect();
+    let workers: Vec<Child> = (0..3).map(|_| spawn()).collect();
     // Kill the first once a few trials are told.
     let start = Instant::now();
     while std::fs::read_to_string(dir.join("driven.log")).map_or(0, |t| t.lines().count()) < 6 {
         assert!(start.elapsed() < Duration::from_secs(60), "no laps driven");
         std::thread::sleep(Duration::from_millis(20));
     }
-    workers[0].kill().unwrap();
-    for (k, w) in workers.into_iter().enumerate() {
-        let out = w.wait_with_output().unwrap();
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert!(!err.contains("panicked"), "{err}");
-        if k > 0 {
-            assert!(out.status.success(), "worker {k}: {err}");
-        }
-    }
+    kill_first_and_reap(workers);
     every_trial_told_once_and_distinct(&history(&dir, "w.db"), trials);
     let driven = std::fs::read_to_string(dir.join("driven.log"))
         .unwrap()

@@ -66,3 +66,17 @@ pub fn history(dir: &Path, db: &str) -> Vec<serde_json::Value> {
     let text = ok(dir, &["study", "history", "s", "--db", db, "--json"]);
     serde_json::from_str(&text).unwrap()
 }
+
+/// Kills the first of `workers` (SIGKILL, mid-lap) and waits for them all: none panicked, and
+/// every survivor ended successfully.
+pub fn kill_first_and_reap(mut workers: Vec<std::process::Child>) {
+    workers[0].kill().unwrap();
+    for (k, w) in workers.into_iter().enumerate() {
+        let out = w.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!err.contains("panicked"), "{err}");
+        if k > 0 {
+            assert!(out.status.success(), "worker {k}: {err}");
+        }
+    }
+}
