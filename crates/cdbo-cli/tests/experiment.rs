@@ -97,6 +97,52 @@ fn results_do_not_depend_on_jobs_and_shards_merge() {
     }
 }
 
+/// Every run records the ceiling (the tracked limit profile's lap, as `cdbo ceiling`
+/// prints it) and `report` gives the best as % of it; records written before the ceiling was
+/// stored still parse, and their cells show no percentage.
+#[test]
+fn report_gives_the_percentage_of_the_ceiling_and_reads_old_records() {
+    let dir = setup("ceiling");
+    ok(&dir, &["experiment", "grid.toml", "--out", "new"]);
+    let ceiling = ok(&dir, &["ceiling", "--track", "ridgeway", "--kernels", "6"]);
+    let old = dir.join("old/runs");
+    std::fs::create_dir_all(&old).unwrap();
+    let mut cdbo_best = Vec::new();
+    let mut recorded = Vec::new();
+    for entry in std::fs::read_dir(dir.join("new/runs")).unwrap() {
+        let path = entry.unwrap().path();
+        let mut v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        recorded.push(v["ceiling_reward_mps"].as_f64().unwrap());
+        if v["spec"]["method"] == "cdbo" {
+            cdbo_best.push(v["best_reward_mps"].as_f64().unwrap());
+        }
+        v.as_object_mut().unwrap().remove("ceiling_reward_mps");
+        std::fs::write(old.join(path.file_name().unwrap()), v.to_string()).unwrap();
+    }
+    let c = recorded[0];
+    assert!(recorded.iter().all(|&r| r == c), "{recorded:?}");
+    assert!(ceiling.contains(&format!("{c:.2}")), "{c} not in {ceiling}");
+    ok(&dir, &["report", "new", "--out", "new-report"]);
+    let results = std::fs::read_to_string(dir.join("new-report/results.md")).unwrap();
+    let mean = cdbo_best.iter().sum::<f64>() / cdbo_best.len() as f64;
+    let row = results
+        .lines()
+        .find(|l| l.starts_with("| ridgeway | 6 | cdbo |"))
+        .unwrap();
+    assert!(
+        row.contains(&format!("| {:.1} |", 100.0 * mean / c)),
+        "{row} ({mean} of {c})"
+    );
+    ok(&dir, &["report", "old", "--out", "old-report"]);
+    let results = std::fs::read_to_string(dir.join("old-report/results.md")).unwrap();
+    let row = results
+        .lines()
+        .find(|l| l.starts_with("| ridgeway | 6 | cdbo |"))
+        .unwrap();
+    assert!(row.contains("| – |"), "{row}");
+}
+
 #[test]
 fn an_interrupted_grid_resumes_with_the_missing_runs() {
     let dir = setup("resume");

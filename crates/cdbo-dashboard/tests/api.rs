@@ -102,6 +102,7 @@ fn run_record(method: &str, repeat: usize, rewards: &[f64]) -> RunRecord {
         demo_speed: 15.0,
         demo_reward_mps: 14.0,
         limit_reward_mps: 40.0,
+        ceiling_reward_mps: None,
         initial_reward_mps: rewards[0],
         best_reward_mps: best,
         best_weights: vec![0.1 * (repeat as f64 + 1.0); KERNELS],

@@ -349,19 +349,29 @@ fn results_md(
         };
         let _ = writeln!(s, "- {}: {verdict}. {}", c.statement, c.evidence);
     }
-    s += "\n## Final best reward (m/s), mean ± standard error\n\n| track | kernels | method | runs | best | × demonstration | % of limit |\n|---|---:|---|---:|---:|---:|---:|\n";
+    s += "\n## Final best reward (m/s), mean ± standard error\n\n% of the ceiling: of the tracked limit profile's lap (`cdbo ceiling`), where the runs recorded it; failed laps: mean per run.\n\n| track | kernels | method | runs | best | × demonstration | % of limit | % of ceiling | failed laps |\n|---|---:|---|---:|---:|---:|---:|---:|---:|\n";
     let demos = cell_means(records, |r| r.demo_reward_mps);
     let limits = cell_means(records, |r| r.limit_reward_mps);
+    let ceilings = cell_means(records, |r| r.ceiling_reward_mps.unwrap_or(f64::NAN));
+    let failed = cell_means(records, |r| {
+        r.laps.iter().filter(|l| l.failure.is_some()).count() as f64
+    });
     for (cell, curve) in curves {
         let (t, m, method) = cell;
-        let (demo, limit) = (demos[cell], limits[cell]);
+        let (demo, limit, ceiling) = (demos[cell], limits[cell], ceilings[cell]);
         let (mean, se) = curve.last();
+        let of_ceiling = if ceiling.is_finite() {
+            format!("{:.1}", 100.0 * mean / ceiling)
+        } else {
+            "–".into()
+        };
         let _ = writeln!(
             s,
-            "| {t} | {m} | {method} | {} | {mean:.2} ± {se:.2} | {:.2} | {:.1} |",
+            "| {t} | {m} | {method} | {} | {mean:.2} ± {se:.2} | {:.2} | {:.1} | {of_ceiling} | {:.0} |",
             curve.runs,
             mean / demo,
-            100.0 * mean / limit
+            100.0 * mean / limit,
+            failed[cell]
         );
     }
     s += "\n## Run times (Table 1)\n\n";

@@ -30,6 +30,11 @@ pub struct RunRecord {
     pub demo_reward_mps: f64,
     /// Reward of the limit lap.
     pub limit_reward_mps: f64,
+    /// Reward of the ceiling: the tracked limit profile's lap
+    /// ([`tracked_profile`](crate::ceiling::tracked_profile)); absent in records written
+    /// before it was stored.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ceiling_reward_mps: Option<f64>,
     /// Reward of the initial policy π(w₀).
     pub initial_reward_mps: f64,
     /// Best reward.
@@ -140,7 +145,9 @@ pub fn run(
         sigma0: grid.sigma0.get(&method).copied(),
     };
     let (track_name, length_m) = (track.name.clone(), track.length);
+    let ceiling_sim = crate::sim::Simulator::new(track.clone(), car);
     let outcome = race(track, car, &config, progress)?;
+    let (_, ceiling_mps) = crate::ceiling::tracked_profile(&ceiling_sim, &outcome.limit)?;
     Ok(RunRecord {
         spec: spec.clone(),
         laps_planned: grid.laps,
@@ -149,6 +156,7 @@ pub fn run(
         demo_speed: grid.demo_speed,
         demo_reward_mps: outcome.demo.reward_mps,
         limit_reward_mps: outcome.limit.reward_mps,
+        ceiling_reward_mps: Some(ceiling_mps),
         initial_reward_mps: outcome.laps.first().map_or(0.0, |l| l.reward_mps),
         best_reward_mps: outcome.best_reward_mps,
         best_weights: outcome.best.weights.clone(),
