@@ -183,3 +183,118 @@ fn bad_grids_and_shards_are_clear_errors() {
         String::from_utf8_lossy(&cdbo(&dir, &["experiment", "typo.toml"]).stderr).into_owned();
     assert!(err.contains("typo.toml") && err.contains("repeat"), "{err}");
 }
+
+/// The runs of a grid in an SQLite file, filled by two workers at once: the same laps as the
+/// grid run into a folder, each cell once; the report from the file equals the folder's
+/// where it does not time; a finished grid runs nothing more, and a different grid under the
+/// same file, a study file or a missing grid are refused.
+#[test]
+fn workers_fill_a_grid_in_an_sqlite_file() {
+    let dir = setup("workers");
+    ok(
+        &dir,
+        &["experiment", "grid.toml", "--out", "one", "--jobs", "1"],
+    );
+    let stored = ok(&dir, &["experiment", "grid.toml", "--storage", "g.db"]);
+    assert!(
+        stored.contains("4 runs in the grid at g.db: 0 finished"),
+        "{stored}"
+    );
+    let workers: Vec<_> = (0..2)
+        .map(|_| {
+            std::process::Command::new(common::CDBO)
+                .args([
+                    "experiment",
+                    "grid.toml",
+                    "--storage",
+                    "g.db",
+                    "--worker",
+                    "--jobs",
+                    "1",
+                ])
+                .current_dir(&dir)
+                .output()
+                .expect("runs")
+        })
+        .collect();
+    let mut ran = Vec::new();
+    for w in &workers {
+        assert!(w.status.success(), "{}", String::from_utf8_lossy(&w.stderr));
+        let out = String::from_utf8_lossy(&w.stdout);
+        ran.extend(
+            out.lines()
+                .filter_map(|l| l.strip_prefix("ran ")?.split(':').next().map(String::from)),
+        );
+    }
+    ran.sort();
+    assert_eq!(ran.len(), 4, "{ran:?}");
+    ran.dedup();
+    assert_eq!(ran.len(), 4, "a cell ran twice: {ran:?}");
+    let again = ok(
+        &dir,
+        &["experiment", "grid.toml", "--storage", "g.db", "--worker"],
+    );
+    assert!(again.contains("0 runs done"), "{again}");
+    ok(
+        &dir,
+        &[
+            "report",
+            "--storage",
+            "g.db",
+            "--out",
+            "rep",
+            "--export",
+            "exported",
+        ],
+    );
+    assert_eq!(laps(&dir.join("exported")), laps(&dir.join("one")));
+    ok(&dir, &["report", "one", "--out", "rep-one"]);
+    let table = |d: &str| {
+        let t = std::fs::read_to_string(dir.join(d).join("results.md")).unwrap();
+        t[t.find("## Final best").unwrap()..t.find("## Run times").unwrap()].to_owned()
+    };
+    assert_eq!(table("rep"), table("rep-one"));
+    // Refusals, each one line, nothing written.
+    std::fs::write(dir.join("other.toml"), GRID.replace("laps = 8", "laps = 9")).unwrap();
+    common::refused(
+        &dir,
+        &["experiment", "other.toml", "--storage", "g.db", "--worker"],
+        &["g.db", "a different grid"],
+    );
+    ok(&dir, &["report", "--storage", "g.db", "--out", "rep-after"]);
+    assert_eq!(
+        std::fs::read_to_string(dir.join("rep-after/results.md")).unwrap(),
+        std::fs::read_to_string(dir.join("rep/results.md")).unwrap(),
+        "the refused worker changed the grid"
+    );
+    common::demo(&dir);
+    ok(
+        &dir,
+        &[
+            "study",
+            "create",
+            "s",
+            "--kernels",
+            "6",
+            "--demo",
+            "demo.csv",
+        ],
+    );
+    common::refused(
+        &dir,
+        &[
+            "experiment",
+            "grid.toml",
+            "--storage",
+            "s.cdbo.db",
+            "--worker",
+        ],
+        &["s.cdbo.db", "not a cdbo grid", "without a grid"],
+    );
+    common::refused(
+        &dir,
+        &["report", "--storage", "none.db"],
+        &["none.db", "no such grid"],
+    );
+    assert!(!dir.join("none.db").exists());
+}

@@ -1,7 +1,9 @@
-//! Studies in a real PostgreSQL server (Debian's `postgresql`): each test starts its own
-//! server (`initdb` + `pg_ctl` into a temporary folder, as `nobody` when run as root,
-//! password authentication, a free port on 127.0.0.1) and stops it after. Where PostgreSQL is
-//! not installed, the tests say so and pass: `.ci/run` installs it when `CI` is set.
+//! Studies and grids in a real PostgreSQL server (Debian's `postgresql`): each test starts its
+//! own server (`initdb` + `pg_ctl` into a folder of its own under the target folder, as
+//! `nobody` when run as root, password authentication, a free port on 127.0.0.1) and stops it
+//! when the test ends, passes or panics (a drop guard); a server left running by a test run
+//! that was killed is stopped by the next run of that test. Where PostgreSQL is not installed,
+//! the tests say so and pass: `.ci/run` installs it when `CI` is set.
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
@@ -14,7 +16,7 @@ use common::{CDBO, demo, fresh_dir, kill_first_and_reap, ok, refused};
 /// The password of the test server's superuser `cdbo`.
 const PASSWORD: &str = "lap-secret";
 
-/// A PostgreSQL server of its own, stopped and removed on drop.
+/// A PostgreSQL server of its own, stopped and removed on drop (also when the test panics).
 struct Server {
     bin: PathBuf,
     dir: PathBuf,
@@ -50,11 +52,22 @@ impl Server {
             );
             return None;
         };
-        let dir = std::env::temp_dir().join(format!("cdbo-pg-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
+        // A fixed folder per test: a server that a killed run of this test left running is
+        // found there and stopped before the folder is made afresh.
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("pg-{name}"));
+        let as_nobody = unsafe { libc::geteuid() } == 0;
+        let stale = Server {
+            bin: bin.clone(),
+            dir: dir.clone(),
+            port: 0,
+            as_nobody,
+        };
+        if dir.join("data").join("postmaster.pid").exists() {
+            eprintln!("stopping the server a killed run left in {}", dir.display());
+        }
+        drop(stale);
         std::fs::create_dir_all(&dir).unwrap();
         std::fs::write(dir.join("pw"), PASSWORD).unwrap();
-        let as_nobody = unsafe { libc::geteuid() } == 0;
         if as_nobody {
             let ok = Command::new("chown")
                 .args(["-R", "nobody", dir.to_str().unwrap()])
@@ -155,8 +168,13 @@ impl Server {
 }
 
 impl Drop for Server {
+    /// Stops the server (if one runs in its folder) and removes the folder.
     fn drop(&mut self) {
         let data = self.dir.join("data");
+        if !data.join("postmaster.pid").exists() {
+            let _ = std::fs::remove_dir_all(&self.dir);
+            return;
+        }
         let _ = self
             .command("pg_ctl")
             .args([
@@ -435,8 +453,8 @@ fn a_trial_told_twice_is_refused() {
 }
 
 /// Bad input — an unreachable database, wrong credentials, a schema from a newer version, an
-/// unknown scheme, a study that does not exist — is one clear line each, and nothing is
-/// written.
+/// unknown scheme, a study or grid that does not exist — is one clear line each, for studies,
+/// grid workers and reports, and nothing is written.
 #[test]
 fn bad_databases_are_one_line_and_write_nothing() {
     let Some(server) = Server::start("bad") else {
@@ -484,12 +502,46 @@ fn bad_databases_are_one_line_and_write_nothing() {
         create("mysql://cdbo@127.0.0.1/db"),
         &["mysql://", "postgresql://"],
     );
+    // The same for a grid's workers and its report.
+    let worker = |storage: &str| -> Vec<String> {
+        ["experiment", "quick", "--storage", storage, "--worker"]
+            .map(String::from)
+            .to_vec()
+    };
+    let report = |storage: &str| -> Vec<String> {
+        ["report", "--storage", storage].map(String::from).to_vec()
+    };
+    run(
+        worker(&unreachable),
+        &["error connecting to server", "#quick", "cdbo:***@"],
+    );
+    run(
+        report(&format!("{unreachable}#quick")),
+        &["error connecting to server", "#quick", "cdbo:***@"],
+    );
+    run(
+        worker(&server.url_with("wrong")),
+        &["password authentication failed", "cdbo:***@"],
+    );
+    run(
+        worker("mysql://cdbo@127.0.0.1/db"),
+        &["mysql://", "postgresql://"],
+    );
+    run(report(&server.url()), &["study or grid name", "#NAME"]);
+    assert!(
+        !dir.join("runs").exists(),
+        "a refused report wrote its folder"
+    );
     // A database without any study: reading is "no such study", and creates no table.
     run(
         ["study", "status", "s", "--storage", &server.url()]
             .map(String::from)
             .to_vec(),
         &["no such study"],
+    );
+    run(
+        report(&format!("{}#quick", server.url())),
+        &["no such grid", "#quick"],
     );
     let mut client = server.client();
     let tables = |client: &mut postgres::Client| -> i64 {
@@ -524,7 +576,10 @@ fn bad_databases_are_one_line_and_write_nothing() {
             )
             .unwrap();
         let trials: i64 = client
-            .query_one("SELECT COUNT(*) FROM cdbo_trials", &[])
+            .query_one(
+                "SELECT (SELECT COUNT(*) FROM cdbo_trials) + (SELECT COUNT(*) FROM cdbo_grids)",
+                &[],
+            )
             .unwrap()
             .get(0);
         format!(
@@ -547,8 +602,150 @@ fn bad_databases_are_one_line_and_write_nothing() {
             .map(String::from)
             .to_vec(),
         create(&format!("{}#other", server.url())),
+        worker(&server.url()),
+        report(&format!("{}#quick", server.url())),
     ] {
         run(args, &["newer cdbo (study schema 99, this version reads"]);
     }
     assert_eq!(dump(&mut client), before);
+}
+
+/// The "Final best reward" table of a report's results.md: the rewards, not the timings.
+fn rewards_table(report: &Path) -> String {
+    let text = std::fs::read_to_string(report.join("results.md")).unwrap();
+    let start = text.find("## Final best reward").expect("a rewards table");
+    let end = text[start..]
+        .find("## Run times")
+        .expect("run times after it")
+        + start;
+    text[start..end].to_owned()
+}
+
+/// Two workers fill the quick grid in PostgreSQL, one killed with SIGKILL while it runs a
+/// cell: every cell is finished once (the killed worker's cell is run again by the other, at
+/// once, its owner being a dead process of this host), a worker started on the finished grid
+/// runs nothing, and the report from the database equals the report of the grid run on one
+/// machine into a folder.
+#[test]
+fn two_workers_fill_the_quick_grid_one_killed() {
+    let Some(server) = Server::start("grid") else {
+        return;
+    };
+    let dir = fresh_dir("grid");
+    ok(
+        &dir,
+        &["experiment", "quick", "--out", "one", "--jobs", "2"],
+    );
+    ok(&dir, &["report", "one", "--out", "report-one"]);
+    let storage = format!("{}#quick", server.url());
+    let spawn = || {
+        Command::new(CDBO)
+            .args([
+                "experiment",
+                "quick",
+                "--storage",
+                &storage,
+                "--worker",
+                "--jobs",
+                "1",
+            ])
+            .current_dir(&dir)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap()
+    };
+    let workers: Vec<Child> = (0..2).map(|_| spawn()).collect();
+    let victim = workers[0].id();
+    let mut client = server.client();
+    // Kill the first worker while it holds an unfinished cell, once a few cells are done.
+    let start = Instant::now();
+    loop {
+        assert!(start.elapsed() < Duration::from_secs(300), "no cell held");
+        let row = client
+            .query_opt(
+                "SELECT (SELECT COUNT(*) FROM cdbo_grid_runs WHERE record IS NOT NULL),
+                        (SELECT COUNT(*) FROM cdbo_grid_runs WHERE record IS NULL AND split_part(owner, '/', 2) = $1)",
+                &[&victim.to_string()],
+            )
+            .ok()
+            .flatten();
+        if let Some(row) = row
+            && row.get::<_, i64>(0) >= 4
+            && row.get::<_, i64>(1) == 1
+        {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let mut workers = workers.into_iter();
+    let mut killed = workers.next().unwrap();
+    killed.kill().unwrap();
+    let killed = killed.wait_with_output().unwrap();
+    let survivor = workers.next().unwrap().wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&survivor.stderr);
+    assert!(survivor.status.success(), "{err}");
+    // Every cell run to the end once, by one worker or the other.
+    let mut ran: Vec<String> = [&killed.stdout, &survivor.stdout]
+        .iter()
+        .flat_map(|out| {
+            String::from_utf8_lossy(out)
+                .lines()
+                .filter_map(|l| l.strip_prefix("ran ")?.split(':').next().map(String::from))
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    ran.sort();
+    let mut cells: Vec<String> = client
+        .query(
+            "SELECT run FROM cdbo_grid_runs WHERE record IS NOT NULL",
+            &[],
+        )
+        .unwrap()
+        .iter()
+        .map(|r| r.get(0))
+        .collect();
+    cells.sort();
+    assert_eq!(cells.len(), 16);
+    assert_eq!(ran, cells, "each cell run once");
+    eprintln!(
+        "2 workers, one killed mid-cell: {} + {} cells ran",
+        String::from_utf8_lossy(&killed.stdout)
+            .matches("\nran ")
+            .count(),
+        String::from_utf8_lossy(&survivor.stdout)
+            .matches("\nran ")
+            .count()
+    );
+    // The finished grid: a new worker runs nothing.
+    let again = ok(
+        &dir,
+        &["experiment", "quick", "--storage", &storage, "--worker"],
+    );
+    assert!(
+        again.contains("16 finished") && again.contains("0 runs done"),
+        "{again}"
+    );
+    ok(
+        &dir,
+        &[
+            "report",
+            "--storage",
+            &storage,
+            "--out",
+            "report-pg",
+            "--export",
+            "exported",
+        ],
+    );
+    assert_eq!(
+        rewards_table(&dir.join("report-pg")),
+        rewards_table(&dir.join("report-one"))
+    );
+    // The exported folder reports the same as the database.
+    ok(&dir, &["report", "exported", "--out", "report-exported"]);
+    assert_eq!(
+        std::fs::read_to_string(dir.join("report-exported/results.md")).unwrap(),
+        std::fs::read_to_string(dir.join("report-pg/results.md")).unwrap()
+    );
 }

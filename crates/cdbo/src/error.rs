@@ -115,6 +115,20 @@ pub enum Error {
         /// The folder's grid file.
         path: PathBuf,
     },
+    /// A database or file that holds no experiment grid this version can read.
+    #[error("{}: not a cdbo grid: {reason}", path.display())]
+    NotAGrid {
+        /// The file, or the database URL (without its password) and grid name.
+        path: PathBuf,
+        /// Why (not SQLite, a study, a newer schema, a stored grid that does not parse).
+        reason: String,
+    },
+    /// A grid that does not exist in its database.
+    #[error("{}: no such grid (run `cdbo experiment GRID --storage ...` first)", path.display())]
+    NoGrid {
+        /// The file, or the database URL (without its password) and grid name.
+        path: PathBuf,
+    },
     /// A value out of its domain.
     #[error("{what} must be {expected}, got {value}")]
     InvalidValue {

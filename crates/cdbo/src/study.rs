@@ -411,7 +411,7 @@ fn create_from(location: &Location, dump: &Dump) -> Result<()> {
 }
 
 /// Refuses a study written with a newer schema than this version reads.
-fn check_version(label: &Path, version: i64) -> Result<()> {
+pub(crate) fn check_version(label: &Path, version: i64) -> Result<()> {
     if version > SCHEMA_VERSION {
         return Err(Error::NotAStudy {
             path: label.to_owned(),

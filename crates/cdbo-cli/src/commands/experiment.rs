@@ -1,9 +1,12 @@
 //! `cdbo experiment`: run a grid of races (the paper's Sec. V) in parallel, resumable, and
-//! splittable into shards for many machines.
+//! splittable into shards for many machines, or spread over workers through a database
+//! (`--storage URL --worker`).
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
+use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Duration;
 
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -15,6 +18,9 @@ use cdbo::data_path::DataPath;
 use cdbo::experiment::folder::{self, Session};
 use cdbo::experiment::grid::{ExperimentConfig, PRESETS, Shard};
 use cdbo::experiment::record::{RunRecord, run};
+use cdbo::experiment::shared::{Progress, SharedGrid, work};
+use cdbo::study::Location;
+use cdbo::study::claim::{DEFAULT_LEASE, Missed, Worker};
 use cdbo::track::Track;
 
 #[derive(Debug, Args)]
@@ -22,13 +28,27 @@ pub struct ExperimentArgs {
     /// A grid as a TOML file, or a preset: paper, paper-plus, quick.
     config: String,
     /// Output folder (default: runs/experiment-NAME); runs already in it are skipped.
-    #[arg(long, value_name = "DIR")]
+    #[arg(long, value_name = "DIR", conflicts_with = "storage")]
     out: Option<PathBuf>,
+    /// Keep the grid in a database instead of a folder, for workers on many machines: an
+    /// SQLite file (FILE or sqlite://FILE) or a PostgreSQL database
+    /// (postgresql://USER@HOST[:PORT]/DB, the grid named NAME or by URL#GRID). Without
+    /// --worker, stores the grid there and runs nothing.
+    #[arg(long, value_name = "URL|FILE")]
+    storage: Option<String>,
+    /// Run cells of the grid in --storage, each taken by one worker, until every cell is
+    /// finished (start any number of workers, anywhere).
+    #[arg(long, requires = "storage")]
+    worker: bool,
+    /// With --worker: seconds a claimed cell stays this worker's without a heartbeat
+    /// (renewed six times per lease while it runs); after that another worker runs it.
+    #[arg(long, default_value_t = DEFAULT_LEASE.as_secs_f64(), value_parser = super::value::positive, requires = "worker")]
+    lease: f64,
     /// Runs in parallel (default: the number of cores).
     #[arg(long, value_parser = super::value::jobs)]
     jobs: Option<usize>,
     /// Run only shard I of N (0 ≤ I < N), e.g. --shard $SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT.
-    #[arg(long, value_name = "I/N")]
+    #[arg(long, value_name = "I/N", conflicts_with = "storage")]
     shard: Option<String>,
     /// Car: built-in spirit-300, a car .xml, or a car name in the data folders.
     #[arg(long, default_value = cars::DEFAULT)]
@@ -48,8 +68,9 @@ fn track_hint(name: &str) -> &'static str {
     }
 }
 
-pub fn run_grid(args: &ExperimentArgs, data: &DataPath) -> CliResult {
-    let (config, name) = match ExperimentConfig::preset(&args.config) {
+/// The grid CONFIG names (a preset or a TOML file) and its name (the preset or file stem).
+fn read_grid(args: &ExperimentArgs) -> Result<(ExperimentConfig, String), String> {
+    Ok(match ExperimentConfig::preset(&args.config) {
         Some(c) => (c, args.config.clone()),
         None => {
             let path = PathBuf::from(&args.config);
@@ -64,11 +85,35 @@ pub fn run_grid(args: &ExperimentArgs, data: &DataPath) -> CliResult {
                 .file_stem()
                 .map_or("grid".into(), |s| s.to_string_lossy().into_owned());
             (
-                ExperimentConfig::from_toml(&text, &path.display().to_string())?,
+                ExperimentConfig::from_toml(&text, &path.display().to_string())
+                    .map_err(|e| e.to_string())?,
                 stem,
             )
         }
-    };
+    })
+}
+
+/// The grid's tracks, each loaded once.
+fn load_tracks(
+    runs: &[cdbo::experiment::grid::RunSpec],
+    data: &DataPath,
+) -> Result<BTreeMap<String, Track>, String> {
+    let mut tracks: BTreeMap<String, Track> = BTreeMap::new();
+    for r in runs {
+        if !tracks.contains_key(&r.track) {
+            let t =
+                load_track(&r.track, data).map_err(|e| format!("{e}{}", track_hint(&r.track)))?;
+            tracks.insert(r.track.clone(), t);
+        }
+    }
+    Ok(tracks)
+}
+
+pub fn run_grid(args: &ExperimentArgs, data: &DataPath) -> CliResult {
+    let (config, name) = read_grid(args)?;
+    if let Some(storage) = &args.storage {
+        return shared_grid(args, data, &config, &name, storage);
+    }
     let out = args
         .out
         .clone()
@@ -103,14 +148,7 @@ pub fn run_grid(args: &ExperimentArgs, data: &DataPath) -> CliResult {
     });
     let skipped = shard_size - runs.len();
     let car = cars::find(&args.car, data)?;
-    let mut tracks: BTreeMap<String, Track> = BTreeMap::new();
-    for r in &runs {
-        if !tracks.contains_key(&r.track) {
-            let t =
-                load_track(&r.track, data).map_err(|e| format!("{e}{}", track_hint(&r.track)))?;
-            tracks.insert(r.track.clone(), t);
-        }
-    }
+    let tracks = load_tracks(&runs, data)?;
     let jobs = args
         .jobs
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
@@ -169,6 +207,117 @@ pub fn run_grid(args: &ExperimentArgs, data: &DataPath) -> CliResult {
         "{} runs done in {wall_s:.1} s; figures and tables: cdbo report {}",
         runs.len(),
         out.display()
+    );
+    Ok(())
+}
+
+/// `--storage URL [--worker]`: stores the grid in the database (or checks that the grid stored
+/// under its name is this one), then, as a worker, runs cells until every cell is finished,
+/// on `--jobs` threads, each a worker of its own; logs the session with the grid.
+fn shared_grid(
+    args: &ExperimentArgs,
+    data: &DataPath,
+    config: &ExperimentConfig,
+    name: &str,
+    storage: &str,
+) -> CliResult {
+    let location = Location::parse(storage, Some(name))?;
+    // Everything a worker needs is checked before the grid is stored.
+    let car = cars::find(&args.car, data)?;
+    let tracks = if args.worker {
+        load_tracks(&config.runs(), data)?
+    } else {
+        BTreeMap::new()
+    };
+    let mut grid = SharedGrid::join(&location, config).map_err(|e| match e {
+        cdbo::Error::DifferentGrid { path } => format!(
+            "{}: holds a different grid under this name; store this one elsewhere (another file, or DATABASE-URL#OTHER-NAME)",
+            path.display()
+        ),
+        e => e.to_string(),
+    })?;
+    let (finished, total) = grid.progress()?;
+    if !args.worker {
+        println!(
+            "{total} runs in the grid at {}: {finished} finished; start workers with --worker",
+            grid.path().display()
+        );
+        return Ok(());
+    }
+    let jobs = args
+        .jobs
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    println!(
+        "{total} runs in the grid at {}: {finished} finished; working on {jobs} threads",
+        grid.path().display()
+    );
+    let process = Worker::this_process(Duration::from_secs_f64(args.lease));
+    let start = std::time::Instant::now();
+    let ran = AtomicUsize::new(0);
+    let out = Mutex::new(());
+    let say = |line: String| {
+        let _lock = out.lock();
+        println!("{line}");
+    };
+    std::thread::scope(|scope| -> CliResult {
+        let threads: Vec<_> = (0..jobs)
+            .map(|k| {
+                let worker = Worker {
+                    id: format!("{}/{k}", process.id),
+                    lease: process.lease,
+                };
+                let (location, tracks, car, ran, say) = (&location, &tracks, &car, &ran, &say);
+                scope.spawn(move || -> Result<(), String> {
+                    let mut grid =
+                        SharedGrid::join(location, config).map_err(|e| e.to_string())?;
+                    work(&mut grid, &worker, tracks, car, &mut |p| match p {
+                        Progress::Ran(r) => {
+                            let k = ran.fetch_add(1, Ordering::Relaxed) + 1;
+                            say(format!(
+                                "ran {}: best {:.2} m/s ({:.0} % of the limit) in {:.1} s ({k} by this worker)",
+                                r.spec.id(),
+                                r.best_reward_mps,
+                                100.0 * r.best_reward_mps / r.limit_reward_mps,
+                                r.wall_s
+                            ));
+                        }
+                        Progress::FinishedElsewhere(spec) => say(format!(
+                            "{}: another worker finished it first; its record is kept",
+                            spec.id()
+                        )),
+                        Progress::Waiting => {
+                            say("waiting: every cell left is running on another worker".into())
+                        }
+                        Progress::Heartbeat(spec, Missed::Lost) => say(format!(
+                            "warning: {}: its claim ran out and another worker took it",
+                            spec.id()
+                        )),
+                        Progress::Heartbeat(spec, Missed::Failed(e)) => {
+                            say(format!("warning: {}: heartbeat: {e}", spec.id()))
+                        }
+                    })
+                    .map(|_| ())
+                    .map_err(|e| e.to_string())
+                })
+            })
+            .collect();
+        for t in threads {
+            t.join().map_err(|_| "a worker thread panicked")??;
+        }
+        Ok(())
+    })?;
+    let wall_s = start.elapsed().as_secs_f64();
+    let runs = ran.load(Ordering::Relaxed);
+    grid.add_session(&Session {
+        runs,
+        skipped: finished,
+        jobs,
+        shard: None,
+        wall_s,
+    })?;
+    println!(
+        "{runs} runs done by this worker in {wall_s:.1} s; the grid is finished; figures and tables: cdbo report --storage {}",
+        location.label().display()
     );
     Ok(())
 }

@@ -16,17 +16,28 @@ use cdbo::data_path::DataPath;
 use cdbo::experiment::folder::Session;
 use cdbo::experiment::race::demonstrate;
 use cdbo::experiment::record::RunRecord;
+use cdbo::experiment::shared::SharedGrid;
 use cdbo::experiment::summary::{Curve, cell_means, claims, curves, times};
 use cdbo::optimizers::Method;
 use cdbo::policy::RkhsPolicy;
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
+use cdbo::study::Location;
 
 #[derive(Debug, Args)]
 pub struct ReportArgs {
     /// Experiment folders written by `cdbo experiment` (shards of one grid are merged).
-    #[arg(required = true)]
+    #[arg(required_unless_present = "storage", conflicts_with = "storage")]
     dirs: Vec<PathBuf>,
-    /// Output folder (default: DIR/report for the first DIR).
+    /// A grid in a database, filled by `cdbo experiment GRID --storage URL --worker`: an
+    /// SQLite file (FILE or sqlite://FILE) or postgresql://USER@HOST[:PORT]/DB#GRID.
+    #[arg(long, value_name = "URL|FILE")]
+    storage: Option<String>,
+    /// With --storage: also write the grid as an experiment folder (experiment.toml, runs/,
+    /// sessions.jsonl), which `cdbo report DIR` reads the same.
+    #[arg(long, value_name = "DIR", requires = "storage")]
+    export: Option<PathBuf>,
+    /// Output folder (default: DIR/report for the first DIR; with --storage,
+    /// runs/report-GRID).
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
     /// Car the runs used.
@@ -52,7 +63,40 @@ fn curves_name(track: &str) -> String {
     }
 }
 
-pub fn run(args: &ReportArgs, data: &DataPath) -> CliResult {
+/// The runs and sessions to report, where they came from, and the default output folder:
+/// from experiment folders, or from a grid in a database (the same records).
+fn load(args: &ReportArgs) -> Result<(Vec<RunRecord>, Vec<Session>, String, PathBuf), String> {
+    if let Some(storage) = &args.storage {
+        let location = Location::parse(storage, None).map_err(|e| e.to_string())?;
+        let mut grid = SharedGrid::open_read_only(&location).map_err(|e| e.to_string())?;
+        if let Some(dir) = &args.export {
+            let n = grid.export(dir).map_err(|e| match e {
+                cdbo::Error::DifferentGrid { .. } => format!("{e}; choose another --export"),
+                e => e.to_string(),
+            })?;
+            println!("{n} runs exported to {}", dir.display());
+        }
+        let records = grid.records().map_err(|e| e.to_string())?;
+        let sessions = grid.sessions().map_err(|e| e.to_string())?;
+        let name = match &location {
+            Location::Postgres { study, .. } => study.clone(),
+            Location::Sqlite(path) => path
+                .file_stem()
+                .map_or("grid".into(), |s| s.to_string_lossy().into_owned()),
+        };
+        let label = grid.path().display().to_string();
+        if records.is_empty() {
+            return Err(format!(
+                "no finished runs in the grid at {label} (run `cdbo experiment GRID --storage URL --worker` first)"
+            ));
+        }
+        return Ok((
+            records,
+            sessions,
+            format!("the grid at {label}"),
+            PathBuf::from("runs").join(format!("report-{name}")),
+        ));
+    }
     let records = RunRecord::load_all(&args.dirs).map_err(|e| match e {
         cdbo::Error::Io { .. } => format!("{e} (expected the output folder of `cdbo experiment`)"),
         e => e.to_string(),
@@ -65,13 +109,20 @@ pub fn run(args: &ReportArgs, data: &DataPath) -> CliResult {
                 .map(|d| d.join("runs").display().to_string())
                 .collect::<Vec<_>>()
                 .join(", ")
-        )
-        .into());
+        ));
     }
-    let out = args
-        .out
-        .clone()
-        .unwrap_or_else(|| args.dirs[0].join("report"));
+    let sessions = Session::load_all(&args.dirs).map_err(|e| e.to_string())?;
+    Ok((
+        records,
+        sessions,
+        format!("{} folder(s)", args.dirs.len()),
+        args.dirs[0].join("report"),
+    ))
+}
+
+pub fn run(args: &ReportArgs, data: &DataPath) -> CliResult {
+    let (records, sessions, source, default_out) = load(args)?;
+    let out = args.out.clone().unwrap_or(default_out);
     std::fs::create_dir_all(&out).map_err(|e| format!("{}: {e}", out.display()))?;
     let car = cars::find(&args.car, data)?;
     let curves = curves(&records);
@@ -109,13 +160,11 @@ pub fn run(args: &ReportArgs, data: &DataPath) -> CliResult {
     }
     let table = table1(&records);
     std::fs::write(out.join("table1.md"), &table)?;
-    let sessions = Session::load_all(&args.dirs)?;
     let results = results_md(&records, &curves, &figures, &table, &sessions);
     std::fs::write(out.join("results.md"), results)?;
     println!(
-        "{} runs from {} folder(s): report in {}",
+        "{} runs from {source}: report in {}",
         records.len(),
-        args.dirs.len(),
         out.display()
     );
     Ok(())

@@ -1,7 +1,9 @@
 //! Which trial a worker drives: claims with an owner and a lease, as Optuna's RDB storage keeps
 //! RUNNING trials with a heartbeat and a grace period. The rules here know nothing of the
-//! storage (SQLite today, PostgreSQL later): the storage lists the pending trials with their
-//! claims inside one transaction, and [`hand_out`] decides.
+//! storage (SQLite or PostgreSQL): the storage lists the pending trials with their claims
+//! inside one transaction, and [`hand_out`] decides. The cells of an experiment grid spread
+//! over workers ([`crate::experiment::shared`]) are handed out by the same rules, a cell
+//! standing for a trial; [`while_renewing`] keeps either claimed while it runs.
 //!
 //! - A worker that asks again gets its own pending trial back (a restarted `optimize` with
 //!   the same worker id, or a retry after an error).
@@ -15,7 +17,10 @@
 //! - Once told plus pending trials reach the total, the worker waits: the laps in flight will
 //!   be told, or handed out again when their lease runs out.
 
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
+
+use crate::error::Error;
 
 /// A process driving laps for a study.
 #[derive(Debug, Clone, PartialEq)]
@@ -152,6 +157,57 @@ pub fn lie(told_rewards: impl IntoIterator<Item = f64>) -> f64 {
         .into_iter()
         .fold(None, |m: Option<f64>, r| Some(m.map_or(r, |m| m.min(r))))
         .unwrap_or(0.0)
+}
+
+/// What the heartbeat met while the work ran.
+#[derive(Debug)]
+pub enum Missed {
+    /// The claim ran out and another worker took the trial (or cell) over, or it was told.
+    Lost,
+    /// A renewal failed (the work goes on; the next beat retries).
+    Failed(Error),
+}
+
+/// Runs `work` while a thread renews a claim every `interval`: `renewer` opens the thread's
+/// own connection and returns the renewal (true while the claim is still ours). Returns the
+/// work's result and what the heartbeat met; it stops at the first lost claim.
+pub fn while_renewing<'a, T>(
+    interval: Duration,
+    renewer: impl FnOnce() -> crate::Result<Box<dyn FnMut() -> crate::Result<bool> + 'a>> + Send + 'a,
+    work: impl FnOnce() -> T,
+) -> (T, Vec<Missed>) {
+    let stop = AtomicBool::new(false);
+    std::thread::scope(|scope| {
+        let beat = scope.spawn(|| {
+            let mut missed = Vec::new();
+            let mut renew = match renewer() {
+                Ok(r) => r,
+                Err(e) => {
+                    missed.push(Missed::Failed(e));
+                    return missed;
+                }
+            };
+            loop {
+                std::thread::park_timeout(interval);
+                if stop.load(Ordering::Acquire) {
+                    return missed;
+                }
+                match renew() {
+                    Ok(true) => {}
+                    Ok(false) => {
+                        missed.push(Missed::Lost);
+                        return missed;
+                    }
+                    Err(e) => missed.push(Missed::Failed(e)),
+                }
+            }
+        });
+        let result = work();
+        stop.store(true, Ordering::Release);
+        beat.thread().unpark();
+        let missed = beat.join().unwrap_or_default();
+        (result, missed)
+    })
 }
 
 #[cfg(test)]

@@ -1,7 +1,9 @@
 //! The PostgreSQL back end: any number of studies by name in one database, driven by workers
 //! on many machines at once. Tables `cdbo_meta` (the schema version, [`SCHEMA_VERSION`], the
 //! same as SQLite's), `cdbo_studies` (settings and optimiser state per study) and
-//! `cdbo_trials` (the same columns as an SQLite study's `trials`, keyed by study and id).
+//! `cdbo_trials` (the same columns as an SQLite study's `trials`, keyed by study and id); the
+//! experiment grids spread over workers keep `cdbo_grids`, `cdbo_grid_runs` and
+//! `cdbo_grid_sessions` ([`crate::experiment::shared`]).
 //! Numbers are `DOUBLE PRECISION`, read and written in binary: bit for bit.
 //!
 //! Every write transaction first takes the study's row lock (`SELECT … FOR UPDATE` on
@@ -43,7 +45,21 @@ const SCHEMA: &str = "
         told_unix_s DOUBLE PRECISION,
         owner TEXT,
         lease_until_unix_s DOUBLE PRECISION,
-        PRIMARY KEY (study, id));";
+        PRIMARY KEY (study, id));
+    CREATE TABLE IF NOT EXISTS cdbo_grids (name TEXT PRIMARY KEY, grid TEXT NOT NULL);
+    CREATE TABLE IF NOT EXISTS cdbo_grid_runs (
+        grid TEXT NOT NULL REFERENCES cdbo_grids (name) ON DELETE CASCADE,
+        id BIGINT NOT NULL,
+        run TEXT NOT NULL,
+        record TEXT,
+        owner TEXT,
+        lease_until_unix_s DOUBLE PRECISION,
+        finished_unix_s DOUBLE PRECISION,
+        PRIMARY KEY (grid, id));
+    CREATE TABLE IF NOT EXISTS cdbo_grid_sessions (
+        grid TEXT NOT NULL REFERENCES cdbo_grids (name) ON DELETE CASCADE,
+        id BIGSERIAL PRIMARY KEY,
+        session TEXT NOT NULL);";
 
 /// The advisory lock key under which a database's tables are created (`cdbo` in ASCII).
 const SCHEMA_LOCK: i64 = 0x6364_626f;
@@ -66,17 +82,7 @@ impl Postgres {
         let err = |e| pg_error(label, e);
         let mut client = connect(url, label)?;
         let mut tx = client.transaction().map_err(err)?;
-        tx.execute("SELECT pg_advisory_xact_lock($1)", &[&SCHEMA_LOCK])
-            .map_err(err)?;
-        if let Some(version) = schema_version(&mut tx, label)? {
-            super::check_version(label, version)?;
-        }
-        tx.batch_execute(SCHEMA).map_err(err)?;
-        tx.execute(
-            "INSERT INTO cdbo_meta (key, value) VALUES ('schema_version', $1) ON CONFLICT (key) DO NOTHING",
-            &[&SCHEMA_VERSION.to_string()],
-        )
-        .map_err(err)?;
+        ensure_schema(&mut tx, label, super::check_version)?;
         let added = tx
             .execute(
                 "INSERT INTO cdbo_studies (name, config, optimizer_state) VALUES ($1, $2, $3) ON CONFLICT (name) DO NOTHING",
@@ -387,9 +393,32 @@ impl Transaction for PostgresTransaction<'_> {
     }
 }
 
+/// Creates the tables where the database has none yet, under the schema lock (workers that
+/// start at once create them once); first refuses a database of a newer schema with
+/// `check_version`'s error, having written nothing.
+pub(crate) fn ensure_schema(
+    tx: &mut postgres::Transaction<'_>,
+    label: &Path,
+    check_version: fn(&Path, i64) -> Result<()>,
+) -> Result<()> {
+    let err = |e| pg_error(label, e);
+    tx.execute("SELECT pg_advisory_xact_lock($1)", &[&SCHEMA_LOCK])
+        .map_err(err)?;
+    if let Some(version) = schema_version(tx, label)? {
+        check_version(label, version)?;
+    }
+    tx.batch_execute(SCHEMA).map_err(err)?;
+    tx.execute(
+        "INSERT INTO cdbo_meta (key, value) VALUES ('schema_version', $1) ON CONFLICT (key) DO NOTHING",
+        &[&SCHEMA_VERSION.to_string()],
+    )
+    .map_err(err)?;
+    Ok(())
+}
+
 /// A connection to the database at `url`: an unreachable server or refused credentials are
 /// one line naming the database.
-fn connect(url: &str, label: &Path) -> Result<Client> {
+pub(crate) fn connect(url: &str, label: &Path) -> Result<Client> {
     let mut config: postgres::Config = url.parse().map_err(|e| pg_error(label, e))?;
     if config.get_connect_timeout().is_none() {
         config.connect_timeout(CONNECT_TIMEOUT);
@@ -409,7 +438,10 @@ fn connect(url: &str, label: &Path) -> Result<Client> {
 }
 
 /// The database's study schema version; `None` if it holds no cdbo tables.
-fn schema_version(tx: &mut postgres::Transaction<'_>, label: &Path) -> Result<Option<i64>> {
+pub(crate) fn schema_version(
+    tx: &mut postgres::Transaction<'_>,
+    label: &Path,
+) -> Result<Option<i64>> {
     let err = |e| pg_error(label, e);
     let has_tables: bool = tx
         .query_one("SELECT to_regclass('cdbo_meta') IS NOT NULL", &[])
@@ -455,7 +487,7 @@ fn to_trial(r: &postgres::Row, label: &Path) -> Result<Trial> {
 }
 
 /// Sorts a PostgreSQL error: a lock not had within the lock timeout is "busy", as in SQLite.
-fn pg_error(label: &Path, source: postgres::Error) -> Error {
+pub(crate) fn pg_error(label: &Path, source: postgres::Error) -> Error {
     if source.code() == Some(&postgres::error::SqlState::LOCK_NOT_AVAILABLE) {
         return Error::Busy {
             path: label.to_owned(),

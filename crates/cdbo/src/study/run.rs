@@ -11,7 +11,7 @@
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use super::claim::Worker;
+use super::claim::{Missed, Worker, while_renewing};
 use super::{Location, Next, Outcome, Study, Trial};
 use crate::error::{Error, Result};
 use crate::evaluator::Evaluator;
@@ -262,38 +262,19 @@ fn with_heartbeat(
     id: i64,
     lap: &mut dyn FnMut() -> Result<Outcome>,
 ) -> (Result<Outcome>, Vec<Event<'static>>) {
-    let stop = std::sync::atomic::AtomicBool::new(false);
-    std::thread::scope(|scope| {
-        let beat = scope.spawn(|| {
-            let mut notes = Vec::new();
-            let study = match Study::open_at(location) {
-                Ok(s) => s,
-                Err(error) => {
-                    notes.push(Event::HeartbeatFailed { trial: id, error });
-                    return notes;
-                }
-            };
-            loop {
-                std::thread::park_timeout(worker.heartbeat_interval());
-                if stop.load(std::sync::atomic::Ordering::Acquire) {
-                    return notes;
-                }
-                match study.heartbeat(id, worker) {
-                    Ok(true) => {}
-                    Ok(false) => {
-                        notes.push(Event::ClaimLost { trial: id });
-                        return notes;
-                    }
-                    Err(error) => notes.push(Event::HeartbeatFailed { trial: id, error }),
-                }
-            }
-        });
-        let result = lap();
-        stop.store(true, std::sync::atomic::Ordering::Release);
-        beat.thread().unpark();
-        let notes = beat.join().unwrap_or_default();
-        (result, notes)
-    })
+    let renewer = move || -> Result<Box<dyn FnMut() -> Result<bool> + '_>> {
+        let study = Study::open_at(location)?;
+        Ok(Box::new(move || study.heartbeat(id, worker)))
+    };
+    let (result, missed) = while_renewing(worker.heartbeat_interval(), renewer, lap);
+    let notes = missed
+        .into_iter()
+        .map(|m| match m {
+            Missed::Lost => Event::ClaimLost { trial: id },
+            Missed::Failed(error) => Event::HeartbeatFailed { trial: id, error },
+        })
+        .collect();
+    (result, notes)
 }
 
 #[cfg(test)]

@@ -30,7 +30,7 @@ pub struct Sqlite {
 }
 
 /// Sorts an SQLite error by its code: busy or locked, not a database, or another failure.
-fn sql_error(path: &Path, source: rusqlite::Error) -> Error {
+pub(crate) fn sql_error(path: &Path, source: rusqlite::Error) -> Error {
     use rusqlite::ErrorCode;
     let path = path.to_owned();
     match source.sqlite_error_code() {
@@ -385,7 +385,7 @@ impl Transaction for SqliteTransaction<'_> {
 }
 
 /// WAL journal, full synchronous commits, a busy timeout.
-fn configure(conn: &Connection) -> rusqlite::Result<()> {
+pub(crate) fn configure(conn: &Connection) -> rusqlite::Result<()> {
     conn.busy_timeout(BUSY_TIMEOUT)?;
     conn.pragma_update(None, "journal_mode", "WAL")?;
     conn.pragma_update(None, "synchronous", "FULL")?;
@@ -394,7 +394,7 @@ fn configure(conn: &Connection) -> rusqlite::Result<()> {
 
 /// Refuses a file that is not an SQLite database before SQLite touches it (opened read-write,
 /// SQLite would write its header into an empty file).
-fn check_header(path: &Path) -> Result<()> {
+pub(crate) fn check_header(path: &Path) -> Result<()> {
     use std::io::Read;
     let mut head = Vec::with_capacity(16);
     std::fs::File::open(path)
@@ -418,14 +418,14 @@ fn check_header(path: &Path) -> Result<()> {
     Ok(())
 }
 
-fn user_version(conn: &Connection) -> rusqlite::Result<i64> {
+pub(crate) fn user_version(conn: &Connection) -> rusqlite::Result<i64> {
     conn.pragma_query_value(None, "user_version", |r| r.get(0))
 }
 
 /// A read-only connection and the schema version. SQLite shares a WAL database through a
 /// `-shm` file beside it; where that cannot be made (a read-only folder), the file is opened
 /// as immutable, which is right while no writer has the study open.
-fn read_only_connection(path: &Path) -> Result<(Connection, i64)> {
+pub(crate) fn read_only_connection(path: &Path) -> Result<(Connection, i64)> {
     let err = |e| sql_error(path, e);
     let shared =
         Connection::open_with_flags(path, OpenFlags::SQLITE_OPEN_READ_ONLY).and_then(|c| {

@@ -48,10 +48,11 @@ impl Location {
                 let study = named
                     .filter(|s| !s.is_empty())
                     .ok_or_else(|| Error::InvalidValue {
-                        what: format!("the study name of {}", redact(url)),
+                        what: format!("the study or grid name of {}", redact(url)),
                         value: "none".into(),
-                        expected: "given (DATABASE-URL#STUDY): a database holds many studies"
-                            .into(),
+                        expected:
+                            "given (DATABASE-URL#NAME): a database holds many studies and grids"
+                                .into(),
                     })?;
                 Ok(Location::Postgres {
                     url: url.to_owned(),
@@ -209,7 +210,7 @@ mod tests {
         let e = Location::parse("postgres://me@h/db", None)
             .unwrap_err()
             .to_string();
-        assert!(e.contains("study name"), "{e}");
+        assert!(e.contains("study or grid name"), "{e}");
         let e = Location::parse("mysql://u:pw@h/db", Some("s"))
             .unwrap_err()
             .to_string();
