@@ -249,11 +249,10 @@ fn workers_fill_a_grid_in_an_sqlite_file() {
     );
     assert_eq!(laps(&dir.join("exported")), laps(&dir.join("one")));
     ok(&dir, &["report", "one", "--out", "rep-one"]);
-    let table = |d: &str| {
-        let t = std::fs::read_to_string(dir.join(d).join("results.md")).unwrap();
-        t[t.find("## Final best").unwrap()..t.find("## Run times").unwrap()].to_owned()
-    };
-    assert_eq!(table("rep"), table("rep-one"));
+    assert_eq!(
+        common::rewards_table(&dir.join("rep")),
+        common::rewards_table(&dir.join("rep-one"))
+    );
     // Refusals, each one line, nothing written.
     std::fs::write(dir.join("other.toml"), GRID.replace("laps = 8", "laps = 9")).unwrap();
     common::refused(

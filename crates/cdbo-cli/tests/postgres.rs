@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 
 mod common;
 
-use common::{CDBO, demo, fresh_dir, kill_first_and_reap, ok, refused};
+use common::{CDBO, demo, fresh_dir, kill_first_and_reap, ok, refused, rewards_table};
 
 /// The password of the test server's superuser `cdbo`.
 const PASSWORD: &str = "lap-secret";
@@ -608,17 +608,6 @@ fn bad_databases_are_one_line_and_write_nothing() {
         run(args, &["newer cdbo (study schema 99, this version reads"]);
     }
     assert_eq!(dump(&mut client), before);
-}
-
-/// The "Final best reward" table of a report's results.md: the rewards, not the timings.
-fn rewards_table(report: &Path) -> String {
-    let text = std::fs::read_to_string(report.join("results.md")).unwrap();
-    let start = text.find("## Final best reward").expect("a rewards table");
-    let end = text[start..]
-        .find("## Run times")
-        .expect("run times after it")
-        + start;
-    text[start..end].to_owned()
 }
 
 /// Two workers fill the quick grid in PostgreSQL, one killed with SIGKILL while it runs a

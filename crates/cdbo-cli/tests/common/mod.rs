@@ -80,3 +80,14 @@ pub fn kill_first_and_reap(mut workers: Vec<std::process::Child>) {
         }
     }
 }
+
+/// The "Final best reward" table of a report's results.md: the rewards, not the timings.
+pub fn rewards_table(report: &Path) -> String {
+    let text = std::fs::read_to_string(report.join("results.md")).unwrap();
+    let start = text.find("## Final best reward").expect("a rewards table");
+    let end = text[start..]
+        .find("## Run times")
+        .expect("run times after it")
+        + start;
+    text[start..end].to_owned()
+}
