@@ -24,7 +24,9 @@
  *   wheelbase L                  (m), the steering gain's L
  *   steering T_LA D_MIN K_I      look-ahead time (s), shortest look-ahead (m), integral gain
  *   ratios G1 ... GN             total ratio engine -> wheel of each forward gear
- *   upshift W1 ... WN            engine speed (rad/s) at which to leave each gear
+ *   throttle_levels K            throttle levels of the shift map, a = k / (K - 1)
+ *   upshift W11 ... W1K ... WNK  engine speed (rad/s) at which to leave each gear, a row of
+ *                                K levels per gear (interpolated in the throttle)
  *   downshift_margin F           hysteresis of the down-shift
  *   shift_time S                 (s) no new shift decision during a shift
  *   driven F R                   weights of the front and rear axle's spin in the drive speed
@@ -37,6 +39,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <algorithm>
 #include <string>
 #include <vector>
 #include <unistd.h>
@@ -69,6 +72,7 @@ struct Settings {
     double wheelbase = 2.6;
     double lookahead_time = 0.8, lookahead_min = 12.0, ki = 0.1;
     std::vector<double> ratios, upshift;
+    size_t throttle_levels = 1;
     double downshift_margin = 0.85, shift_time = 0.2;
     double driven[2] = {0.0, 1.0};
     double aid_slip[2] = {0.0, 0.0};
@@ -146,6 +150,10 @@ bool read_settings(const std::string &path, Settings *s, std::string *error) {
         }
         else if (k == "ratios") s->ratios = nums;
         else if (k == "upshift") s->upshift = nums;
+        else if (k == "throttle_levels") {
+            if ((ok = need(1) && nums[0] >= 2.0 && nums[0] == std::floor(nums[0]))) s->throttle_levels = size_t(nums[0]);
+            else *error = path + ":" + std::to_string(number) + ": throttle_levels needs a whole number >= 2";
+        }
         else if (k == "downshift_margin") { if ((ok = need(1))) s->downshift_margin = nums[0]; }
         else if (k == "shift_time") { if ((ok = need(1))) s->shift_time = nums[0]; }
         else if (k == "driven") { if ((ok = need(2))) { s->driven[0] = nums[0]; s->driven[1] = nums[1]; } }
@@ -162,8 +170,8 @@ bool read_settings(const std::string &path, Settings *s, std::string *error) {
         }
     }
     fclose(f);
-    if (s->ratios.empty() || s->ratios.size() != s->upshift.size()) {
-        *error = path + ": 'ratios' and 'upshift' must give one number per gear";
+    if (s->ratios.empty() || s->ratios.size() * s->throttle_levels != s->upshift.size()) {
+        *error = path + ": 'upshift' must give 'throttle_levels' numbers per gear of 'ratios'";
         return false;
     }
     const std::string &p = s->pedal;
@@ -271,17 +279,30 @@ double axle_omega(tCarElt *car, int axle) {
     return 0.5 * (car->_wheelSpinVel(2 * axle) + car->_wheelSpinVel(2 * axle + 1));
 }
 
+/// The engine speed at which to leave gear g at a throttle (sim/powertrain.rs
+/// ShiftMap::upshift): linear between the levels, full throttle's when coasting or braking.
+double upshift_at(size_t g, double throttle) {
+    const Settings &c = lap.cfg;
+    size_t n = c.throttle_levels;
+    const double *row = &c.upshift[g * n];
+    if (throttle <= 0.0 || throttle >= 1.0 || n < 2) return row[n - 1];
+    double f = throttle * double(n - 1);
+    size_t k = std::min(size_t(f), n - 2);
+    double t = f - double(k);
+    return row[k] + (row[k + 1] - row[k]) * t;
+}
+
 /// cdbo's automatic gearbox (sim/powertrain.rs Gearbox::update).
-void choose_gear(tCarElt *car, double dt) {
+void choose_gear(tCarElt *car, double throttle, double dt) {
     const Settings &c = lap.cfg;
     lap.shifting = std::fmax(lap.shifting - dt, 0.0);
     if (lap.shifting > 0.0) return;
     double w = c.driven[0] * axle_omega(car, 0) + c.driven[1] * axle_omega(car, 1);
     size_t g = lap.gear;
-    if (g + 1 < c.ratios.size() && w * c.ratios[g] >= c.upshift[g]) {
+    if (g + 1 < c.ratios.size() && w * c.ratios[g] >= upshift_at(g, throttle)) {
         lap.gear++;
         lap.shifting = c.shift_time;
-    } else if (g > 0 && w * c.ratios[g - 1] < c.downshift_margin * c.upshift[g - 1]) {
+    } else if (g > 0 && w * c.ratios[g - 1] < c.downshift_margin * upshift_at(g - 1, throttle)) {
         lap.gear--;
         lap.shifting = c.shift_time;
     }
@@ -443,7 +464,7 @@ void drive(int, tCarElt *car, tSituation *s) {
     double x = clamp(lap.distance / len, 0.0, 1.0);
     double a = pedal(x, speed, dt);
     double delta = steer(car, speed, dt);
-    choose_gear(car, dt);
+    choose_gear(car, std::fmax(a, 0.0), dt);
 
     // Traction control and ABS, as cdbo's vehicle applies them (sim/vehicle.rs).
     double throttle = std::fmax(a, 0.0), brake = std::fmax(-a, 0.0);

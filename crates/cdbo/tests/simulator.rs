@@ -148,14 +148,14 @@ fn drive_straight(
     s.omega = [v0 / car.front_tyre.radius, v0 / car.rear_tyre.radius];
     // Settle the gearbox into the gear for this speed before the clock starts.
     for _ in 0..car.gears.len() {
-        vehicle.shift(&mut s);
+        vehicle.shift(&mut s, throttle);
         s.gearbox.shifting = 0.0;
     }
     let c = Controls::new(0.0, throttle, brake);
     let dt = 0.002;
     for i in 0..(seconds / dt) as usize {
         if i % 10 == 0 {
-            vehicle.shift(&mut s);
+            vehicle.shift(&mut s, throttle);
         }
         let k = track.index_at(s.x);
         vehicle.step(&mut s, &c, track.frame(k), dt);

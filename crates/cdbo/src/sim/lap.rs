@@ -251,7 +251,7 @@ impl Simulator {
                     driver_dt,
                 );
                 controls = Controls::new(steer, a.max(0.0), (-a).max(0.0));
-                self.vehicle.shift(&mut state);
+                self.vehicle.shift(&mut state, controls.throttle());
                 if cfg.trace {
                     trace.push(TracePoint {
                         t,

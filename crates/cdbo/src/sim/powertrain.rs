@@ -5,10 +5,14 @@
 //! engine brake K = c·(ω_e − ω_idle)/(ω_max − ω_idle) of simuv2's `engine.cpp`: at part
 //! throttle the engine's net torque falls with its speed and turns negative, and a closed
 //! throttle brakes. Below idle the clutch slips and the engine delivers a·T_e(ω_idle); above
-//! the rev limiter it delivers nothing. The gearbox shifts up when the next gear gives
-//! more wheel torque at the same road speed (or at the rev limiter) and down when the lower
-//! gear would still be below its own up-shift speed; each shift cuts the drive for the car's
-//! `shift time`.
+//! the rev limiter it delivers nothing. The gearbox shifts up when the next gear gives more
+//! wheel torque at the same road speed *at the current throttle* (or at the rev limiter), and
+//! down when the lower gear would still be below its own up-shift speed at that throttle by
+//! the margin [`DOWNSHIFT_MARGIN`]; while coasting or braking it keeps the full-throttle
+//! points, ready to accelerate. Each shift cuts the drive for the car's `shift time`. At part
+//! throttle the engine brake makes the net torque fall with engine speed and vanish near the
+//! red line, so a gearbox with full-throttle points would hold a low gear there for ever (the
+//! "gear trap": 2.7 km of first gear at 8000 rpm on e-track-2 at a = 0.2).
 
 use crate::car::Car;
 
@@ -24,36 +28,66 @@ pub struct Gearbox {
     pub shifting: f64,
 }
 
+/// Throttle levels of the shift map: a = k / (LEVELS − 1), k = 0 … LEVELS − 1.
+pub const THROTTLE_LEVELS: usize = 11;
+
 /// Shift points of a car, computed once.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ShiftMap {
-    /// Engine speed at which to leave gear i for gear i+1 (rad/s).
-    pub upshift: Vec<f64>,
+    /// Engine speed at which to leave gear i for gear i+1 (rad/s) at each throttle level:
+    /// `upshift[i][k]` at a = k / ([`THROTTLE_LEVELS`] − 1).
+    pub upshift: Vec<[f64; THROTTLE_LEVELS]>,
 }
 
 impl ShiftMap {
-    /// The engine speed in each gear above which the next gear gives more wheel torque.
+    /// The lowest engine speed in each gear at which the next gear gives more wheel torque,
+    /// T_e(ω·r)·(a(1 + K) − K)·gᵢ₊₁ > T_e(ω)·(a(1 + K) − K)·gᵢ with r = gᵢ₊₁/gᵢ and K of each
+    /// engine speed, with the next gear's engine at or above idle; the rev limiter (less
+    /// 0.5 %) where it never does; the last gear's is the rev limiter.
     pub fn new(car: &Car) -> ShiftMap {
         let g = &car.gears;
+        let net = |w: f64, a: f64| {
+            let w = w.max(car.tickover);
+            car.part_throttle_torque(car.engine_torque(w), a, w)
+        };
         let upshift = (0..g.len())
             .map(|i| {
-                if i + 1 == g.len() {
-                    return car.rev_limiter;
-                }
-                let ratio = g[i + 1] / g[i];
-                let steps = 400;
-                (0..=steps)
-                    .map(|k| {
-                        car.tickover + (car.rev_limiter - car.tickover) * k as f64 / steps as f64
-                    })
-                    .find(|&w| {
-                        car.engine_torque(w * ratio) * g[i + 1] > car.engine_torque(w) * g[i]
-                    })
-                    .unwrap_or(car.rev_limiter)
-                    .min(car.rev_limiter * 0.995)
+                std::array::from_fn(|k| {
+                    if i + 1 == g.len() {
+                        return car.rev_limiter;
+                    }
+                    let a = k as f64 / (THROTTLE_LEVELS - 1) as f64;
+                    let ratio = g[i + 1] / g[i];
+                    let steps = 400;
+                    (0..=steps)
+                        .map(|j| {
+                            car.tickover
+                                + (car.rev_limiter - car.tickover) * j as f64 / steps as f64
+                        })
+                        .find(|&w| {
+                            w * ratio >= car.tickover
+                                && net(w * ratio, a) * g[i + 1] > net(w, a) * g[i]
+                        })
+                        .unwrap_or(car.rev_limiter)
+                        .min(car.rev_limiter * 0.995)
+                })
             })
             .collect();
         ShiftMap { upshift }
+    }
+
+    /// The engine speed at which to leave `gear` at `throttle`, linear between the levels;
+    /// a throttle of 0 or less (coasting, braking) takes the full-throttle point.
+    #[inline]
+    pub fn upshift(&self, gear: usize, throttle: f64) -> f64 {
+        let row = &self.upshift[gear];
+        if throttle <= 0.0 || throttle >= 1.0 {
+            return row[THROTTLE_LEVELS - 1];
+        }
+        let f = throttle * (THROTTLE_LEVELS - 1) as f64;
+        let k = (f as usize).min(THROTTLE_LEVELS - 2);
+        let t = f - k as f64;
+        row[k] + (row[k + 1] - row[k]) * t
     }
 }
 
@@ -113,18 +147,20 @@ impl Gearbox {
         }
     }
 
-    /// Chooses the gear for a driven-wheel speed ω (rad/s); starts a shift when it changes.
-    pub fn update(&mut self, car: &Car, map: &ShiftMap, wheel_omega: f64) {
+    /// Chooses the gear for a driven-wheel speed ω (rad/s) and the throttle in [0, 1]; starts
+    /// a shift when it changes.
+    pub fn update(&mut self, car: &Car, map: &ShiftMap, wheel_omega: f64, throttle: f64) {
         if self.shifting > 0.0 {
             return;
         }
         let fd = car.final_drive;
         let engine = |gear: usize| wheel_omega * car.gears[gear] * fd;
-        if self.gear + 1 < car.gears.len() && engine(self.gear) >= map.upshift[self.gear] {
+        if self.gear + 1 < car.gears.len() && engine(self.gear) >= map.upshift(self.gear, throttle)
+        {
             self.gear += 1;
             self.shifting = car.shift_time;
         } else if self.gear > 0
-            && engine(self.gear - 1) < DOWNSHIFT_MARGIN * map.upshift[self.gear - 1]
+            && engine(self.gear - 1) < DOWNSHIFT_MARGIN * map.upshift(self.gear - 1, throttle)
         {
             self.gear -= 1;
             self.shifting = car.shift_time;
@@ -173,7 +209,7 @@ mod tests {
         let map = ShiftMap::new(&car);
         assert_eq!(map.upshift.len(), car.gears.len());
         for i in 0..car.gears.len() - 1 {
-            let w = map.upshift[i];
+            let w = map.upshift(i, 1.0);
             let ratio = car.gears[i + 1] / car.gears[i];
             // Just past the point the next gear is better, just before it the current one is.
             assert!(
@@ -187,6 +223,45 @@ mod tests {
                 w * 30.0 / std::f64::consts::PI
             );
         }
+    }
+
+    #[test]
+    fn part_throttle_shifts_up_where_the_next_gear_pulls_harder() {
+        let car = Car::spirit_300();
+        let map = ShiftMap::new(&car);
+        let net = |w: f64, a: f64| car.part_throttle_torque(car.engine_torque(w), a, w);
+        for i in 0..car.gears.len() - 1 {
+            let ratio = car.gears[i + 1] / car.gears[i];
+            for k in 1..THROTTLE_LEVELS - 1 {
+                let a = k as f64 / (THROTTLE_LEVELS - 1) as f64;
+                let w = map.upshift(i, a);
+                assert_eq!(w, map.upshift[i][k]);
+                // Earlier than at full throttle: the engine brake eats the top of the range.
+                assert!(w <= map.upshift(i, 1.0), "gear {i} a = {a}");
+                // At the point the next gear pulls harder, one grid step before it does not.
+                let step = (car.rev_limiter - car.tickover) / 400.0;
+                if w < car.rev_limiter * 0.99 && w - step >= car.tickover / ratio {
+                    assert!(net(w * ratio, a) * car.gears[i + 1] > net(w, a) * car.gears[i]);
+                    let w0 = w - step;
+                    assert!(
+                        net(w0 * ratio, a) * car.gears[i + 1] <= net(w0, a) * car.gears[i],
+                        "gear {i} a = {a}"
+                    );
+                }
+            }
+            // Between the levels the point is interpolated; coasting keeps full throttle's.
+            let mid = map.upshift(i, 0.25);
+            assert!((mid - 0.5 * (map.upshift[i][2] + map.upshift[i][3])).abs() < 1e-9);
+            assert_eq!(map.upshift(i, 0.0), map.upshift(i, 1.0));
+        }
+        // The trap: at a = 0.2 in first gear the net torque vanishes below the full-throttle
+        // up-shift point, so the car could never reach it; the part-throttle point lies below.
+        let zero = (0..4000)
+            .map(|j| car.tickover + j as f64 * 0.25)
+            .find(|&w| net(w, 0.2) <= 0.0)
+            .unwrap_or(car.rev_limiter);
+        assert!(zero < map.upshift(0, 1.0), "{zero}");
+        assert!(map.upshift(0, 0.2) < zero);
     }
 
     #[test]
@@ -231,12 +306,12 @@ mod tests {
         let mut g = Gearbox::new();
         for v in 1..90 {
             g.shifting = 0.0;
-            g.update(&car, &map, v as f64 / car.rear_tyre.radius);
+            g.update(&car, &map, v as f64 / car.rear_tyre.radius, 1.0);
         }
         assert_eq!(g.gear, car.gears.len() - 1);
         for v in (1..90).rev() {
             g.shifting = 0.0;
-            g.update(&car, &map, v as f64 / car.rear_tyre.radius);
+            g.update(&car, &map, v as f64 / car.rear_tyre.radius, 1.0);
         }
         assert_eq!(g.gear, 0);
     }

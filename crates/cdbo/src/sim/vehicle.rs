@@ -17,7 +17,8 @@
 //!   m(v̇_y + vₓ r) = F_xf sin δ + F_yf cos δ + F_yr − m g sin β,
 //!   I_z ṙ = a(F_xf sin δ + F_yf cos δ) − b F_yr, with β the banking.
 //! - Drag F = 0.645·Cx·A·v², downforce Dᵢ = 0.645·Clᵢ·A·v², rolling resistance
-//!   F = c_rr·(F_zf + F_zr)·sgn vₓ.
+//!   F = c_rr·(F_zf + F_zr)·sgn vₓ, c_rr the road surface's where the track gives one (as
+//!   TORCS's simuv2 does), else the tyres'.
 //! - Brakes: T = p·share·A_piston·μ_pad·r_disc per wheel, with ABS easing the pressure while an
 //!   axle's slip exceeds half the tyre's peak slip; traction control eases the throttle
 //!   likewise (the Spirit 300 has both; TORCS robots implement them in the driver).
@@ -211,12 +212,12 @@ impl Vehicle {
         }
     }
 
-    /// The automatic gearbox's decision, taken at the driver's rate; also re-synchronises the
-    /// incrementally rotated (sin ψ, cos ψ) with ψ.
-    pub fn shift(&self, s: &mut State) {
+    /// The automatic gearbox's decision for the driver's throttle in [0, 1], taken at the
+    /// driver's rate; also re-synchronises the incrementally rotated (sin ψ, cos ψ) with ψ.
+    pub fn shift(&self, s: &mut State, throttle: f64) {
         s.yaw_sin_cos = s.yaw.sin_cos();
         let w = self.driven_omega(s);
-        s.gearbox.update(&self.car, &self.shift_map, w);
+        s.gearbox.update(&self.car, &self.shift_map, w, throttle);
     }
 
     fn driven_omega(&self, s: &State) -> f64 {
@@ -308,7 +309,9 @@ impl Vehicle {
 
         // Body forces and moments.
         // Rolling resistance opposes motion; sgn vₓ is smoothed over ±0.5 m/s for standing starts.
-        let roll = self.rolling * (fz[0] + fz[1]) * (s.vx / 0.5).clamp(-1.0, 1.0);
+        // The road's coefficient where the track gives one (simuv2), else the tyres'.
+        let c_rr = frame.rolling_resistance.unwrap_or(self.rolling);
+        let roll = c_rr * (fz[0] + fz[1]) * (s.vx / 0.5).clamp(-1.0, 1.0);
         // Drag 0.645·Cx·A·v² along the velocity: its x component is 0.645·Cx·A·v·vₓ.
         let drag = self.drag_per_v2 * v2.sqrt() * s.vx;
         let force_x = fx[0] * cos_d - fy[0] * sin_d + fx[1] - drag - roll - m * G * frame.sin_pitch;

@@ -22,7 +22,7 @@ use crate::car::Car;
 use crate::error::{Error, Result};
 use crate::policy::RkhsPolicy;
 use crate::sim::lap::{Failure, LapConfig, LapResult, TracePoint};
-use crate::sim::powertrain::DOWNSHIFT_MARGIN;
+use crate::sim::powertrain::{DOWNSHIFT_MARGIN, THROTTLE_LEVELS};
 use crate::sim::vehicle::Vehicle;
 
 /// What the robot's pedal follows.
@@ -201,10 +201,11 @@ fn settings(req: &LapRequest, output: &Path, trace: Option<&Path>, time_limit: f
     );
     let fd = car.final_drive;
     let _ = writeln!(s, "ratios {}", list(&mut car.gears.iter().map(|g| g * fd)));
+    let _ = writeln!(s, "throttle_levels {THROTTLE_LEVELS}");
     let _ = writeln!(
         s,
         "upshift {}",
-        list(&mut vehicle.shift_map().upshift.iter().copied())
+        list(&mut vehicle.shift_map().upshift.iter().flatten().copied())
     );
     let _ = writeln!(s, "downshift_margin {DOWNSHIFT_MARGIN:e}");
     let _ = writeln!(s, "shift_time {:e}", car.shift_time);

@@ -239,6 +239,7 @@ fn build(rows: &[[f64; 4]], name: &str, file: &str) -> Result<Track> {
             banking: 0.0,
             width: sw.eval(ti).0,
             friction: 1.0,
+            rolling_resistance: None,
         });
     }
     smooth_curvature(

@@ -35,6 +35,10 @@ pub struct Sample {
     pub width: f64,
     /// Friction coefficient of the road surface (TORCS `friction`), scales the tyre grip.
     pub friction: f64,
+    /// Rolling resistance coefficient of the road surface (TORCS `rolling resistance`:
+    /// simuv2 takes it from the road, F = c_rr·F_z), when the track names one; else the
+    /// car's tyres give it.
+    pub rolling_resistance: Option<f64>,
 }
 
 /// How far the centre line's end is from its start: a closed track has both near zero.
@@ -83,6 +87,8 @@ pub struct Frame {
     pub half_width: f64,
     /// Surface friction.
     pub friction: f64,
+    /// The surface's rolling resistance coefficient, if the track gives one.
+    pub rolling_resistance: Option<f64>,
     /// sin of the heading.
     pub sin_heading: f64,
     /// cos of the heading.
@@ -109,6 +115,7 @@ impl Frame {
             curvature: c.curvature,
             half_width: 0.5 * c.width,
             friction: c.friction,
+            rolling_resistance: c.rolling_resistance,
             sin_heading,
             cos_heading,
             sin_pitch,
@@ -337,6 +344,7 @@ impl Track {
                     banking: p.banking0 + (p.banking1 - p.banking0) * t,
                     width: p.width,
                     friction: p.friction,
+                    rolling_resistance: p.rolling_resistance,
                 });
                 i += 1;
             }
@@ -414,10 +422,13 @@ pub struct Piece {
     pub width: f64,
     /// Surface friction.
     pub friction: f64,
+    /// Surface rolling resistance, if the track gives one.
+    pub rolling_resistance: Option<f64>,
 }
 
 impl Piece {
-    /// A level, unbanked piece 12 m wide on a friction-1 surface.
+    /// A level, unbanked piece 12 m wide on a friction-1 surface, the tyres' rolling
+    /// resistance.
     pub fn flat(length: f64, curvature: f64) -> Piece {
         Piece {
             length,
@@ -428,6 +439,7 @@ impl Piece {
             banking1: 0.0,
             width: 12.0,
             friction: 1.0,
+            rolling_resistance: None,
         }
     }
 }

@@ -16,7 +16,8 @@
 //!   segment) gives z_end = z_start + length·grade; left and right edges follow cubic Hermite
 //!   profiles with `profil start/end tangent`; `banking start/end` override the edge heights.
 //!   Banking is atan((z_left − z_right) / width).
-//! - Road friction is the `friction` of the segment's `surface` in the `Surfaces` section.
+//! - Road friction and rolling resistance are the `friction` and `rolling resistance` of the
+//!   segment's `surface` in the `Surfaces` section (simuv2 takes both from the road).
 
 use std::path::Path;
 
@@ -143,9 +144,14 @@ impl Layout {
     }
 }
 
-/// Friction of a named surface (in `Surfaces` or, for version 3, `Surfaces/List`); 1.0 with
-/// a warning when the surface is not defined.
-fn surface_friction(params: &Params, surface: &str, warnings: &mut Vec<String>) -> Result<f64> {
+/// Friction and rolling resistance of a named surface (in `Surfaces` or, for version 3,
+/// `Surfaces/List`); friction 1.0 and the tyres' rolling resistance, with a warning, when the
+/// surface is not defined.
+fn surface_friction(
+    params: &Params,
+    surface: &str,
+    warnings: &mut Vec<String>,
+) -> Result<(f64, Option<f64>)> {
     let surfaces = params.section("Surfaces");
     let found = surfaces
         .and_then(|s| s.section(surface))
@@ -160,7 +166,17 @@ fn surface_friction(params: &Params, surface: &str, warnings: &mut Vec<String>) 
                     format!("friction must be positive, got {f}"),
                 ));
             }
-            Ok(f)
+            let rolling = match sec.num("rolling resistance")? {
+                Some(r) if !(r >= 0.0 && r < 1.0) => {
+                    return Err(params.error(
+                        &format!("{}/rolling resistance", sec.path),
+                        Some(sec.line_of("rolling resistance")),
+                        format!("rolling resistance must be in [0, 1), got {r}"),
+                    ));
+                }
+                r => r,
+            };
+            Ok((f, rolling))
         }
         None => {
             let w = format!(
@@ -170,7 +186,7 @@ fn surface_friction(params: &Params, surface: &str, warnings: &mut Vec<String>) 
             if !warnings.contains(&w) {
                 warnings.push(w);
             }
-            Ok(1.0)
+            Ok((1.0, None))
         }
     }
 }
@@ -205,7 +221,7 @@ fn segment_pieces(
     seg: &Section,
     width: f64,
     global_step: f64,
-    friction: f64,
+    (friction, rolling_resistance): (f64, Option<f64>),
     st: &mut ProfileState,
     out: &mut Vec<Piece>,
 ) -> Result<()> {
@@ -369,6 +385,7 @@ fn segment_pieces(
             banking1: (zl1 - zr1).atan2(width),
             width,
             friction,
+            rolling_resistance,
         });
         (zl0, zr0) = (zl1, zr1);
         if sign != 0.0 {
