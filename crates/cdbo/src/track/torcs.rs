@@ -167,7 +167,7 @@ fn surface_friction(
                 ));
             }
             let rolling = match sec.num("rolling resistance")? {
-                Some(r) if !(r >= 0.0 && r < 1.0) => {
+                Some(r) if !(0.0..1.0).contains(&r) => {
                     return Err(params.error(
                         &format!("{}/rolling resistance", sec.path),
                         Some(sec.line_of("rolling resistance")),
