@@ -1,9 +1,11 @@
-//! Where the dashboard reads studies and experiments from, behind one small trait so that
-//! another storage (a database server) can slot in beside the files. Every read is read-only.
+//! Where the dashboard reads studies and experiments from, behind one small trait: studies in
+//! SQLite files or PostgreSQL, experiments in folders or as grids in a database (filled by
+//! `cdbo experiment --storage URL --worker`). Every read is read-only.
 
 use std::path::{Path, PathBuf};
 
 use cdbo::experiment::record::RunRecord;
+use cdbo::experiment::shared::SharedGrid;
 use cdbo::study::{Location, Study, StudyConfig, Trial};
 use cdbo::{Error, Result};
 use serde::Serialize;
@@ -28,6 +30,9 @@ pub struct Source {
     /// A study's place, to open it (never sent to the page: a URL may hold a password).
     #[serde(skip)]
     pub study: Option<Location>,
+    /// A grid's place in a database, for an experiment not in a folder (never sent either).
+    #[serde(skip)]
+    pub grid: Option<Location>,
 }
 
 /// Read access to studies and experiments.
@@ -56,7 +61,50 @@ impl Files {
             kind: Kind::Study,
             location: study.path().display().to_string(),
             study: Some(location),
+            grid: None,
         })
+    }
+
+    /// Checks that there is a grid at `location`, opening it read-only.
+    pub fn grid_at(location: Location) -> Result<Source> {
+        let grid = SharedGrid::open_read_only(&location)?;
+        Ok(Source {
+            kind: Kind::Experiment,
+            location: grid.path().display().to_string(),
+            study: None,
+            grid: Some(location),
+        })
+    }
+
+    /// What `storage` names: a study or a grid (an SQLite file, or `DATABASE-URL#NAME`), or,
+    /// for a PostgreSQL URL without a name, every study and grid the database holds.
+    pub fn storage(storage: &str) -> Result<Vec<Source>> {
+        let database = ["postgresql://", "postgres://"]
+            .iter()
+            .any(|s| storage.starts_with(s));
+        if database && !storage.contains('#') {
+            let label = Location::parse(storage, Some("*"))?.label();
+            let (studies, grids) = cdbo::study::postgres::names(storage, &label)?;
+            let at = |name: &String| Location::parse(storage, Some(name));
+            let mut sources = Vec::new();
+            for name in &studies {
+                sources.push(Files::study_at(at(name)?)?);
+            }
+            for name in &grids {
+                sources.push(Files::grid_at(at(name)?)?);
+            }
+            return Ok(sources);
+        }
+        let location = Location::parse(storage, None)?;
+        match Files::study_at(location.clone()) {
+            Err(e @ (Error::NotAStudy { .. } | Error::NoStudy { .. })) => {
+                match Files::grid_at(location) {
+                    Err(Error::NotAGrid { .. } | Error::NoGrid { .. }) => Err(e),
+                    grid => grid.map(|g| vec![g]),
+                }
+            }
+            study => study.map(|s| vec![s]),
+        }
     }
 
     /// Checks that `dir` is a folder that can hold an experiment's runs. A grid that has not
@@ -80,6 +128,7 @@ impl Files {
             kind: Kind::Experiment,
             location: dir.display().to_string(),
             study: None,
+            grid: None,
         })
     }
 }
@@ -94,6 +143,9 @@ impl Store for Files {
     }
 
     fn runs(&self, source: &Source) -> Result<Vec<RunRecord>> {
+        if let Some(location) = &source.grid {
+            return SharedGrid::open_read_only(location)?.records();
+        }
         let dir = PathBuf::from(&source.location);
         if !dir.join("runs").is_dir() {
             return Ok(Vec::new());

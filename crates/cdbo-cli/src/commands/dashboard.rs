@@ -15,8 +15,9 @@ use super::CliResult;
 /// Arguments of `cdbo dashboard`.
 #[derive(Debug, Args)]
 pub struct DashboardArgs {
-    /// A study to show (repeatable), opened read-only: an SQLite file (FILE or sqlite://FILE)
-    /// or a study in PostgreSQL (postgresql://USER@HOST[:PORT]/DB#STUDY).
+    /// A study or grid to show (repeatable), opened read-only: an SQLite file (FILE or
+    /// sqlite://FILE), one in PostgreSQL (postgresql://USER@HOST[:PORT]/DB#NAME), or every
+    /// study and grid of a PostgreSQL database (its URL without #NAME).
     #[arg(long = "storage", visible_alias = "db", value_name = "URL|FILE")]
     studies: Vec<String>,
     /// An experiment output folder to show (repeatable); runs appear as they finish.
@@ -39,12 +40,22 @@ pub fn run(args: &DashboardArgs, data: &DataPath) -> CliResult {
         return Err("nothing to show: give --storage STUDY and/or --experiment DIR".into());
     }
     let mut sources = Vec::new();
-    for study in &args.studies {
-        sources.push(Files::study_at(Location::parse(study, None)?)?);
+    for storage in &args.studies {
+        let found = Files::storage(storage)?;
+        if found.is_empty() {
+            return Err(format!(
+                "{}: no study or grid in this database yet",
+                Location::parse(storage, Some("*"))?.label().display()
+            )
+            .into());
+        }
+        sources.extend(found);
     }
     for dir in &args.experiments {
         sources.push(Files::experiment_source(dir)?);
     }
+    let studies = sources.iter().filter(|s| s.study.is_some()).count();
+    let experiments = sources.len() - studies;
     let dashboard = Dashboard {
         sources,
         store: Box::new(Files),
@@ -56,8 +67,8 @@ pub fn run(args: &DashboardArgs, data: &DataPath) -> CliResult {
     println!(
         "cdbo dashboard on http://{}/ ({} studies, {} experiments); Ctrl-C to stop",
         bound.local_addr()?,
-        args.studies.len(),
-        args.experiments.len()
+        studies,
+        experiments
     );
     std::io::stdout().flush()?;
     bound.serve()?;

@@ -393,6 +393,41 @@ impl Transaction for PostgresTransaction<'_> {
     }
 }
 
+/// The studies and the grids the database at `url` holds, by name, in a read-only session
+/// (none of either where it has no cdbo tables); refuses a database of a newer schema.
+pub fn names(url: &str, label: &Path) -> Result<(Vec<String>, Vec<String>)> {
+    let err = |e| pg_error(label, e);
+    let mut client = connect(url, label)?;
+    client
+        .batch_execute("SET SESSION CHARACTERISTICS AS TRANSACTION READ ONLY")
+        .map_err(err)?;
+    let mut tx = client.transaction().map_err(err)?;
+    let Some(version) = schema_version(&mut tx, label)? else {
+        return Ok((Vec::new(), Vec::new()));
+    };
+    super::check_version(label, version)?;
+    let mut listed = Vec::new();
+    for table in ["cdbo_studies", "cdbo_grids"] {
+        let exists: bool = tx
+            .query_one("SELECT to_regclass($1) IS NOT NULL", &[&table])
+            .and_then(|r| r.try_get(0))
+            .map_err(err)?;
+        let names = if exists {
+            tx.query(&format!("SELECT name FROM {table} ORDER BY name"), &[])
+                .map_err(err)?
+                .iter()
+                .map(|r| r.try_get(0).map_err(err))
+                .collect::<Result<Vec<String>>>()?
+        } else {
+            Vec::new()
+        };
+        listed.push(names);
+    }
+    let grids = listed.pop().unwrap_or_default();
+    let studies = listed.pop().unwrap_or_default();
+    Ok((studies, grids))
+}
+
 /// Creates the tables where the database has none yet, under the schema lock (workers that
 /// start at once create them once); first refuses a database of a newer schema with
 /// `check_version`'s error, having written nothing.
