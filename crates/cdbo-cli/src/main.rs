@@ -78,25 +78,30 @@ fn main() -> ExitCode {
         Err(e) => return usage_error(&e),
     };
     let data = cdbo::data_path::DataPath::new(&cli.data_dirs);
-    // Only `lap`, `race` and `optimize` drive laps in the game so far; anything else would
-    // silently drive cdbo's simulator instead.
+    // Only these drive laps in the game; anything else would silently drive cdbo's
+    // simulator instead.
     let drives_torcs = matches!(
         cli.command,
-        Command::Lap(_) | Command::Race(_) | Command::Optimize(_) | Command::Torcs(_)
+        Command::Lap(_)
+            | Command::Race(_)
+            | Command::Optimize(_)
+            | Command::Experiment(_)
+            | Command::ServeSim(_)
+            | Command::Torcs(_)
     );
     if cli.simulator == commands::Simulator::Torcs && !drives_torcs {
         eprintln!(
-            "error: --simulator torcs works with `lap`, `race` and `optimize --track T` (and `cdbo torcs ...`); `experiment` and `serve-sim` drive cdbo's simulator only"
+            "error: --simulator torcs works with `lap`, `race`, `experiment`, `serve-sim` and `optimize --track T` (and `cdbo torcs ...`)"
         );
         return ExitCode::from(2);
     }
     let result = match cli.command {
         Command::Race(args) => commands::race::run(&args, &data, cli.simulator),
-        Command::Experiment(args) => commands::experiment::run_grid(&args, &data),
+        Command::Experiment(args) => commands::experiment::run_grid(&args, &data, cli.simulator),
         Command::Report(args) => commands::report::run(&args, &data),
         Command::Study(cmd) => commands::study::run(&cmd),
         Command::Optimize(args) => commands::optimize::run(&args, cli.simulator),
-        Command::ServeSim(args) => commands::serve_sim::run(&args, &data),
+        Command::ServeSim(args) => commands::serve_sim::run(&args, &data, cli.simulator),
         Command::Lap(args) => commands::lap::run(&args, &data, cli.simulator),
         Command::Limit(args) => commands::limit::run(&args, &data),
         Command::Ceiling(args) => commands::ceiling::run(&args, &data),

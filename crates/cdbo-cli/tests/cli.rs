@@ -419,12 +419,24 @@ fn bench_optimizers_compares_every_method() {
 /// A command that cannot drive the game says so instead of quietly driving cdbo's simulator.
 #[test]
 fn simulator_torcs_is_refused_where_it_is_not_supported() {
-    let works = "--simulator torcs works with `lap`, `race` and `optimize --track T`";
-    fails_with(&["--simulator", "torcs", "experiment", "quick"], &[works]);
+    let works = "--simulator torcs works with `lap`, `race`, `experiment`, `serve-sim` and `optimize --track T`";
+    fails_with(&["--simulator", "torcs", "limit"], &[works]);
+    fails_with(&["--simulator", "torcs", "ceiling"], &[works]);
+    // A grid in the game runs in a folder; workers over storage drive cdbo's simulator only.
+    let grid_db = scratch("torcs-grid.db", "");
+    std::fs::remove_file(&grid_db).unwrap();
     fails_with(
-        &["--simulator", "torcs", "serve-sim", "--kernels", "10"],
-        &[works],
+        &[
+            "--simulator",
+            "torcs",
+            "experiment",
+            "quick",
+            "--storage",
+            grid_db.to_str().unwrap(),
+        ],
+        &["--simulator torcs runs a grid in a folder", "--storage"],
     );
+    assert!(!grid_db.exists());
     // optimize drives the game itself with --track, and refuses the mix-ups before any study
     // file is made.
     let db = scratch("torcs-opt.db", "");

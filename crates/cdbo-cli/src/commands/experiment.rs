@@ -12,12 +12,12 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 
-use super::{CliResult, from_flag, load_track};
+use super::{CliResult, Simulator, from_flag, game_track, load_track};
 use cdbo::car::catalog as cars;
 use cdbo::data_path::DataPath;
 use cdbo::experiment::folder::{self, Session};
 use cdbo::experiment::grid::{ExperimentConfig, PRESETS, Shard};
-use cdbo::experiment::record::{RunRecord, run};
+use cdbo::experiment::record::{RunRecord, Venue, run_at};
 use cdbo::experiment::shared::{Progress, SharedGrid, work};
 use cdbo::study::Location;
 use cdbo::study::claim::{DEFAULT_LEASE, Missed, Worker};
@@ -93,31 +93,71 @@ fn read_grid(args: &ExperimentArgs) -> Result<(ExperimentConfig, String), String
     })
 }
 
-/// The grid's tracks, each loaded once.
+/// The grid's tracks, each loaded once; in the game, cdbo's reading of the game's track,
+/// checked to be one the game has.
 fn load_tracks(
     runs: &[cdbo::experiment::grid::RunSpec],
     data: &DataPath,
+    venue: &Venue,
 ) -> Result<BTreeMap<String, Track>, String> {
     let mut tracks: BTreeMap<String, Track> = BTreeMap::new();
     for r in runs {
         if !tracks.contains_key(&r.track) {
-            let t =
-                load_track(&r.track, data).map_err(|e| format!("{e}{}", track_hint(&r.track)))?;
+            let t = match venue {
+                Venue::Simulator => load_track(&r.track, data)
+                    .map_err(|e| format!("{e}{}", track_hint(&r.track)))?,
+                Venue::Torcs { game, .. } => {
+                    game.install
+                        .track_category(&r.track)
+                        .map_err(|e| e.to_string())?;
+                    game_track(&r.track, game, data).map_err(|e| e.to_string())?
+                }
+            };
             tracks.insert(r.track.clone(), t);
         }
     }
     Ok(tracks)
 }
 
-pub fn run_grid(args: &ExperimentArgs, data: &DataPath) -> CliResult {
+/// Where the grid's laps are driven, and the car as cdbo reads it: in the game, the game's
+/// car (car1-trb1 unless --car names another) from the game's own files.
+fn venue(
+    args: &ExperimentArgs,
+    data: &DataPath,
+    simulator: Simulator,
+) -> Result<(Venue, cdbo::car::Car), Box<dyn std::error::Error>> {
+    match simulator {
+        Simulator::Cdbo => Ok((Venue::Simulator, cars::find(&args.car, data)?)),
+        Simulator::Torcs => {
+            let game = cdbo::torcs::Game::ready()?;
+            let car = simulator.car(&args.car).to_owned();
+            let read = game.car(&car)?;
+            Ok((Venue::Torcs { game, car }, read))
+        }
+    }
+}
+
+pub fn run_grid(args: &ExperimentArgs, data: &DataPath, simulator: Simulator) -> CliResult {
     let (config, name) = read_grid(args)?;
     if let Some(storage) = &args.storage {
+        if simulator == Simulator::Torcs {
+            return Err(
+                "--simulator torcs runs a grid in a folder (--out, with --jobs games at once), not over --storage workers"
+                    .into(),
+            );
+        }
         return shared_grid(args, data, &config, &name, storage);
     }
+    // A grid in the game keeps its own folder: its runs are not cdbo's simulator's.
+    let suffix = if simulator == Simulator::Torcs {
+        "-torcs"
+    } else {
+        ""
+    };
     let out = args
         .out
         .clone()
-        .unwrap_or_else(|| PathBuf::from("runs").join(format!("experiment-{name}")));
+        .unwrap_or_else(|| PathBuf::from("runs").join(format!("experiment-{name}{suffix}")));
     folder::claim(&out, &config).map_err(|e| match e {
         cdbo::Error::DifferentGrid { .. } => format!("{e}; choose another --out"),
         e => e.to_string(),
@@ -147,8 +187,8 @@ pub fn run_grid(args: &ExperimentArgs, data: &DataPath) -> CliResult {
         }
     });
     let skipped = shard_size - runs.len();
-    let car = cars::find(&args.car, data)?;
-    let tracks = load_tracks(&runs, data)?;
+    let (venue, car) = venue(args, data, simulator)?;
+    let tracks = load_tracks(&runs, data, &venue)?;
     let jobs = args
         .jobs
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
@@ -170,7 +210,7 @@ pub fn run_grid(args: &ExperimentArgs, data: &DataPath) -> CliResult {
     pool.install(|| {
         runs.par_iter().try_for_each(|spec| -> Result<(), String> {
             let track = tracks[&spec.track].clone();
-            let record = run(spec, &config, track, &car, |_| bar.inc(1))
+            let record = run_at(spec, &config, track, &car, &venue, |_| bar.inc(1))
                 .map_err(|e| format!("{}: {e}", spec.id()))?;
             record.save(&out).map_err(|e| e.to_string())?;
             let k = done.fetch_add(1, Ordering::Relaxed) + 1;
@@ -225,7 +265,7 @@ fn shared_grid(
     // Everything a worker needs is checked before the grid is stored.
     let car = cars::find(&args.car, data)?;
     let tracks = if args.worker {
-        load_tracks(&config.runs(), data)?
+        load_tracks(&config.runs(), data, &Venue::Simulator)?
     } else {
         BTreeMap::new()
     };

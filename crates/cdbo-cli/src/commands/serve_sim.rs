@@ -1,18 +1,22 @@
-//! `cdbo serve-sim`: the simulator as a JSON-lines service ([`cdbo::serve`]), so that any
-//! optimiser in any language can race on our tracks: `{"info": true}` and
-//! `{"weights": [...]}` in, one reply line out for each, `{"error": ...}` for a bad line.
+//! `cdbo serve-sim`: the simulator (or, with `--simulator torcs`, the game) as a JSON-lines
+//! service ([`cdbo::serve`]), so that any optimiser in any language can race on our tracks:
+//! `{"info": true}` and `{"weights": [...]}` in, one reply line out for each,
+//! `{"error": ...}` for a bad line.
 
 use clap::Args;
 
-use super::{CliResult, Setup};
+use super::{CliResult, Setup, Simulator};
 use cdbo::data_path::DataPath;
+use cdbo::evaluator::Evaluator;
 use cdbo::evaluator::simulator::SimEvaluator;
+use cdbo::evaluator::torcs::TorcsEvaluator;
 use cdbo::experiment::race::demonstrate;
 use cdbo::optimizers::{DEFAULT_BOX_RADIUS, SearchBox};
 use cdbo::policy::RkhsPolicy;
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 use cdbo::serve::{Info, Server};
-use cdbo::sim::Simulator;
+use cdbo::torcs::{Game, GamePedal};
+use cdbo::track::Track;
 
 #[derive(Debug, Args)]
 pub struct ServeSimArgs {
@@ -26,13 +30,51 @@ pub struct ServeSimArgs {
     demo_speed: f64,
 }
 
-pub fn run(args: &ServeSimArgs, data: &DataPath) -> CliResult {
-    let (track, car) = args.setup.load(data)?;
-    let limit = cdbo::limit::limit_lap(&track, &car);
-    let sim = Simulator::new(track, &car);
-    let (_, demo) = demonstrate(&sim, args.demo_speed);
+pub fn run(args: &ServeSimArgs, data: &DataPath, simulator: Simulator) -> CliResult {
     let lengthscale = default_lengthscale(args.kernels);
-    let w0 = RkhsPolicy::fit(&demo, args.kernels, lengthscale, DEFAULT_RIDGE)?;
+    match simulator {
+        Simulator::Cdbo => {
+            let (track, car) = args.setup.load(data)?;
+            let limit = cdbo::limit::limit_lap(&track, &car);
+            let sim = cdbo::sim::Simulator::new(track, &car);
+            let (_, demo) = demonstrate(&sim, args.demo_speed);
+            let track = sim.track.clone();
+            let evaluator = SimEvaluator { sim, lengthscale };
+            serve(args, &track, &limit, &demo, evaluator)
+        }
+        // In the game: the demonstration and every lap a fresh game process; the limit on
+        // cdbo's reading of the game's track.
+        Simulator::Torcs => {
+            let game = Game::ready()?;
+            let car = simulator.car(&args.setup.car);
+            let mut request =
+                game.request(&args.setup.track, car, GamePedal::Demo(args.demo_speed))?;
+            let track = super::game_track(&args.setup.track, &game, data)?;
+            let limit = cdbo::limit::limit_lap(&track, &request.car);
+            request.record = true;
+            let demo = cdbo::torcs::race::drive(&game, &request, request.pedal.clone())?;
+            request.record = false;
+            let pairs: Vec<(f64, f64)> = demo.trace.iter().map(|p| (p.x, p.pedal)).collect();
+            let evaluator = TorcsEvaluator {
+                game,
+                request,
+                lengthscale,
+            };
+            serve(args, &track, &limit, &pairs, evaluator)
+        }
+    }
+}
+
+/// Fits w₀ to the demonstration's (x, a) pairs and answers requests with `evaluator`'s laps.
+fn serve(
+    args: &ServeSimArgs,
+    track: &Track,
+    limit: &cdbo::limit::Limit,
+    demo: &[(f64, f64)],
+    evaluator: impl Evaluator,
+) -> CliResult {
+    let lengthscale = default_lengthscale(args.kernels);
+    let w0 = RkhsPolicy::fit(demo, args.kernels, lengthscale, DEFAULT_RIDGE)?;
     let bounds = SearchBox::around(&w0.weights, DEFAULT_BOX_RADIUS)?;
     let info = Info {
         dim: args.kernels,
@@ -40,11 +82,10 @@ pub fn run(args: &ServeSimArgs, data: &DataPath) -> CliResult {
         lower: bounds.lower,
         upper: bounds.upper,
         lengthscale,
-        track: sim.track.name.clone(),
-        length_m: sim.track.length,
+        track: track.name.clone(),
+        length_m: track.length,
         limit_reward_mps: limit.reward_mps,
     };
-    let evaluator = SimEvaluator { sim, lengthscale };
     Server { info, evaluator }.serve(std::io::stdin().lock(), std::io::stdout().lock())?;
     Ok(())
 }

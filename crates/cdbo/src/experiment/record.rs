@@ -125,12 +125,43 @@ impl RunRecord {
     }
 }
 
-/// Races one run of the grid; `progress` is called after every lap.
+/// Where a grid's laps are driven.
+#[derive(Debug, Clone, Default)]
+pub enum Venue {
+    /// cdbo's simulator.
+    #[default]
+    Simulator,
+    /// The game TORCS: every lap (the demonstration's too) a fresh game process driven by
+    /// cdbo's robot ([`crate::torcs::race`]); the car by its TORCS name, the track by the
+    /// run's. The record's limit is cdbo's reading of the game's track; it has no ceiling
+    /// (that is a lap in cdbo's simulator).
+    Torcs {
+        /// The set-up game.
+        game: crate::torcs::Game,
+        /// The game's car.
+        car: String,
+    },
+}
+
+/// Races one run of the grid in cdbo's simulator; `progress` is called after every lap.
 pub fn run(
     spec: &RunSpec,
     grid: &ExperimentConfig,
     track: Track,
     car: &Car,
+    progress: impl FnMut(&LapRecord),
+) -> Result<RunRecord> {
+    run_at(spec, grid, track, car, &Venue::Simulator, progress)
+}
+
+/// Races one run of the grid where `venue` drives its laps (`track` and `car` are cdbo's
+/// reading of them, for the limit); `progress` is called after every lap.
+pub fn run_at(
+    spec: &RunSpec,
+    grid: &ExperimentConfig,
+    track: Track,
+    car: &Car,
+    venue: &Venue,
     progress: impl FnMut(&LapRecord),
 ) -> Result<RunRecord> {
     let start = std::time::Instant::now();
@@ -145,9 +176,20 @@ pub fn run(
         sigma0: grid.sigma0.get(&method).copied(),
     };
     let (track_name, length_m) = (track.name.clone(), track.length);
-    let ceiling_sim = crate::sim::Simulator::new(track.clone(), car);
-    let outcome = race(track, car, &config, progress)?;
-    let (_, ceiling_mps) = crate::ceiling::tracked_profile(&ceiling_sim, &outcome.limit)?;
+    let (outcome, ceiling_reward_mps) = match venue {
+        Venue::Simulator => {
+            let ceiling_sim = crate::sim::Simulator::new(track.clone(), car);
+            let outcome = race(track, car, &config, progress)?;
+            let (_, ceiling) = crate::ceiling::tracked_profile(&ceiling_sim, &outcome.limit)?;
+            (outcome, Some(ceiling))
+        }
+        Venue::Torcs { game, car } => {
+            let demo = crate::torcs::GamePedal::Demo(config.demo_speed);
+            let request = game.request(&spec.track, car, demo)?;
+            let outcome = crate::torcs::race::race(game, &request, &track, &config, progress)?;
+            (outcome, None)
+        }
+    };
     Ok(RunRecord {
         spec: spec.clone(),
         laps_planned: grid.laps,
@@ -156,7 +198,7 @@ pub fn run(
         demo_speed: grid.demo_speed,
         demo_reward_mps: outcome.demo.reward_mps,
         limit_reward_mps: outcome.limit.reward_mps,
-        ceiling_reward_mps: Some(ceiling_mps),
+        ceiling_reward_mps,
         initial_reward_mps: outcome.laps.first().map_or(0.0, |l| l.reward_mps),
         best_reward_mps: outcome.best_reward_mps,
         best_weights: outcome.best.weights.clone(),

@@ -219,21 +219,26 @@ fn settings(req: &LapRequest, output: &Path, trace: Option<&Path>, time_limit: f
 }
 
 impl Game {
-    /// A lap of `pedal` with the game's `car` on its `track` (TORCS names), with cdbo's
-    /// default lap settings; the car's parameters are read from the game's own car file.
-    pub fn request(&self, track: &str, car: &str, pedal: GamePedal) -> Result<LapRequest> {
-        self.install.track_category(track)?;
-        self.install.check_car(car)?;
+    /// The game's car of this name, read from its own car file.
+    pub fn car(&self, name: &str) -> Result<crate::car::Car> {
+        self.install.check_car(name)?;
         let file = self
             .install
             .data_dir
             .join("cars")
-            .join(car)
-            .join(format!("{car}.xml"));
+            .join(name)
+            .join(format!("{name}.xml"));
+        crate::car::torcs::read(&file, None)
+    }
+
+    /// A lap of `pedal` with the game's `car` on its `track` (TORCS names), with cdbo's
+    /// default lap settings; the car's parameters are read from the game's own car file.
+    pub fn request(&self, track: &str, car: &str, pedal: GamePedal) -> Result<LapRequest> {
+        self.install.track_category(track)?;
         Ok(LapRequest {
             track: track.to_owned(),
             car_name: car.to_owned(),
-            car: crate::car::torcs::read(&file, None)?,
+            car: self.car(car)?,
             pedal,
             config: LapConfig::default(),
             trace: None,

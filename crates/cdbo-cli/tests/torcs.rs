@@ -1,0 +1,157 @@
+//! The game TORCS behind `experiment` and `serve-sim` (`--simulator torcs`): a grid of races
+//! in the game with two games at once gives the records one game at a time gives, and the
+//! service answers with game laps; no game process and no lap folder is left. Skipped (with a
+//! message) where TORCS or the robot headers (../shared/torcs-sdk) are missing.
+
+mod common;
+
+use std::io::{BufRead, BufReader, Write};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+use common::{CDBO, fresh_dir};
+
+/// The private game tree, set up for this test in its own cache, or `None` (with a message)
+/// where the game or the robot headers are missing.
+fn game_cache(dir: &Path) -> Option<PathBuf> {
+    let sdk = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/torcs-sdk");
+    if !sdk.join("include/robot.h").is_file() {
+        eprintln!("skipped: no TORCS robot headers at ../shared/torcs-sdk/include/robot.h");
+        return None;
+    }
+    let cache = dir.join("torcs-cache");
+    let out = torcs_cmd(&cache)
+        .env("CDBO_TORCS_SDK", &sdk)
+        .args(["torcs", "setup"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    if !out.status.success() && err.contains("not installed") {
+        eprintln!("skipped: {err}");
+        return None;
+    }
+    assert!(out.status.success(), "{err}");
+    Some(cache)
+}
+
+/// `cdbo` with the game's tree in `cache`.
+fn torcs_cmd(cache: &Path) -> Command {
+    let mut c = Command::new(CDBO);
+    c.env("CDBO_TORCS_CACHE", cache);
+    c
+}
+
+/// No lap folder left in the tree, and no game process of this tree running.
+fn nothing_left(cache: &Path) {
+    let laps = cache.join("tree").join("laps");
+    let left: Vec<_> = std::fs::read_dir(&laps)
+        .map(|d| d.filter_map(|e| e.ok()).map(|e| e.path()).collect())
+        .unwrap_or_default();
+    assert!(left.is_empty(), "lap folders left: {left:?}");
+    let ps = Command::new("ps").args(["-eo", "args"]).output().unwrap();
+    let tree = cache.join("tree").display().to_string();
+    assert!(
+        !String::from_utf8_lossy(&ps.stdout)
+            .lines()
+            .any(|l| l.contains("torcs-bin") && l.contains(&tree)),
+        "a game process of {tree} is still running"
+    );
+}
+
+/// The best rewards of the runs in an experiment folder, by run.
+fn bests(out: &Path) -> Vec<(String, f64, usize)> {
+    let mut runs: Vec<_> = std::fs::read_dir(out.join("runs"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    runs.sort();
+    runs.iter()
+        .map(|p| {
+            let r: serde_json::Value =
+                serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap();
+            (
+                p.file_name().unwrap().to_string_lossy().into_owned(),
+                r["best_reward_mps"].as_f64().unwrap(),
+                r["laps"].as_array().unwrap().len(),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn a_grid_in_the_game_runs_with_jobs_like_any_other() {
+    let dir = fresh_dir("grid");
+    let Some(cache) = game_cache(&dir) else {
+        return;
+    };
+    let grid = dir.join("grid.toml");
+    std::fs::write(
+        &grid,
+        "laps = 6\nrepeats = 2\nmethods = [\"cdbo\"]\n\n[[tracks]]\ntrack = \"forza\"\nkernels = [8]\n",
+    )
+    .unwrap();
+    let run = |jobs: &str, out: &str| {
+        let o = torcs_cmd(&cache)
+            .current_dir(&dir)
+            .args(["--simulator", "torcs", "experiment"])
+            .args([grid.to_str().unwrap(), "--jobs", jobs, "--out", out])
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        bests(&dir.join(out))
+    };
+    let two = run("2", "two");
+    let one = run("1", "one");
+    assert_eq!(two.len(), 2);
+    assert!(
+        two.iter().all(|(_, best, laps)| *best > 10.0 && *laps == 6),
+        "{two:?}"
+    );
+    // The game is deterministic: two games at once give what one at a time gives.
+    assert_eq!(two, one);
+    nothing_left(&cache);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn serve_sim_in_the_game_answers_with_game_laps() {
+    let dir = fresh_dir("serve");
+    let Some(cache) = game_cache(&dir) else {
+        return;
+    };
+    let mut child = torcs_cmd(&cache)
+        .args([
+            "--simulator",
+            "torcs",
+            "serve-sim",
+            "--track",
+            "forza",
+            "--kernels",
+            "8",
+        ])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut stdin = child.stdin.take().unwrap();
+    let mut lines = BufReader::new(child.stdout.take().unwrap()).lines();
+    let mut ask = |line: &str| -> serde_json::Value {
+        writeln!(stdin, "{line}").unwrap();
+        serde_json::from_str(&lines.next().unwrap().unwrap()).unwrap()
+    };
+    let info = ask(r#"{"info": true}"#);
+    assert_eq!(info["dim"], 8);
+    assert_eq!(info["track"], "Forza");
+    let w0 = info["w0"].clone();
+    // w0, fitted to the game's 15 m/s demonstration, laps Forza near 15 m/s in the game.
+    let lap = ask(&format!(r#"{{"weights": {w0}}}"#));
+    let reward = lap["reward_mps"].as_f64().unwrap();
+    assert!((12.0..16.0).contains(&reward), "{lap}");
+    let brake = ask(r#"{"weights": [-1, -1, -1, -1, -1, -1, -1, -1]}"#);
+    assert_eq!(brake["failure"]["reason"], "stalled");
+    drop(stdin);
+    assert!(child.wait().unwrap().success());
+    nothing_left(&cache);
+    let _ = std::fs::remove_dir_all(&dir);
+}
