@@ -1,14 +1,14 @@
 //! Studies for a real car: the ask/tell workflow, bad input, external evaluators, crash
 //! safety under SIGKILL, and the simulator as a JSON-lines service.
 
-use std::io::{BufRead, BufReader, Write};
+use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
 mod common;
 
-use common::{CDBO, cdbo, demo, fresh_dir, history, ok};
+use common::{CDBO, Service, cdbo, demo, fresh_dir, history, ok};
 
 /// Expects failure with one clear error line containing `needle`.
 fn fails(dir: &Path, args: &[&str], needle: &str) {
@@ -296,21 +296,14 @@ fn sigkill_at_random_moments_loses_nothing() {
 
 #[test]
 fn serve_sim_answers_json_lines() {
-    let mut child = Command::new(CDBO)
+    let mut command = Command::new(CDBO);
+    command
         // Since the gearbox shifts at the current throttle, the 8-kernel fits of the 13-18 m/s
         // demonstrations stall on Ridgeway's climb near x = 0.45 (their smoothed pedal holds a
         // high gear there); that of a 20 m/s one completes.
-        .args(["serve-sim", "--kernels", "8", "--demo-speed", "20"])
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut stdin = child.stdin.take().unwrap();
-    let mut lines = BufReader::new(child.stdout.take().unwrap()).lines();
-    let mut ask = |line: &str| -> serde_json::Value {
-        writeln!(stdin, "{line}").unwrap();
-        serde_json::from_str(&lines.next().unwrap().unwrap()).unwrap()
-    };
+        .args(["serve-sim", "--kernels", "8", "--demo-speed", "20"]);
+    let mut service = Service::start(command);
+    let mut ask = |line: &str| service.ask(line);
     let info = ask(r#"{"info": true}"#);
     assert_eq!(info["dim"], 8);
     let w0 = info["w0"].clone();
@@ -331,6 +324,5 @@ fn serve_sim_answers_json_lines() {
     }
     // Still serving after the errors.
     assert_eq!(ask(&format!(r#"{{"weights": {w0}}}"#)), lap);
-    drop(stdin);
-    assert!(child.wait().unwrap().success());
+    assert!(service.finish().success());
 }

@@ -5,11 +5,10 @@
 
 mod common;
 
-use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
-use common::{CDBO, fresh_dir};
+use common::{CDBO, Service, fresh_dir};
 
 /// The private game tree, set up for this test in its own cache, or `None` (with a message)
 /// where the game or the robot headers are missing.
@@ -119,27 +118,13 @@ fn serve_sim_in_the_game_answers_with_game_laps() {
     let Some(cache) = game_cache(&dir) else {
         return;
     };
-    let mut child = torcs_cmd(&cache)
-        .args([
-            "--simulator",
-            "torcs",
-            "serve-sim",
-            "--track",
-            "forza",
-            "--kernels",
-            "8",
-        ])
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let mut stdin = child.stdin.take().unwrap();
-    let mut lines = BufReader::new(child.stdout.take().unwrap()).lines();
-    let mut ask = |line: &str| -> serde_json::Value {
-        writeln!(stdin, "{line}").unwrap();
-        serde_json::from_str(&lines.next().unwrap().unwrap()).unwrap()
-    };
+    let mut command = torcs_cmd(&cache);
+    command
+        .args(["--simulator", "torcs", "serve-sim"])
+        .args(["--track", "forza", "--kernels", "8"])
+        .stderr(Stdio::null());
+    let mut service = Service::start(command);
+    let mut ask = |line: &str| service.ask(line);
     let info = ask(r#"{"info": true}"#);
     assert_eq!(info["dim"], 8);
     assert_eq!(info["track"], "Forza");
@@ -150,8 +135,7 @@ fn serve_sim_in_the_game_answers_with_game_laps() {
     assert!((12.0..16.0).contains(&reward), "{lap}");
     let brake = ask(r#"{"weights": [-1, -1, -1, -1, -1, -1, -1, -1]}"#);
     assert_eq!(brake["failure"]["reason"], "stalled");
-    drop(stdin);
-    assert!(child.wait().unwrap().success());
+    assert!(service.finish().success());
     nothing_left(&cache);
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -2,8 +2,9 @@
 //! recorded demonstration, a study's history.
 #![allow(dead_code)]
 
+use std::io::{BufRead, BufReader, Lines, Write};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::{Child, ChildStdin, ChildStdout, Command, ExitStatus, Output, Stdio};
 
 /// The `cdbo` binary under test.
 pub const CDBO: &str = env!("CARGO_BIN_EXE_cdbo");
@@ -90,4 +91,44 @@ pub fn rewards_table(report: &Path) -> String {
         .expect("run times after it")
         + start;
     text[start..end].to_owned()
+}
+
+/// A running `cdbo serve-sim`, asked one JSON line at a time.
+pub struct Service {
+    child: Child,
+    stdin: ChildStdin,
+    lines: Lines<BufReader<ChildStdout>>,
+}
+
+impl Service {
+    /// Starts `command` (a `cdbo ... serve-sim ...`) with piped standard input and output.
+    pub fn start(mut command: Command) -> Service {
+        let mut child = command
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let stdin = child.stdin.take().unwrap();
+        let lines = BufReader::new(child.stdout.take().unwrap()).lines();
+        Service {
+            child,
+            stdin,
+            lines,
+        }
+    }
+
+    /// Sends one line and reads the reply line as JSON.
+    pub fn ask(&mut self, line: &str) -> serde_json::Value {
+        writeln!(self.stdin, "{line}").unwrap();
+        serde_json::from_str(&self.lines.next().unwrap().unwrap()).unwrap()
+    }
+
+    /// Closes its input and waits for it to end.
+    pub fn finish(self) -> ExitStatus {
+        let Service {
+            mut child, stdin, ..
+        } = self;
+        drop(stdin);
+        child.wait().unwrap()
+    }
 }
