@@ -169,8 +169,9 @@ pub enum Missed {
 }
 
 /// Runs `work` while a thread renews a claim every `interval`: `renewer` opens the thread's
-/// own connection and returns the renewal (true while the claim is still ours). Returns the
-/// work's result and what the heartbeat met; it stops at the first lost claim.
+/// own connection, at the first beat (work shorter than one interval opens none), and returns
+/// the renewal (true while the claim is still ours). Returns the work's result and what the
+/// heartbeat met; it stops at the first lost claim.
 pub fn while_renewing<'a, T>(
     interval: Duration,
     renewer: impl FnOnce() -> crate::Result<Box<dyn FnMut() -> crate::Result<bool> + 'a>> + Send + 'a,
@@ -180,6 +181,10 @@ pub fn while_renewing<'a, T>(
     std::thread::scope(|scope| {
         let beat = scope.spawn(|| {
             let mut missed = Vec::new();
+            std::thread::park_timeout(interval);
+            if stop.load(Ordering::Acquire) {
+                return missed;
+            }
             let mut renew = match renewer() {
                 Ok(r) => r,
                 Err(e) => {
@@ -188,10 +193,6 @@ pub fn while_renewing<'a, T>(
                 }
             };
             loop {
-                std::thread::park_timeout(interval);
-                if stop.load(Ordering::Acquire) {
-                    return missed;
-                }
                 match renew() {
                     Ok(true) => {}
                     Ok(false) => {
@@ -199,6 +200,10 @@ pub fn while_renewing<'a, T>(
                         return missed;
                     }
                     Err(e) => missed.push(Missed::Failed(e)),
+                }
+                std::thread::park_timeout(interval);
+                if stop.load(Ordering::Acquire) {
+                    return missed;
                 }
             }
         });
@@ -280,6 +285,30 @@ mod tests {
         assert!(!owner_is_gone(&format!("another-host/{pid}/0")));
         let c = claim(1, Some(&dead), 1e12);
         assert!(is_free(&c, 0.0));
+    }
+
+    #[test]
+    fn the_heartbeat_connects_at_its_first_beat_and_stops_at_a_lost_claim() {
+        use std::sync::atomic::AtomicUsize;
+        let interval = Duration::from_millis(40);
+        let (opened, beats) = (AtomicUsize::new(0), AtomicUsize::new(0));
+        let renewer = || -> crate::Result<Box<dyn FnMut() -> crate::Result<bool> + '_>> {
+            opened.fetch_add(1, Ordering::SeqCst);
+            Ok(Box::new(|| Ok(beats.fetch_add(1, Ordering::SeqCst) < 2)))
+        };
+        // Shorter than one interval: no connection, no beat.
+        let (v, missed) = while_renewing(interval, renewer, || 7);
+        assert_eq!((v, missed.len()), (7, 0));
+        assert_eq!(opened.load(Ordering::SeqCst), 0);
+        // Long work: one connection, two renewals, then the claim is lost and beats stop.
+        let renewer = || -> crate::Result<Box<dyn FnMut() -> crate::Result<bool> + '_>> {
+            opened.fetch_add(1, Ordering::SeqCst);
+            Ok(Box::new(|| Ok(beats.fetch_add(1, Ordering::SeqCst) < 2)))
+        };
+        let ((), missed) = while_renewing(interval, renewer, || std::thread::sleep(interval * 25));
+        assert_eq!(opened.load(Ordering::SeqCst), 1);
+        assert_eq!(beats.load(Ordering::SeqCst), 3);
+        assert!(matches!(missed.as_slice(), [Missed::Lost]), "{missed:?}");
     }
 
     #[test]
