@@ -68,9 +68,12 @@ fn default_beta() -> f64 {
 /// The presets [`ExperimentConfig::preset`] knows.
 pub const PRESETS: &[&str] = &["paper", "paper-plus", "quick"];
 
-/// The main knobs tuned on the training tracks (ridgeway, forza, e-track-2; 30 kernels,
-/// seeds 100–101; docs/results/beyond): random search's σ, CMA-ES's σ₀, the pattern search's
-/// first step. `paper-plus` runs them; `paper` keeps every method at the race default 0.03.
+/// The main knobs tuned on the training tracks (docs/results/beyond): random search's σ and
+/// the pattern search's first step swept on ridgeway-30, forza-30, e-track-2-30 and forza-50
+/// (seeds 100–105) and re-checked with session 8's final physics on ridgeway-30 and
+/// e-track-2-30 (seeds 100–101), which decided; CMA-ES's σ₀ on ridgeway, forza and e-track-2
+/// with 30 kernels (seeds 100–101, session 6). `paper-plus` runs them; `paper` keeps every
+/// method at the race default 0.03.
 pub const TUNED_SIGMA0: [(Method, f64); 3] = [
     (Method::Random, 0.01),
     (Method::Cmaes, 0.01),
