@@ -268,6 +268,7 @@ fn a_short_race_writes_its_results() {
     // Same seed, same race.
     let again = json(args);
     assert_eq!(again["best_reward_mps"], v["best_reward_mps"]);
+    let _ = std::fs::remove_dir_all(&out);
 }
 
 #[test]
@@ -378,6 +379,7 @@ fn a_race_draws_its_figures() {
             "{name}"
         );
     }
+    let _ = std::fs::remove_dir_all(&out);
 }
 
 #[test]
