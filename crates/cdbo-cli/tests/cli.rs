@@ -1,6 +1,6 @@
 //! The command line as a user meets it: outputs, JSON keys, and one clear error line.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn cdbo(args: &[&str]) -> Output {
@@ -37,7 +37,8 @@ fn json(args: &[&str]) -> serde_json::Value {
 
 /// A scratch file with `content`, unique to this test.
 fn scratch(name: &str, content: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("cdbo-cli-test-{}", std::process::id()));
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("cdbo-cli-test-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let p = dir.join(name);
     std::fs::write(&p, content).unwrap();
@@ -208,7 +209,8 @@ fn bad_track_files_give_one_clear_error() {
 fn a_short_race_writes_its_results() {
     // 20 kernels: since the gearbox shifts at the current throttle, the 10-kernel fit of the
     // demonstration laps Ridgeway at 8.8 m/s (its smoothed pedal climbs the gears), 20 at 15.4.
-    let out = std::env::temp_dir().join(format!("cdbo-cli-race-{}", std::process::id()));
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("cdbo-cli-race-{}", std::process::id()));
     let args = &[
         "race",
         "--laps",
@@ -355,7 +357,8 @@ fn bench_suggest_reports_its_keys() {
 
 #[test]
 fn a_race_draws_its_figures() {
-    let out = std::env::temp_dir().join(format!("cdbo-cli-race-plots-{}", std::process::id()));
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("cdbo-cli-race-plots-{}", std::process::id()));
     succeed(&[
         "race",
         "--laps",
@@ -470,7 +473,7 @@ fn dashboard_refuses_bad_sources_and_a_port_in_use_in_one_line() {
     fails_with(&["dashboard"], &["nothing to show"]);
     let taken = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
     let addr = taken.local_addr().unwrap().to_string();
-    let dir = std::env::temp_dir().to_str().unwrap().to_owned();
+    let dir = env!("CARGO_TARGET_TMPDIR").to_owned();
     fails_with(
         &["dashboard", "--experiment", &dir, "--bind", &addr],
         &[&addr, "in use"],

@@ -484,7 +484,8 @@ fn read_only_and_foreign_studies() {
             String::from_utf8_lossy(&out.stderr)
         );
     }
-    let export = std::env::temp_dir().join(format!("cdbo-rel-{}-export", std::process::id()));
+    let export = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("cdbo-rel-{}-export", std::process::id()));
     let _ = std::fs::remove_dir_all(&export);
     std::fs::create_dir_all(&export).unwrap();
     std::fs::set_permissions(&export, std::fs::Permissions::from_mode(0o777)).unwrap();

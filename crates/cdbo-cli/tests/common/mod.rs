@@ -29,9 +29,10 @@ pub fn ok(dir: &Path, args: &[&str]) -> String {
     String::from_utf8(out.stdout).unwrap()
 }
 
-/// An empty scratch folder of its own for test `name` of this test file.
+/// An empty scratch folder of its own for test `name` of this test file, under cargo's
+/// `target/tmp` (nothing is left in the system's temporary folder).
 pub fn fresh_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!(
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!(
         "cdbo-{}-{}-{name}",
         env!("CARGO_CRATE_NAME"),
         std::process::id()
