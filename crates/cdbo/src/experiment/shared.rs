@@ -42,6 +42,8 @@ pub trait GridStorage: Send {
     fn grid(&mut self) -> Result<Option<String>>;
     /// The finished cells' records (JSON), in cell order.
     fn records(&mut self) -> Result<Vec<String>>;
+    /// Number of unfinished cells, read without the write lock (a waiting worker's cheap poll).
+    fn unfinished_count(&mut self) -> Result<usize>;
     /// The sessions logged (JSON of [`Session`]), in order.
     fn sessions(&mut self) -> Result<Vec<String>>;
     /// Logs a session.
@@ -300,10 +302,21 @@ pub fn work(
                     on_progress(Progress::Waiting);
                     waiting = true;
                 }
-                std::thread::sleep(worker.heartbeat_interval().clamp(
+                // Claims again (to take over a cell whose lease runs out) once per heartbeat
+                // interval, between 0.1 and 1 s; meanwhile polls every 50 ms, without the
+                // grid's write lock, for the last cell's end, so that a waiting worker stops
+                // as the grid is done and not up to a second later.
+                let interval = worker.heartbeat_interval().clamp(
                     std::time::Duration::from_millis(100),
                     std::time::Duration::from_secs(1),
-                ));
+                );
+                let start = std::time::Instant::now();
+                while start.elapsed() < interval {
+                    std::thread::sleep(std::time::Duration::from_millis(50));
+                    if grid.storage.unfinished_count()? == 0 {
+                        return Ok(ran);
+                    }
+                }
                 continue;
             }
             Next::Run(cell) => cell,

@@ -114,6 +114,18 @@ impl GridStorage for PostgresGrid {
         )
     }
 
+    fn unfinished_count(&mut self) -> Result<usize> {
+        let row = self
+            .client
+            .query_one(
+                "SELECT COUNT(*) FROM cdbo_grid_runs WHERE grid = $1 AND record IS NULL",
+                &[&self.name],
+            )
+            .map_err(|e| pg_error(&self.label, e))?;
+        let n: i64 = row.try_get(0).map_err(|e| pg_error(&self.label, e))?;
+        Ok(n as usize)
+    }
+
     fn sessions(&mut self) -> Result<Vec<String>> {
         self.strings("SELECT session FROM cdbo_grid_sessions WHERE grid = $1 ORDER BY id")
     }

@@ -145,6 +145,15 @@ impl GridStorage for SqliteGrid {
         .map_err(|e| sql_error(&self.path, e))
     }
 
+    fn unfinished_count(&mut self) -> Result<usize> {
+        self.conn
+            .query_row("SELECT COUNT(*) FROM runs WHERE record IS NULL", [], |r| {
+                r.get::<_, i64>(0)
+            })
+            .map(|n| n as usize)
+            .map_err(|e| sql_error(&self.path, e))
+    }
+
     fn sessions(&mut self) -> Result<Vec<String>> {
         strings(&self.conn, "SELECT session FROM sessions ORDER BY id")
             .map_err(|e| sql_error(&self.path, e))
