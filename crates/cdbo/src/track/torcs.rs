@@ -216,6 +216,10 @@ fn hermite(p0: f64, p1: f64, t0: f64, t1: f64, t: f64) -> f64 {
         + t1 * (t3 - t2)
 }
 
+/// The longest segment a track file may give: a whole lap of the Nürburgring's Nordschleife is
+/// 21 km, so a longer segment is a mistake in the file, not a track.
+const MAX_SEGMENT_LENGTH_M: f64 = 100_000.0;
+
 fn segment_pieces(
     params: &Params,
     seg: &Section,
@@ -271,10 +275,10 @@ fn segment_pieces(
             ));
         }
     };
-    if length <= 0.0 {
+    if !(length > 0.0 && length <= MAX_SEGMENT_LENGTH_M) {
         return Err(err(
             "lg",
-            format!("length must be positive, got {length} m"),
+            format!("length must be positive and at most 100 km, got {length} m"),
         ));
     }
 
@@ -320,7 +324,7 @@ fn segment_pieces(
         if n <= 1 {
             let step_len = seg.num_or("profil steps length", global_step)?;
             n = if step_len > 0.0 {
-                (length / step_len) as usize + 1
+                ((length / step_len) as usize).saturating_add(1)
             } else {
                 1
             };
@@ -435,6 +439,22 @@ mod tests {
             t.closure
         );
         assert!((t.min_radius() - 50.0).abs() < 1e-9);
+    }
+
+    /// A fuzzer's find: a 2·10⁵¹ m straight overflowed the count of profile steps. A segment
+    /// past 100 km is refused, naming it; a tiny profile step length is capped, not a panic.
+    #[test]
+    fn an_absurd_segment_length_is_an_error_and_a_tiny_step_no_panic() {
+        let e = track_of(r#"<section name="s1"><attstr name="type" val="str"/><attnum name="lg" unit="m" val="2e51"/></section>"#)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("s1/lg") && e.contains("at most 100 km") && e.contains("2000000000"),
+            "{e}"
+        );
+        let tiny = r#"<section name="s1"><attstr name="type" val="str"/><attnum name="lg" unit="m" val="100"/>
+            <attnum name="profil steps length" unit="m" val="1e-300"/></section>"#;
+        let _ = track_of(tiny);
     }
 
     #[test]
