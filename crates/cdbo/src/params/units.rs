@@ -79,7 +79,9 @@ fn powered_token_factor(token: &str) -> Option<f64> {
     if let Some(f) = token_factor(token) {
         return Some(f);
     }
-    let (base, power) = token.split_at(token.len().checked_sub(1)?);
+    // The last character, not the last byte: a unit may end in any character (`m²`).
+    let (last, _) = token.char_indices().next_back()?;
+    let (base, power) = token.split_at(last);
     let power: i32 = power.parse().ok()?;
     if !(2..=4).contains(&power) {
         return None;
@@ -102,6 +104,14 @@ mod tests {
         assert!(close(si_factor("%").unwrap(), 0.01));
         assert!(close(si_factor("rpm").unwrap() * 60.0, 2.0 * PI));
         assert!(close(si_factor("").unwrap(), 1.0));
+    }
+
+    /// A fuzzer's find: a unit ending in a multi-byte character split inside it.
+    #[test]
+    fn a_unit_ending_in_a_multibyte_character_is_unknown_not_a_panic() {
+        assert_eq!(si_factor("m²"), None);
+        assert_eq!(si_factor("kg.é"), None);
+        assert!(close(si_factor("kg.m2").unwrap(), 1.0));
     }
 
     #[test]
