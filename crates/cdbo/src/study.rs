@@ -18,6 +18,7 @@
 
 pub mod claim;
 pub mod postgres;
+pub(crate) mod rows;
 pub mod run;
 pub mod sqlite;
 pub mod storage;

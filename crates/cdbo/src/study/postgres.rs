@@ -14,11 +14,13 @@
 //! is renewing and count too few in flight. The pending trials are read `FOR UPDATE` too, so
 //! that a claim sees a heartbeat that committed while it waited.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Duration;
 
 use postgres::{Client, NoTls};
 
+use super::rows::TRIALS;
+use super::rows::postgres::{PgRows, PgRowsTransaction};
 use super::storage::{Dump, Row, Storage, Told, Transaction};
 use super::{SCHEMA_VERSION, Trial, claim::Claim};
 use crate::error::{Error, Result};
@@ -69,9 +71,7 @@ const TRIAL_COLUMNS: &str = "id, weights, reward, lap_time_s, failure, x_fail";
 
 /// A study in a PostgreSQL database.
 pub struct Postgres {
-    label: PathBuf,
-    study: String,
-    client: Client,
+    rows: PgRows,
 }
 
 impl Postgres {
@@ -148,32 +148,27 @@ impl Postgres {
         tx.commit().map_err(err)?;
         Ok((
             Postgres {
-                label: label.to_owned(),
-                study: study.to_owned(),
-                client,
+                rows: PgRows::new(label, study, client, &TRIALS),
             },
             config,
         ))
     }
 
     fn rows(&mut self) -> Result<Vec<Row>> {
-        let rows = self
-            .client
-            .query(
-                &format!(
-                    "SELECT {TRIAL_COLUMNS}, asked_unix_s, told_unix_s, owner, lease_until_unix_s FROM cdbo_trials WHERE study = $1 ORDER BY id"
-                ),
-                &[&self.study],
-            )
-            .map_err(|e| pg_error(&self.label, e))?;
+        let sql = format!(
+            "SELECT {TRIAL_COLUMNS}, asked_unix_s, told_unix_s, owner, lease_until_unix_s FROM cdbo_trials WHERE study = $1 ORDER BY id"
+        );
+        let rows = self.rows.with(|c, study| c.query(&sql, &[&study]))?;
+        let label = self.rows.label();
+        let err = |e| pg_error(label, e);
         rows.iter()
             .map(|r| {
                 Ok(Row {
-                    trial: to_trial(r, &self.label)?,
-                    asked_unix_s: r.try_get(6).map_err(|e| pg_error(&self.label, e))?,
-                    told_unix_s: r.try_get(7).map_err(|e| pg_error(&self.label, e))?,
-                    owner: r.try_get(8).map_err(|e| pg_error(&self.label, e))?,
-                    lease_until_unix_s: r.try_get(9).map_err(|e| pg_error(&self.label, e))?,
+                    trial: to_trial(r, label)?,
+                    asked_unix_s: r.try_get(6).map_err(err)?,
+                    told_unix_s: r.try_get(7).map_err(err)?,
+                    owner: r.try_get(8).map_err(err)?,
+                    lease_until_unix_s: r.try_get(9).map_err(err)?,
                 })
             })
             .collect()
@@ -182,51 +177,21 @@ impl Postgres {
 
 impl Storage for Postgres {
     fn label(&self) -> &Path {
-        &self.label
+        self.rows.label()
     }
 
     fn begin(&mut self) -> Result<Box<dyn Transaction + '_>> {
-        let label = &self.label;
-        let mut tx = self.client.transaction().map_err(|e| pg_error(label, e))?;
-        let locked = tx
-            .query_opt(
-                "SELECT 1 FROM cdbo_studies WHERE name = $1 FOR UPDATE",
-                &[&self.study],
-            )
-            .map_err(|e| pg_error(label, e))?;
-        if locked.is_none() {
-            return Err(Error::NoStudy {
-                path: label.clone(),
-            });
-        }
         Ok(Box::new(PostgresTransaction {
-            label,
-            study: &self.study,
-            tx,
+            rows: self.rows.begin()?,
         }))
     }
 
     fn heartbeat(&mut self, id: i64, owner: &str, until: f64) -> Result<bool> {
-        let n = self
-            .client
-            .execute(
-                "UPDATE cdbo_trials SET lease_until_unix_s = $1 WHERE study = $2 AND id = $3 AND owner = $4 AND reward IS NULL",
-                &[&until, &self.study, &id, &owner],
-            )
-            .map_err(|e| pg_error(&self.label, e))?;
-        Ok(n == 1)
+        self.rows.heartbeat(id, owner, until)
     }
 
     fn told(&mut self) -> Result<usize> {
-        let n: i64 = self
-            .client
-            .query_one(
-                "SELECT COUNT(*) FROM cdbo_trials WHERE study = $1 AND reward IS NOT NULL",
-                &[&self.study],
-            )
-            .and_then(|r| r.try_get(0))
-            .map_err(|e| pg_error(&self.label, e))?;
-        Ok(n as usize)
+        self.rows.count(true)
     }
 
     fn history(&mut self) -> Result<Vec<Trial>> {
@@ -234,17 +199,16 @@ impl Storage for Postgres {
     }
 
     fn dump(&mut self) -> Result<Dump> {
-        let row = self
-            .client
-            .query_one(
+        let (config, optimizer) = self.rows.with(|c, study| {
+            let row = c.query_one(
                 "SELECT config, optimizer_state FROM cdbo_studies WHERE name = $1",
-                &[&self.study],
-            )
-            .map_err(|e| pg_error(&self.label, e))?;
-        let err = |e| pg_error(&self.label, e);
+                &[&study],
+            )?;
+            Ok((row.try_get(0)?, row.try_get(1)?))
+        })?;
         Ok(Dump {
-            config: row.try_get(0).map_err(err)?,
-            optimizer: row.try_get(1).map_err(err)?,
+            config,
+            optimizer,
             trials: self.rows()?,
         })
     }
@@ -252,35 +216,24 @@ impl Storage for Postgres {
 
 /// A write transaction on a PostgreSQL study, holding its row lock.
 struct PostgresTransaction<'a> {
-    label: &'a Path,
-    study: &'a str,
-    tx: postgres::Transaction<'a>,
-}
-
-impl PostgresTransaction<'_> {
-    fn err(&self) -> impl Fn(postgres::Error) -> Error + '_ {
-        |e| pg_error(self.label, e)
-    }
+    rows: PgRowsTransaction<'a>,
 }
 
 impl Transaction for PostgresTransaction<'_> {
     fn pending(&mut self) -> Result<Vec<(Trial, Claim)>> {
-        let rows = self
-            .tx
-            .query(
-                &format!(
-                    "SELECT {TRIAL_COLUMNS}, owner, lease_until_unix_s FROM cdbo_trials WHERE study = $1 AND reward IS NULL ORDER BY id FOR UPDATE"
-                ),
-                &[&self.study],
-            )
-            .map_err(self.err())?;
+        let sql = format!(
+            "SELECT {TRIAL_COLUMNS}, owner, lease_until_unix_s FROM cdbo_trials WHERE study = $1 AND reward IS NULL ORDER BY id FOR UPDATE"
+        );
+        let rows = self.rows.with(|tx, study| tx.query(&sql, &[&study]))?;
+        let label = self.rows.label();
+        let err = |e| pg_error(label, e);
         rows.iter()
             .map(|r| {
-                let t = to_trial(r, self.label)?;
+                let t = to_trial(r, label)?;
                 let c = Claim {
                     trial: t.id,
-                    owner: r.try_get(6).map_err(self.err())?,
-                    lease_until: r.try_get(7).map_err(self.err())?,
+                    owner: r.try_get(6).map_err(err)?,
+                    lease_until: r.try_get(7).map_err(err)?,
                 };
                 Ok((t, c))
             })
@@ -288,51 +241,39 @@ impl Transaction for PostgresTransaction<'_> {
     }
 
     fn told(&mut self) -> Result<usize> {
-        let n: i64 = self
-            .tx
-            .query_one(
-                "SELECT COUNT(*) FROM cdbo_trials WHERE study = $1 AND reward IS NOT NULL",
-                &[&self.study],
-            )
-            .and_then(|r| r.try_get(0))
-            .map_err(self.err())?;
-        Ok(n as usize)
+        self.rows.count(true)
     }
 
     fn told_rewards(&mut self) -> Result<Vec<f64>> {
-        let rows = self
-            .tx
-            .query(
+        self.rows.with(|tx, study| {
+            tx.query(
                 "SELECT reward FROM cdbo_trials WHERE study = $1 AND reward IS NOT NULL ORDER BY id",
-                &[&self.study],
-            )
-            .map_err(self.err())?;
-        rows.iter()
-            .map(|r| r.try_get(0).map_err(self.err()))
+                &[&study],
+            )?
+            .iter()
+            .map(|r| r.try_get(0))
             .collect()
+        })
     }
 
     fn trial(&mut self, id: i64) -> Result<Option<Trial>> {
+        let sql = format!(
+            "SELECT {TRIAL_COLUMNS} FROM cdbo_trials WHERE study = $1 AND id = $2 FOR UPDATE"
+        );
         let row = self
-            .tx
-            .query_opt(
-                &format!(
-                    "SELECT {TRIAL_COLUMNS} FROM cdbo_trials WHERE study = $1 AND id = $2 FOR UPDATE"
-                ),
-                &[&self.study, &id],
-            )
-            .map_err(self.err())?;
-        row.map(|r| to_trial(&r, self.label)).transpose()
+            .rows
+            .with(|tx, study| tx.query_opt(&sql, &[&study, &id]))?;
+        row.map(|r| to_trial(&r, self.rows.label())).transpose()
     }
 
     fn optimizer_state(&mut self) -> Result<String> {
-        self.tx
-            .query_one(
+        self.rows.with(|tx, study| {
+            tx.query_one(
                 "SELECT optimizer_state FROM cdbo_studies WHERE name = $1",
-                &[&self.study],
-            )
-            .and_then(|r| r.try_get(0))
-            .map_err(self.err())
+                &[&study],
+            )?
+            .try_get(0)
+        })
     }
 
     fn add_trial(
@@ -342,30 +283,24 @@ impl Transaction for PostgresTransaction<'_> {
         claim: Option<(&str, f64)>,
     ) -> Result<i64> {
         let (owner, until) = claim.unzip();
-        self.tx
-            .query_one(
+        self.rows.with(|tx, study| {
+            tx.query_one(
                 "INSERT INTO cdbo_trials (study, id, weights, asked_unix_s, owner, lease_until_unix_s)
                  SELECT $1, COALESCE(MAX(id), 0) + 1, $2, $3, $4, $5 FROM cdbo_trials WHERE study = $1
                  RETURNING id",
-                &[&self.study, &weights, &asked_unix_s, &owner, &until],
-            )
-            .and_then(|r| r.try_get(0))
-            .map_err(self.err())
+                &[&study, &weights, &asked_unix_s, &owner, &until],
+            )?
+            .try_get(0)
+        })
     }
 
     fn set_claim(&mut self, id: i64, owner: &str, until: f64) -> Result<()> {
-        self.tx
-            .execute(
-                "UPDATE cdbo_trials SET owner = $1, lease_until_unix_s = $2 WHERE study = $3 AND id = $4",
-                &[&owner, &until, &self.study, &id],
-            )
-            .map_err(self.err())?;
-        Ok(())
+        self.rows.set_claim(id, owner, until)
     }
 
     fn record(&mut self, id: i64, told: &Told, optimizer_state: &str) -> Result<()> {
-        self.tx
-            .execute(
+        self.rows.with(|tx, study| {
+            tx.execute(
                 "UPDATE cdbo_trials SET reward = $1, lap_time_s = $2, failure = $3, x_fail = $4, told_unix_s = $5 WHERE study = $6 AND id = $7",
                 &[
                     &told.reward,
@@ -373,23 +308,20 @@ impl Transaction for PostgresTransaction<'_> {
                     &told.failure,
                     &told.x_fail,
                     &told.told_unix_s,
-                    &self.study,
+                    &study,
                     &id,
                 ],
-            )
-            .map_err(self.err())?;
-        self.tx
-            .execute(
+            )?;
+            tx.execute(
                 "UPDATE cdbo_studies SET optimizer_state = $1 WHERE name = $2",
-                &[&optimizer_state, &self.study],
+                &[&optimizer_state, &study],
             )
-            .map_err(self.err())?;
+        })?;
         Ok(())
     }
 
     fn commit(self: Box<Self>) -> Result<()> {
-        let label = self.label;
-        self.tx.commit().map_err(|e| pg_error(label, e))
+        self.rows.commit()
     }
 }
 

@@ -3,14 +3,16 @@
 //! transaction (`BEGIN IMMEDIATE`); a second process waits up to [`BUSY_TIMEOUT`] and then
 //! gets a clear "busy" error. The schema version is SQLite's `user_version`.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Duration;
 
-use rusqlite::{Connection, OpenFlags, OptionalExtension, TransactionBehavior, params};
+use rusqlite::{Connection, OpenFlags, OptionalExtension, params};
 
 use super::SCHEMA_VERSION;
 use super::Trial;
 use super::claim::Claim;
+use super::rows::TRIALS;
+use super::rows::sqlite::{SqliteRows, SqliteRowsTransaction};
 use super::storage::{Dump, Row, Storage, Told, Transaction};
 use crate::error::{Error, Result};
 
@@ -25,8 +27,7 @@ const TRIAL_COLUMNS: &str = "id, weights, reward, lap_time_s, failure, x_fail";
 
 /// A study in an SQLite file.
 pub struct Sqlite {
-    path: PathBuf,
-    conn: Connection,
+    rows: SqliteRows,
 }
 
 /// Sorts an SQLite error by its code: busy or locked, not a database, or another failure.
@@ -175,8 +176,7 @@ impl Sqlite {
         }
         Ok((
             Sqlite {
-                path: path.to_owned(),
-                conn,
+                rows: SqliteRows::new(path, conn, &TRIALS),
             },
             config,
         ))
@@ -185,33 +185,21 @@ impl Sqlite {
 
 impl Storage for Sqlite {
     fn label(&self) -> &Path {
-        &self.path
+        self.rows.path()
     }
 
     fn begin(&mut self) -> Result<Box<dyn Transaction + '_>> {
-        let tx = self
-            .conn
-            .transaction_with_behavior(TransactionBehavior::Immediate)
-            .map_err(|e| sql_error(&self.path, e))?;
         Ok(Box::new(SqliteTransaction {
-            path: &self.path,
-            tx,
+            rows: self.rows.begin()?,
         }))
     }
 
     fn heartbeat(&mut self, id: i64, owner: &str, until: f64) -> Result<bool> {
-        let n = self
-            .conn
-            .execute(
-                "UPDATE trials SET lease_until_unix_s = ?1 WHERE id = ?2 AND owner = ?3 AND reward IS NULL",
-                params![until, id, owner],
-            )
-            .map_err(|e| sql_error(&self.path, e))?;
-        Ok(n == 1)
+        self.rows.heartbeat(id, owner, until)
     }
 
     fn told(&mut self) -> Result<usize> {
-        told_count(&self.conn).map_err(|e| sql_error(&self.path, e))
+        self.rows.count(true)
     }
 
     fn history(&mut self) -> Result<Vec<Trial>> {
@@ -219,14 +207,15 @@ impl Storage for Sqlite {
     }
 
     fn dump(&mut self) -> Result<Dump> {
-        let err = |e| sql_error(&self.path, e);
+        let err = self.rows.err();
         let config = self
-            .conn
+            .rows
+            .conn()
             .query_row("SELECT value FROM meta WHERE key = 'config'", [], |r| {
                 r.get(0)
             })
-            .map_err(err)?;
-        let optimizer = optimizer_state(&self.conn).map_err(err)?;
+            .map_err(&err)?;
+        let optimizer = optimizer_state(self.rows.conn()).map_err(err)?;
         Ok(Dump {
             config,
             optimizer,
@@ -237,19 +226,19 @@ impl Storage for Sqlite {
 
 impl Sqlite {
     fn dump_rows(&self) -> Result<Vec<Row>> {
-        let err = |e| sql_error(&self.path, e);
+        let err = self.rows.err();
+        let conn = self.rows.conn();
         // A schema-1 study opened read-only is read as it is: it has no claim columns.
-        let claims = if user_version(&self.conn).map_err(err)? >= 2 {
+        let claims = if user_version(conn).map_err(&err)? >= 2 {
             "owner, lease_until_unix_s"
         } else {
             "NULL, NULL"
         };
-        let mut stmt = self
-            .conn
+        let mut stmt = conn
             .prepare(&format!(
                 "SELECT {TRIAL_COLUMNS}, asked_unix_s, told_unix_s, {claims} FROM trials ORDER BY id"
             ))
-            .map_err(err)?;
+            .map_err(&err)?;
         let rows = stmt
             .query_map([], |r| {
                 Ok(Row {
@@ -260,27 +249,30 @@ impl Sqlite {
                     lease_until_unix_s: r.get(9)?,
                 })
             })
-            .map_err(err)?;
+            .map_err(&err)?;
         rows.collect::<rusqlite::Result<Vec<_>>>().map_err(err)
     }
 }
 
 /// A write transaction on an SQLite study.
 struct SqliteTransaction<'a> {
-    path: &'a Path,
-    tx: rusqlite::Transaction<'a>,
+    rows: SqliteRowsTransaction<'a>,
 }
 
-impl SqliteTransaction<'_> {
-    fn err(&self) -> impl Fn(rusqlite::Error) -> Error + '_ {
-        |e| sql_error(self.path, e)
+impl<'a> SqliteTransaction<'a> {
+    fn tx(&self) -> &rusqlite::Transaction<'a> {
+        self.rows.tx()
+    }
+
+    fn err(&self) -> impl Fn(rusqlite::Error) -> Error + 'a {
+        self.rows.err()
     }
 }
 
 impl Transaction for SqliteTransaction<'_> {
     fn pending(&mut self) -> Result<Vec<(Trial, Claim)>> {
         let mut stmt = self
-            .tx
+            .tx()
             .prepare(&format!(
                 "SELECT {TRIAL_COLUMNS}, owner, lease_until_unix_s FROM trials WHERE reward IS NULL ORDER BY id"
             ))
@@ -301,12 +293,12 @@ impl Transaction for SqliteTransaction<'_> {
     }
 
     fn told(&mut self) -> Result<usize> {
-        told_count(&self.tx).map_err(self.err())
+        self.rows.count(true)
     }
 
     fn told_rewards(&mut self) -> Result<Vec<f64>> {
         let mut stmt = self
-            .tx
+            .tx()
             .prepare("SELECT reward FROM trials WHERE reward IS NOT NULL")
             .map_err(self.err())?;
         let rows = stmt.query_map([], |r| r.get(0)).map_err(self.err())?;
@@ -315,7 +307,7 @@ impl Transaction for SqliteTransaction<'_> {
     }
 
     fn trial(&mut self, id: i64) -> Result<Option<Trial>> {
-        self.tx
+        self.tx()
             .query_row(
                 &format!("SELECT {TRIAL_COLUMNS} FROM trials WHERE id = ?1"),
                 params![id],
@@ -326,7 +318,7 @@ impl Transaction for SqliteTransaction<'_> {
     }
 
     fn optimizer_state(&mut self) -> Result<String> {
-        optimizer_state(&self.tx).map_err(self.err())
+        optimizer_state(self.tx()).map_err(self.err())
     }
 
     fn add_trial(
@@ -336,27 +328,21 @@ impl Transaction for SqliteTransaction<'_> {
         claim: Option<(&str, f64)>,
     ) -> Result<i64> {
         let (owner, until) = claim.unzip();
-        self.tx
+        self.tx()
             .execute(
                 "INSERT INTO trials (weights, asked_unix_s, owner, lease_until_unix_s) VALUES (?1, ?2, ?3, ?4)",
                 params![weights, asked_unix_s, owner, until],
             )
             .map_err(self.err())?;
-        Ok(self.tx.last_insert_rowid())
+        Ok(self.tx().last_insert_rowid())
     }
 
     fn set_claim(&mut self, id: i64, owner: &str, until: f64) -> Result<()> {
-        self.tx
-            .execute(
-                "UPDATE trials SET owner = ?1, lease_until_unix_s = ?2 WHERE id = ?3",
-                params![owner, until, id],
-            )
-            .map_err(self.err())?;
-        Ok(())
+        self.rows.set_claim(id, owner, until)
     }
 
     fn record(&mut self, id: i64, told: &Told, optimizer_state: &str) -> Result<()> {
-        self.tx
+        self.tx()
             .execute(
                 "UPDATE trials SET reward = ?1, lap_time_s = ?2, failure = ?3, x_fail = ?4, told_unix_s = ?5 WHERE id = ?6",
                 params![
@@ -369,7 +355,7 @@ impl Transaction for SqliteTransaction<'_> {
                 ],
             )
             .map_err(self.err())?;
-        self.tx
+        self.tx()
             .execute(
                 "UPDATE optimizer SET state = ?1 WHERE id = 1",
                 params![optimizer_state],
@@ -379,8 +365,7 @@ impl Transaction for SqliteTransaction<'_> {
     }
 
     fn commit(self: Box<Self>) -> Result<()> {
-        let path = self.path;
-        self.tx.commit().map_err(|e| sql_error(path, e))
+        self.rows.commit()
     }
 }
 
@@ -485,15 +470,6 @@ fn row_to_trial(r: &rusqlite::Row<'_>) -> rusqlite::Result<Trial> {
         failure: r.get(4)?,
         x_fail: r.get(5)?,
     })
-}
-
-fn told_count(conn: &Connection) -> rusqlite::Result<usize> {
-    conn.query_row(
-        "SELECT COUNT(*) FROM trials WHERE reward IS NOT NULL",
-        [],
-        |r| r.get::<_, i64>(0),
-    )
-    .map(|n| n as usize)
 }
 
 fn optimizer_state(conn: &Connection) -> rusqlite::Result<String> {

@@ -5,20 +5,20 @@
 //! are serialised, as SQLite's write lock does, and workers that start at once on a grid not
 //! stored yet store it once.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use postgres::Client;
+use postgres::GenericClient;
 
 use super::{GridStorage, GridTransaction, check_version};
 use crate::error::{Error, Result};
 use crate::study::claim::Claim;
 use crate::study::postgres::{connect, ensure_schema, pg_error, schema_version};
+use crate::study::rows::CELLS;
+use crate::study::rows::postgres::{PgRows, PgRowsTransaction, Sql};
 
 /// A grid in a PostgreSQL database.
 pub struct PostgresGrid {
-    label: PathBuf,
-    name: String,
-    client: Client,
+    rows: PgRows,
 }
 
 impl PostgresGrid {
@@ -44,68 +44,46 @@ impl PostgresGrid {
             tx.commit().map_err(err)?;
         }
         Ok(PostgresGrid {
-            label: label.to_owned(),
-            name: name.to_owned(),
-            client,
+            rows: PgRows::new(label, name, client, &CELLS),
         })
     }
 
+    /// The first column of the rows `sql` selects for this grid (`$1`).
     fn strings(&mut self, sql: &str) -> Result<Vec<String>> {
-        let rows = self
-            .client
-            .query(sql, &[&self.name])
-            .map_err(|e| pg_error(&self.label, e))?;
-        rows.iter()
-            .map(|r| r.try_get(0).map_err(|e| pg_error(&self.label, e)))
-            .collect()
+        self.rows.with(|c, name| {
+            c.query(sql, &[&name])?
+                .iter()
+                .map(|r| r.try_get(0))
+                .collect()
+        })
     }
 }
 
-fn stored_grid(
-    client: &mut impl postgres::GenericClient,
-    name: &str,
-    label: &Path,
-) -> Result<Option<String>> {
+/// The grid as stored (TOML), if the database holds grid `name`.
+fn stored_grid(client: &mut impl GenericClient, name: &str) -> Sql<Option<String>> {
     client
-        .query_opt("SELECT grid FROM cdbo_grids WHERE name = $1", &[&name])
-        .map_err(|e| pg_error(label, e))?
-        .map(|r| r.try_get(0).map_err(|e| pg_error(label, e)))
+        .query_opt("SELECT grid FROM cdbo_grids WHERE name = $1", &[&name])?
+        .map(|r| r.try_get(0))
         .transpose()
 }
 
 impl GridStorage for PostgresGrid {
     fn label(&self) -> &Path {
-        &self.label
+        self.rows.label()
     }
 
     fn begin(&mut self) -> Result<Box<dyn GridTransaction + '_>> {
-        let label = &self.label;
-        let mut tx = self.client.transaction().map_err(|e| pg_error(label, e))?;
-        tx.execute(
-            "SELECT pg_advisory_xact_lock(hashtextextended('cdbo grid ' || $1, 0))",
-            &[&self.name],
-        )
-        .map_err(|e| pg_error(label, e))?;
         Ok(Box::new(PostgresGridTransaction {
-            label,
-            name: &self.name,
-            tx,
+            rows: self.rows.begin()?,
         }))
     }
 
     fn heartbeat(&mut self, id: i64, owner: &str, until: f64) -> Result<bool> {
-        let n = self
-            .client
-            .execute(
-                "UPDATE cdbo_grid_runs SET lease_until_unix_s = $1 WHERE grid = $2 AND id = $3 AND owner = $4 AND record IS NULL",
-                &[&until, &self.name, &id, &owner],
-            )
-            .map_err(|e| pg_error(&self.label, e))?;
-        Ok(n == 1)
+        self.rows.heartbeat(id, owner, until)
     }
 
     fn grid(&mut self) -> Result<Option<String>> {
-        stored_grid(&mut self.client, &self.name, &self.label)
+        self.rows.with(stored_grid)
     }
 
     fn records(&mut self) -> Result<Vec<String>> {
@@ -115,15 +93,7 @@ impl GridStorage for PostgresGrid {
     }
 
     fn unfinished_count(&mut self) -> Result<usize> {
-        let row = self
-            .client
-            .query_one(
-                "SELECT COUNT(*) FROM cdbo_grid_runs WHERE grid = $1 AND record IS NULL",
-                &[&self.name],
-            )
-            .map_err(|e| pg_error(&self.label, e))?;
-        let n: i64 = row.try_get(0).map_err(|e| pg_error(&self.label, e))?;
-        Ok(n as usize)
+        self.rows.count(false)
     }
 
     fn sessions(&mut self) -> Result<Vec<String>> {
@@ -131,105 +101,78 @@ impl GridStorage for PostgresGrid {
     }
 
     fn add_session(&mut self, session: &str) -> Result<()> {
-        self.client
-            .execute(
+        self.rows.with(|c, name| {
+            c.execute(
                 "INSERT INTO cdbo_grid_sessions (grid, session) VALUES ($1, $2)",
-                &[&self.name, &session],
+                &[&name, &session],
             )
-            .map_err(|e| pg_error(&self.label, e))?;
+        })?;
         Ok(())
     }
 }
 
 /// A write transaction on a PostgreSQL grid, holding its advisory lock.
 struct PostgresGridTransaction<'a> {
-    label: &'a Path,
-    name: &'a str,
-    tx: postgres::Transaction<'a>,
-}
-
-impl PostgresGridTransaction<'_> {
-    fn err(&self) -> impl Fn(postgres::Error) -> Error + '_ {
-        |e| pg_error(self.label, e)
-    }
+    rows: PgRowsTransaction<'a>,
 }
 
 impl GridTransaction for PostgresGridTransaction<'_> {
     fn grid(&mut self) -> Result<Option<String>> {
-        stored_grid(&mut self.tx, self.name, self.label)
+        self.rows.with(stored_grid)
     }
 
     fn create(&mut self, grid: &str, runs: &[String]) -> Result<()> {
-        self.tx
-            .execute(
-                "INSERT INTO cdbo_grids (name, grid) VALUES ($1, $2)",
-                &[&self.name, &grid],
-            )
-            .map_err(self.err())?;
         let ids: Vec<i64> = (1..=runs.len() as i64).collect();
-        self.tx
-            .execute(
+        self.rows.with(|tx, name| {
+            tx.execute(
+                "INSERT INTO cdbo_grids (name, grid) VALUES ($1, $2)",
+                &[&name, &grid],
+            )?;
+            tx.execute(
                 "INSERT INTO cdbo_grid_runs (grid, id, run) SELECT $1, * FROM UNNEST($2::BIGINT[], $3::TEXT[])",
-                &[&self.name, &ids, &runs],
+                &[&name, &ids, &runs],
             )
-            .map_err(self.err())?;
+        })?;
         Ok(())
     }
 
     fn unfinished(&mut self) -> Result<Vec<Claim>> {
-        let rows = self
-            .tx
-            .query(
+        self.rows.with(|tx, name| {
+            tx.query(
                 "SELECT id, owner, lease_until_unix_s FROM cdbo_grid_runs WHERE grid = $1 AND record IS NULL ORDER BY id",
-                &[&self.name],
-            )
-            .map_err(self.err())?;
-        rows.iter()
+                &[&name],
+            )?
+            .iter()
             .map(|r| {
                 Ok(Claim {
-                    trial: r.try_get(0).map_err(self.err())?,
-                    owner: r.try_get(1).map_err(self.err())?,
-                    lease_until: r.try_get(2).map_err(self.err())?,
+                    trial: r.try_get(0)?,
+                    owner: r.try_get(1)?,
+                    lease_until: r.try_get(2)?,
                 })
             })
             .collect()
+        })
     }
 
     fn finished(&mut self) -> Result<usize> {
-        let n: i64 = self
-            .tx
-            .query_one(
-                "SELECT COUNT(*) FROM cdbo_grid_runs WHERE grid = $1 AND record IS NOT NULL",
-                &[&self.name],
-            )
-            .and_then(|r| r.try_get(0))
-            .map_err(self.err())?;
-        Ok(n as usize)
+        self.rows.count(true)
     }
 
     fn set_claim(&mut self, id: i64, owner: &str, until: f64) -> Result<()> {
-        self.tx
-            .execute(
-                "UPDATE cdbo_grid_runs SET owner = $1, lease_until_unix_s = $2 WHERE grid = $3 AND id = $4",
-                &[&owner, &until, &self.name, &id],
-            )
-            .map_err(self.err())?;
-        Ok(())
+        self.rows.set_claim(id, owner, until)
     }
 
     fn finish(&mut self, id: i64, record: &str, now: f64) -> Result<bool> {
-        let n = self
-            .tx
-            .execute(
+        let n = self.rows.with(|tx, name| {
+            tx.execute(
                 "UPDATE cdbo_grid_runs SET record = $1, finished_unix_s = $2 WHERE grid = $3 AND id = $4 AND record IS NULL",
-                &[&record, &now, &self.name, &id],
+                &[&record, &now, &name, &id],
             )
-            .map_err(self.err())?;
+        })?;
         Ok(n == 1)
     }
 
     fn commit(self: Box<Self>) -> Result<()> {
-        let label = self.label;
-        self.tx.commit().map_err(|e| pg_error(label, e))
+        self.rows.commit()
     }
 }

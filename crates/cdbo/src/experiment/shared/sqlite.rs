@@ -3,14 +3,16 @@
 //! schema version in `user_version` as a study's. Writers take SQLite's write lock for the
 //! whole transaction (`BEGIN IMMEDIATE`), as a study's do.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use rusqlite::{Connection, OpenFlags, OptionalExtension, TransactionBehavior, params};
+use rusqlite::{Connection, OpenFlags, OptionalExtension, params};
 
 use super::{GridStorage, GridTransaction, check_version};
 use crate::error::{Error, Result};
 use crate::study::SCHEMA_VERSION;
 use crate::study::claim::Claim;
+use crate::study::rows::CELLS;
+use crate::study::rows::sqlite::{SqliteRows, SqliteRowsTransaction};
 use crate::study::sqlite::{
     check_header, configure, read_only_connection, sql_error, user_version,
 };
@@ -29,8 +31,7 @@ const SCHEMA: &str = "
 
 /// A grid in an SQLite file.
 pub struct SqliteGrid {
-    path: PathBuf,
-    conn: Connection,
+    rows: SqliteRows,
 }
 
 impl SqliteGrid {
@@ -82,8 +83,7 @@ impl SqliteGrid {
             });
         }
         Ok(SqliteGrid {
-            path: path.to_owned(),
-            conn,
+            rows: SqliteRows::new(path, conn, &CELLS),
         })
     }
 }
@@ -108,107 +108,85 @@ fn strings(conn: &Connection, sql: &str) -> rusqlite::Result<Vec<String>> {
 
 impl GridStorage for SqliteGrid {
     fn label(&self) -> &Path {
-        &self.path
+        self.rows.path()
     }
 
     fn begin(&mut self) -> Result<Box<dyn GridTransaction + '_>> {
-        let tx = self
-            .conn
-            .transaction_with_behavior(TransactionBehavior::Immediate)
-            .map_err(|e| sql_error(&self.path, e))?;
         Ok(Box::new(SqliteGridTransaction {
-            path: &self.path,
-            tx,
+            rows: self.rows.begin()?,
         }))
     }
 
     fn heartbeat(&mut self, id: i64, owner: &str, until: f64) -> Result<bool> {
-        let n = self
-            .conn
-            .execute(
-                "UPDATE runs SET lease_until_unix_s = ?1 WHERE id = ?2 AND owner = ?3 AND record IS NULL",
-                params![until, id, owner],
-            )
-            .map_err(|e| sql_error(&self.path, e))?;
-        Ok(n == 1)
+        self.rows.heartbeat(id, owner, until)
     }
 
     fn grid(&mut self) -> Result<Option<String>> {
-        stored_grid(&self.conn).map_err(|e| sql_error(&self.path, e))
+        stored_grid(self.rows.conn()).map_err(self.rows.err())
     }
 
     fn records(&mut self) -> Result<Vec<String>> {
         strings(
-            &self.conn,
+            self.rows.conn(),
             "SELECT record FROM runs WHERE record IS NOT NULL ORDER BY id",
         )
-        .map_err(|e| sql_error(&self.path, e))
+        .map_err(self.rows.err())
     }
 
     fn unfinished_count(&mut self) -> Result<usize> {
-        self.conn
-            .query_row("SELECT COUNT(*) FROM runs WHERE record IS NULL", [], |r| {
-                r.get::<_, i64>(0)
-            })
-            .map(|n| n as usize)
-            .map_err(|e| sql_error(&self.path, e))
+        self.rows.count(false)
     }
 
     fn sessions(&mut self) -> Result<Vec<String>> {
-        strings(&self.conn, "SELECT session FROM sessions ORDER BY id")
-            .map_err(|e| sql_error(&self.path, e))
+        strings(self.rows.conn(), "SELECT session FROM sessions ORDER BY id")
+            .map_err(self.rows.err())
     }
 
     fn add_session(&mut self, session: &str) -> Result<()> {
-        self.conn
+        self.rows
+            .conn()
             .execute(
                 "INSERT INTO sessions (session) VALUES (?1)",
                 params![session],
             )
-            .map_err(|e| sql_error(&self.path, e))?;
+            .map_err(self.rows.err())?;
         Ok(())
     }
 }
 
 /// A write transaction on an SQLite grid.
 struct SqliteGridTransaction<'a> {
-    path: &'a Path,
-    tx: rusqlite::Transaction<'a>,
-}
-
-impl SqliteGridTransaction<'_> {
-    fn err(&self) -> impl Fn(rusqlite::Error) -> Error + '_ {
-        |e| sql_error(self.path, e)
-    }
+    rows: SqliteRowsTransaction<'a>,
 }
 
 impl GridTransaction for SqliteGridTransaction<'_> {
     fn grid(&mut self) -> Result<Option<String>> {
-        stored_grid(&self.tx).map_err(self.err())
+        stored_grid(self.rows.tx()).map_err(self.rows.err())
     }
 
     fn create(&mut self, grid: &str, runs: &[String]) -> Result<()> {
-        self.tx
-            .execute("INSERT INTO grid (id, grid) VALUES (1, ?1)", params![grid])
-            .map_err(self.err())?;
+        let (tx, err) = (self.rows.tx(), self.rows.err());
+        tx.execute("INSERT INTO grid (id, grid) VALUES (1, ?1)", params![grid])
+            .map_err(&err)?;
         for (k, run) in runs.iter().enumerate() {
-            self.tx
-                .execute(
-                    "INSERT INTO runs (id, run) VALUES (?1, ?2)",
-                    params![k as i64 + 1, run],
-                )
-                .map_err(self.err())?;
+            tx.execute(
+                "INSERT INTO runs (id, run) VALUES (?1, ?2)",
+                params![k as i64 + 1, run],
+            )
+            .map_err(&err)?;
         }
         Ok(())
     }
 
     fn unfinished(&mut self) -> Result<Vec<Claim>> {
+        let err = self.rows.err();
         let mut stmt = self
-            .tx
+            .rows
+            .tx()
             .prepare(
                 "SELECT id, owner, lease_until_unix_s FROM runs WHERE record IS NULL ORDER BY id",
             )
-            .map_err(self.err())?;
+            .map_err(&err)?;
         let rows = stmt
             .query_map([], |r| {
                 Ok(Claim {
@@ -217,45 +195,31 @@ impl GridTransaction for SqliteGridTransaction<'_> {
                     lease_until: r.get(2)?,
                 })
             })
-            .map_err(self.err())?;
-        rows.collect::<rusqlite::Result<Vec<_>>>()
-            .map_err(self.err())
+            .map_err(&err)?;
+        rows.collect::<rusqlite::Result<Vec<_>>>().map_err(err)
     }
 
     fn finished(&mut self) -> Result<usize> {
-        self.tx
-            .query_row(
-                "SELECT COUNT(*) FROM runs WHERE record IS NOT NULL",
-                [],
-                |r| r.get::<_, i64>(0),
-            )
-            .map(|n| n as usize)
-            .map_err(self.err())
+        self.rows.count(true)
     }
 
     fn set_claim(&mut self, id: i64, owner: &str, until: f64) -> Result<()> {
-        self.tx
-            .execute(
-                "UPDATE runs SET owner = ?1, lease_until_unix_s = ?2 WHERE id = ?3",
-                params![owner, until, id],
-            )
-            .map_err(self.err())?;
-        Ok(())
+        self.rows.set_claim(id, owner, until)
     }
 
     fn finish(&mut self, id: i64, record: &str, now: f64) -> Result<bool> {
         let n = self
-            .tx
+            .rows
+            .tx()
             .execute(
                 "UPDATE runs SET record = ?1, finished_unix_s = ?2 WHERE id = ?3 AND record IS NULL",
                 params![record, now, id],
             )
-            .map_err(self.err())?;
+            .map_err(self.rows.err())?;
         Ok(n == 1)
     }
 
     fn commit(self: Box<Self>) -> Result<()> {
-        let path = self.path;
-        self.tx.commit().map_err(|e| sql_error(path, e))
+        self.rows.commit()
     }
 }
