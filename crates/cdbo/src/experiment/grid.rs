@@ -71,12 +71,12 @@ pub const PRESETS: &[&str] = &["paper", "paper-plus", "quick"];
 /// The main knobs tuned on the training tracks (docs/results/beyond): random search's σ and
 /// the pattern search's first step swept on ridgeway-30, forza-30, e-track-2-30 and forza-50
 /// (seeds 100–105) and re-checked with session 8's final physics on ridgeway-30 and
-/// e-track-2-30 (seeds 100–101), which decided; CMA-ES's σ₀ on ridgeway, forza and e-track-2
-/// with 30 kernels (seeds 100–101, session 6). `paper-plus` runs them; `paper` keeps every
-/// method at the race default 0.03.
+/// e-track-2-30 (seeds 100–101), which decided; CMA-ES's σ₀ swept over 0.003–0.1 on the same
+/// four panels with the final physics (seeds 100–105, session 9). `paper-plus` runs them;
+/// `paper` keeps every method at the race default 0.03.
 pub const TUNED_SIGMA0: [(Method, f64); 3] = [
     (Method::Random, 0.01),
-    (Method::Cmaes, 0.01),
+    (Method::Cmaes, 0.03),
     (Method::PatternSearch, 0.1),
 ];
 
@@ -329,6 +329,7 @@ mod tests {
         let plus = ExperimentConfig::preset("paper-plus").unwrap();
         assert_eq!(plus.runs().len(), 6 * 9 * 4);
         assert_eq!(plus.sigma0.get(&Method::Random), Some(&0.01));
+        assert_eq!(plus.sigma0.get(&Method::Cmaes), Some(&0.03));
         for p in PRESETS {
             ExperimentConfig::preset(p).unwrap().check().unwrap();
         }
