@@ -255,22 +255,47 @@ fn a_legal_but_slow_study_says_so_first() {
         );
         assert!(!dir.join("s.db").exists());
     }
-    // The paper's sizes say nothing.
-    let out = cdbo(
-        &dir,
+    // The paper's sizes say nothing, nor do methods without a GP at the largest sizes.
+    let quiet: [&[&str]; 3] = [
+        &["study", "create", "s", "--kernels", "30"],
         &[
-            "study",
-            "create",
-            "s",
+            "optimize",
+            "--kernels",
+            "1000",
+            "--laps",
+            "10000",
+            "--method",
+            "random",
+        ],
+        &[
+            "optimize",
+            "--kernels",
+            "1000",
+            "--laps",
+            "10000",
+            "--method",
+            "pattern-search",
+        ],
+    ];
+    for args in quiet {
+        let more = [
             "--db",
             "s.db",
-            "--kernels",
-            "30",
             "--demo",
             "gone.csv",
-        ],
-    );
-    assert!(!String::from_utf8_lossy(&out.stderr).contains("warning"));
+            "--evaluator",
+            "echo 1",
+        ];
+        let more = if args[0] == "study" {
+            &more[..4]
+        } else {
+            &more[..]
+        };
+        let out = cdbo(&dir, &[args, more].concat());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!err.contains("warning"), "{args:?}: {err}");
+        assert!(err.contains("gone.csv"), "{args:?}: {err}");
+    }
 }
 
 /// `cdbo optimize` on study `db` to `laps` told trials, every lap driven appended to

@@ -162,8 +162,18 @@ pub fn run_grid(args: &ExperimentArgs, data: &DataPath, simulator: Simulator) ->
         cdbo::Error::DifferentGrid { .. } => format!("{e}; choose another --out"),
         e => e.to_string(),
     })?;
+    // The grid's costliest run: its largest policy, raced by its costliest method.
     let largest = config.tracks.iter().flat_map(|t| t.kernels.iter()).max();
-    if let Some(w) = largest.and_then(|&k| cdbo::sizes::slow_race_warning(k, config.laps)) {
+    let slow = largest.and_then(|&k| {
+        let cost = |m| cdbo::sizes::race_seconds(m, k, config.laps);
+        let costliest = config
+            .methods
+            .iter()
+            .copied()
+            .max_by(|a, b| cost(*a).total_cmp(&cost(*b)))?;
+        cdbo::sizes::slow_race_warning(costliest, k, config.laps)
+    });
+    if let Some(w) = slow {
         eprintln!("warning: {name}: each of its largest runs: {w}");
     }
     let mut runs = config.runs();

@@ -70,7 +70,7 @@ struct Summary {
 }
 
 pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult {
-    if let Some(w) = cdbo::sizes::slow_race_warning(args.kernels, args.laps) {
+    if let Some(w) = cdbo::sizes::slow_race_warning(args.method, args.kernels, args.laps) {
         eprintln!("warning: {w}");
     }
     // In the game, the track and car are the game's, read by cdbo for the limit and plots.

@@ -69,6 +69,11 @@ pub struct InitialPolicy {
 }
 
 impl InitialPolicy {
+    /// The optimiser given, or CDBO.
+    pub fn method(&self) -> Method {
+        self.method.unwrap_or(Method::Cdbo)
+    }
+
     /// The study's settings from the demonstration or the weights.
     pub fn config(&self) -> Result<StudyConfig, Box<dyn std::error::Error>> {
         let lengthscale = self
@@ -93,7 +98,7 @@ impl InitialPolicy {
             .into());
         }
         Ok(StudyConfig {
-            method: self.method.unwrap_or(Method::Cdbo),
+            method: self.method(),
             kernels: self.kernels,
             lengthscale: policy.lengthscale,
             seed: self.seed.unwrap_or(0),
@@ -242,7 +247,9 @@ pub fn run(cmd: &StudyCommand) -> CliResult {
             track,
         } => {
             let laps = cdbo::sizes::STUDY_LAPS_ASSUMED;
-            if let Some(w) = cdbo::sizes::slow_study_warning(initial.kernels, laps) {
+            if let Some(w) =
+                cdbo::sizes::slow_study_warning(initial.method(), initial.kernels, laps)
+            {
                 eprintln!("warning: {w}; {laps} laps assumed, the paper's budget");
             }
             let mut config = initial.config()?;
