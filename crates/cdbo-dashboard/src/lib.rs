@@ -7,7 +7,9 @@
 //! - `GET /api/sources/{id}/map?key=KEY`: a trial (study) or run (experiment) re-driven in the
 //!   simulator, its path coloured by speed ([`map::MapView`]).
 //!
-//! The data come through the [`store::Store`] trait; nothing is ever written.
+//! The data come through the [`store::Store`] trait; nothing is ever written. A database shown
+//! whole is listed again on every `GET /api/sources`: a study or grid created in it since
+//! start-up joins the list, and every source keeps its id.
 
 pub mod map;
 pub mod store;
@@ -16,7 +18,7 @@ pub mod view;
 use std::collections::HashMap;
 use std::net::{SocketAddr, TcpListener};
 use std::path::PathBuf;
-use std::sync::Arc;
+use std::sync::{Arc, PoisonError, RwLock};
 
 use axum::Router;
 use axum::extract::{Path, Query, State};
@@ -41,6 +43,9 @@ pub const DEFAULT_BIND: &str = "127.0.0.1:8050";
 pub struct Dashboard {
     /// Studies and experiments, in the order given.
     pub sources: Vec<Source>,
+    /// Databases shown whole ([`store::is_database`]), whose studies and grids created later
+    /// are added to the sources as they appear.
+    pub databases: Vec<String>,
     /// Where they are read from.
     pub store: Box<dyn Store>,
     /// The track of the studies that record none (experiments name their own).
@@ -76,7 +81,7 @@ pub struct Bound {
 
 impl Dashboard {
     /// Binds `addr`; a port in use or an address not of this machine is a one-line error.
-    pub fn bind(self, addr: &str) -> Result<Bound> {
+    pub fn bind(mut self, addr: &str) -> Result<Bound> {
         let parsed: SocketAddr = addr.parse().map_err(|_| Error::InvalidValue {
             what: "--bind".to_owned(),
             value: addr.to_owned(),
@@ -86,9 +91,13 @@ impl Dashboard {
             path: PathBuf::from(format!("--bind {addr}")),
             source,
         })?;
+        let sources = RwLock::new(std::mem::take(&mut self.sources));
         Ok(Bound {
             listener,
-            app: router(Arc::new(self)),
+            app: router(Arc::new(Live {
+                dashboard: self,
+                sources,
+            })),
         })
     }
 
@@ -119,14 +128,11 @@ impl Dashboard {
         }
     }
 
-    fn source(&self, id: usize) -> std::result::Result<&Source, ApiError> {
-        self.sources
-            .get(id)
-            .ok_or_else(|| ApiError::Missing(format!("no source {id}")))
-    }
-
-    fn view(&self, id: usize, run: Option<&str>) -> std::result::Result<view::View, ApiError> {
-        let source = self.source(id)?;
+    fn view(
+        &self,
+        source: &Source,
+        run: Option<&str>,
+    ) -> std::result::Result<view::View, ApiError> {
         match source.kind {
             Kind::Study => {
                 let (config, trials) = self.store.study(source)?;
@@ -136,8 +142,7 @@ impl Dashboard {
         }
     }
 
-    fn map(&self, id: usize, key: &str) -> std::result::Result<map::MapView, ApiError> {
-        let source = self.source(id)?;
+    fn map(&self, source: &Source, key: &str) -> std::result::Result<map::MapView, ApiError> {
         let (track, weights, lengthscale) = match source.kind {
             Kind::Study => {
                 let (config, trials) = self.store.study(source)?;
@@ -180,6 +185,35 @@ impl Dashboard {
             &weights,
             lengthscale,
         )?)
+    }
+}
+
+/// A dashboard being served, with its sources so far: those given, then those its databases
+/// gained since, each keeping its id (its place in the list).
+struct Live {
+    dashboard: Dashboard,
+    sources: RwLock<Vec<Source>>,
+}
+
+impl Live {
+    /// The sources now, the databases listed again: a study or grid created since is added
+    /// (a database out of reach keeps its sources as they were; their reads say why).
+    fn refresh(&self) -> Vec<Source> {
+        let mut sources = self.sources.write().unwrap_or_else(PoisonError::into_inner);
+        for database in &self.dashboard.databases {
+            if let Ok(found) = self.dashboard.store.database(database, &sources) {
+                sources.extend(found);
+            }
+        }
+        sources.clone()
+    }
+
+    fn source(&self, id: usize) -> std::result::Result<Source, ApiError> {
+        let sources = self.sources.read().unwrap_or_else(PoisonError::into_inner);
+        sources
+            .get(id)
+            .cloned()
+            .ok_or_else(|| ApiError::Missing(format!("no source {id}")))
     }
 }
 
@@ -251,7 +285,7 @@ async fn blocking<T: Send + 'static>(
     }
 }
 
-fn router(dashboard: Arc<Dashboard>) -> Router {
+fn router(live: Arc<Live>) -> Router {
     let asset = |mime: &'static str, body: &'static str| {
         move || async move { ([(header::CONTENT_TYPE, mime)], body) }
     };
@@ -266,33 +300,39 @@ fn router(dashboard: Arc<Dashboard>) -> Router {
         .route("/api/sources", get(sources))
         .route("/api/sources/{id}", get(source_view))
         .route("/api/sources/{id}/map", get(source_map))
-        .with_state(dashboard)
+        .with_state(live)
 }
 
-async fn sources(State(d): State<Arc<Dashboard>>) -> ApiResult<Vec<SourceSummary>> {
+async fn sources(State(live): State<Arc<Live>>) -> ApiResult<Vec<SourceSummary>> {
     blocking(move || {
-        Ok(d.sources
+        Ok(live
+            .refresh()
             .iter()
             .enumerate()
-            .map(|(id, s)| d.summary(id, s))
+            .map(|(id, s)| live.dashboard.summary(id, s))
             .collect())
     })
     .await
 }
 
 async fn source_view(
-    State(d): State<Arc<Dashboard>>,
+    State(live): State<Arc<Live>>,
     Path(id): Path<usize>,
     Query(q): Query<HashMap<String, String>>,
 ) -> ApiResult<view::View> {
-    blocking(move || d.view(id, q.get("run").map(String::as_str))).await
+    blocking(move || {
+        let source = live.source(id)?;
+        live.dashboard
+            .view(&source, q.get("run").map(String::as_str))
+    })
+    .await
 }
 
 async fn source_map(
-    State(d): State<Arc<Dashboard>>,
+    State(live): State<Arc<Live>>,
     Path(id): Path<usize>,
     Query(q): Query<HashMap<String, String>>,
 ) -> ApiResult<map::MapView> {
     let key = q.get("key").cloned().unwrap_or_default();
-    blocking(move || d.map(id, &key)).await
+    blocking(move || live.dashboard.map(&live.source(id)?, &key)).await
 }

@@ -41,6 +41,18 @@ pub trait Store: Send + Sync {
     fn study(&self, source: &Source) -> Result<(StudyConfig, Vec<Trial>)>;
     /// An experiment's finished runs, in grid order.
     fn runs(&self, source: &Source) -> Result<Vec<RunRecord>>;
+    /// The studies and grids of `database` (a whole database, [`is_database`]) other than
+    /// `known`: studies, then grids, each by name.
+    fn database(&self, database: &str, known: &[Source]) -> Result<Vec<Source>>;
+}
+
+/// Whether `storage` names a whole PostgreSQL database (its URL without `#NAME`), every study
+/// and grid of which is shown.
+pub fn is_database(storage: &str) -> bool {
+    ["postgresql://", "postgres://"]
+        .iter()
+        .any(|s| storage.starts_with(s))
+        && !storage.contains('#')
 }
 
 /// Studies wherever they live (SQLite files, PostgreSQL databases) and experiments in folders
@@ -79,21 +91,8 @@ impl Files {
     /// What `storage` names: a study or a grid (an SQLite file, or `DATABASE-URL#NAME`), or,
     /// for a PostgreSQL URL without a name, every study and grid the database holds.
     pub fn storage(storage: &str) -> Result<Vec<Source>> {
-        let database = ["postgresql://", "postgres://"]
-            .iter()
-            .any(|s| storage.starts_with(s));
-        if database && !storage.contains('#') {
-            let label = Location::parse(storage, Some("*"))?.label();
-            let (studies, grids) = cdbo::study::postgres::names(storage, &label)?;
-            let at = |name: &String| Location::parse(storage, Some(name));
-            let mut sources = Vec::new();
-            for name in &studies {
-                sources.push(Files::study_at(at(name)?)?);
-            }
-            for name in &grids {
-                sources.push(Files::grid_at(at(name)?)?);
-            }
-            return Ok(sources);
+        if is_database(storage) {
+            return Files.database(storage, &[]);
         }
         let location = Location::parse(storage, None)?;
         match Files::study_at(location.clone()) {
@@ -140,6 +139,31 @@ impl Store for Files {
             None => Study::open_read_only(Path::new(&source.location))?,
         };
         Ok((study.config().clone(), study.history()?))
+    }
+
+    fn database(&self, database: &str, known: &[Source]) -> Result<Vec<Source>> {
+        let label = Location::parse(database, Some("*"))?.label();
+        let (studies, grids) = cdbo::study::postgres::names(database, &label)?;
+        let at = |name: &String| Location::parse(database, Some(name));
+        let shown = |l: &Location| {
+            known
+                .iter()
+                .any(|s| s.study.as_ref() == Some(l) || s.grid.as_ref() == Some(l))
+        };
+        let mut sources = Vec::new();
+        for name in &studies {
+            let location = at(name)?;
+            if !shown(&location) {
+                sources.push(Files::study_at(location)?);
+            }
+        }
+        for name in &grids {
+            let location = at(name)?;
+            if !shown(&location) {
+                sources.push(Files::grid_at(location)?);
+            }
+        }
+        Ok(sources)
     }
 
     fn runs(&self, source: &Source) -> Result<Vec<RunRecord>> {

@@ -13,7 +13,7 @@ use cdbo::experiment::record::RunRecord;
 use cdbo::policy::RkhsPolicy;
 use cdbo::sim::{FailureReason, Simulator};
 use cdbo::study::{Outcome, Study, StudyConfig};
-use cdbo_dashboard::store::{Files, Kind};
+use cdbo_dashboard::store::{Files, Kind, Source, Store};
 use cdbo_dashboard::view::POLICY_POINTS;
 use cdbo_dashboard::{Dashboard, map::MAP_POINTS};
 use serde_json::Value;
@@ -149,6 +149,7 @@ fn serve(dir: &Path) -> Served {
             Files::study_source(&db).unwrap(),
             Files::experiment_source(&experiment).unwrap(),
         ],
+        databases: Vec::new(),
         store: Box::new(Files),
         study_track: Some("ridgeway".into()),
         car: cars::DEFAULT.into(),
@@ -352,6 +353,7 @@ fn bad_sources_and_a_port_in_use_are_one_line_errors() {
     let addr = taken.local_addr().unwrap().to_string();
     let dashboard = Dashboard {
         sources: vec![source],
+        databases: Vec::new(),
         store: Box::new(Files),
         study_track: None,
         car: cars::DEFAULT.into(),
@@ -359,4 +361,82 @@ fn bad_sources_and_a_port_in_use_are_one_line_errors() {
     };
     let e = dashboard.bind(&addr).err().unwrap().to_string();
     assert!(e.contains(&addr) && e.contains("in use"), "{e}");
+}
+
+/// A store whose "database" is a folder of study files, listed as `Files` lists a PostgreSQL
+/// database: every study in it, those known aside.
+struct Folder;
+
+impl Store for Folder {
+    fn study(&self, source: &Source) -> cdbo::Result<(StudyConfig, Vec<cdbo::study::Trial>)> {
+        Files.study(source)
+    }
+
+    fn runs(&self, source: &Source) -> cdbo::Result<Vec<RunRecord>> {
+        Files.runs(source)
+    }
+
+    fn database(&self, database: &str, known: &[Source]) -> cdbo::Result<Vec<Source>> {
+        let mut files: Vec<PathBuf> = std::fs::read_dir(database)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.to_string_lossy().ends_with(".cdbo.db"))
+            .collect();
+        files.sort();
+        files
+            .iter()
+            .filter(|p| !known.iter().any(|s| Path::new(&s.location) == p.as_path()))
+            .map(|p| Files::study_source(p))
+            .collect()
+    }
+}
+
+/// A database shown whole is listed again on every `GET /api/sources`: a study created after
+/// start-up joins the list with the next id, and the sources listed before keep theirs. (The
+/// database here is a folder, through [`Folder`]; `.ci/dashboard-check` checks the same of a
+/// real PostgreSQL database in headless Chromium.)
+#[test]
+fn a_study_created_after_start_up_is_listed() {
+    let dir = fresh_dir("later");
+    let tell = |study: &mut Study, laps: usize| {
+        for _ in 0..laps {
+            let trial = study.ask().unwrap();
+            study.tell(trial.id, &Outcome::Reward(20.0)).unwrap();
+        }
+    };
+    tell(
+        &mut Study::create(&dir.join("a.cdbo.db"), study_config()).unwrap(),
+        1,
+    );
+    let database = dir.display().to_string();
+    let dashboard = Dashboard {
+        sources: Folder.database(&database, &[]).unwrap(),
+        databases: vec![database],
+        store: Box::new(Folder),
+        study_track: None,
+        car: cars::DEFAULT.into(),
+        data: DataPath::default(),
+    };
+    let bound = dashboard.bind("127.0.0.1:0").unwrap();
+    let addr = bound.local_addr().unwrap();
+    std::thread::spawn(move || bound.serve().unwrap());
+    let (status, listed) = get(addr, "/api/sources");
+    assert_eq!(status, 200, "{listed}");
+    assert_eq!(listed.as_array().unwrap().len(), 1, "{listed}");
+
+    tell(
+        &mut Study::create(&dir.join("b.cdbo.db"), study_config()).unwrap(),
+        2,
+    );
+    let (_, listed) = get(addr, "/api/sources");
+    let listed = listed.as_array().unwrap();
+    assert_eq!(listed.len(), 2, "{listed:?}");
+    for (id, (file, laps)) in [("a.cdbo.db", 1), ("b.cdbo.db", 2)].into_iter().enumerate() {
+        assert_eq!(listed[id]["id"], id, "{listed:?}");
+        assert!(listed[id]["location"].as_str().unwrap().ends_with(file));
+        assert_eq!(listed[id]["laps"], laps, "{listed:?}");
+    }
+    let (status, view) = get(addr, "/api/sources/1");
+    assert_eq!(status, 200, "{view}");
+    assert_eq!(view["laps_total"], 2, "{view}");
 }

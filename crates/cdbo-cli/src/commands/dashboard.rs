@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use cdbo::car::catalog as cars;
 use cdbo::data_path::DataPath;
 use cdbo::study::Location;
-use cdbo_dashboard::store::Files;
+use cdbo_dashboard::store::{Files, is_database};
 use cdbo_dashboard::{DEFAULT_BIND, Dashboard};
 use clap::Args;
 
@@ -40,6 +40,7 @@ pub fn run(args: &DashboardArgs, data: &DataPath) -> CliResult {
         return Err("nothing to show: give --storage STUDY and/or --experiment DIR".into());
     }
     let mut sources = Vec::new();
+    let mut databases = Vec::new();
     for storage in &args.studies {
         let found = Files::storage(storage)?;
         if found.is_empty() {
@@ -50,6 +51,9 @@ pub fn run(args: &DashboardArgs, data: &DataPath) -> CliResult {
             .into());
         }
         sources.extend(found);
+        if is_database(storage) {
+            databases.push(storage.clone());
+        }
     }
     for dir in &args.experiments {
         sources.push(Files::experiment_source(dir)?);
@@ -58,6 +62,7 @@ pub fn run(args: &DashboardArgs, data: &DataPath) -> CliResult {
     let experiments = sources.len() - studies;
     let dashboard = Dashboard {
         sources,
+        databases,
         store: Box::new(Files),
         study_track: args.track.clone(),
         car: args.car.clone(),
