@@ -267,18 +267,7 @@ fn workers_fill_a_grid_in_an_sqlite_file() {
         "the refused worker changed the grid"
     );
     common::demo(&dir);
-    ok(
-        &dir,
-        &[
-            "study",
-            "create",
-            "s",
-            "--kernels",
-            "6",
-            "--demo",
-            "demo.csv",
-        ],
-    );
+    ok(&dir, &common::create_study("s", &[]));
     common::refused(
         &dir,
         &[

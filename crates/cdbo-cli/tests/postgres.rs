@@ -6,12 +6,15 @@
 //! the tests say so and pass: `.ci/run` installs it when `CI` is set.
 
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::process::{Child, Command};
 use std::time::{Duration, Instant};
 
 mod common;
 
-use common::{CDBO, demo, fresh_dir, kill_first_and_reap, ok, refused, rewards_table};
+use common::{
+    CDBO, create_study, driven, every_trial_told_once_and_distinct, fresh_dir, fresh_dir_with_demo,
+    history, kill_first_and_reap, ok, optimize, refused, rewards_table, spawn, wait_until,
+};
 
 /// The password of the test server's superuser `cdbo`.
 const PASSWORD: &str = "lap-secret";
@@ -191,50 +194,11 @@ impl Drop for Server {
     }
 }
 
-/// A fresh folder with a demonstration recorded on the built-in track.
-fn fresh_dir_with_demo(name: &str) -> PathBuf {
-    let dir = fresh_dir(name);
-    demo(&dir);
-    dir
-}
-
-/// `cdbo optimize` with `method` on `storage` to `laps` told trials, every lap driven appended
-/// to `driven.log`.
-fn optimize(storage: &str, laps: usize, method: &str) -> Command {
-    let evaluator = format!("echo {{policy}} >> driven.log; {CDBO} lap --policy {{policy}} --json");
-    let mut c = Command::new(CDBO);
-    c.args([
-        "optimize",
-        "--evaluator",
-        &evaluator,
-        "--kernels",
-        "6",
-        "--laps",
-        &laps.to_string(),
-        "--storage",
-        storage,
-        "--demo",
-        "demo.csv",
-        "--seed",
-        "3",
-        "--method",
-        method,
-        "--lease",
-        "2",
-    ]);
+/// A worker of `method` (seed 3) on `storage` to `laps` told trials ([`optimize`]).
+fn worker(storage: &str, laps: usize, method: &str) -> Command {
+    let mut c = optimize(storage, laps, 0.0);
+    c.args(["--seed", "3", "--method", method]);
     c
-}
-
-fn history(dir: &Path, name: &str, storage: &str) -> Vec<serde_json::Value> {
-    let text = ok(
-        dir,
-        &["study", "history", name, "--storage", storage, "--json"],
-    );
-    serde_json::from_str(&text).unwrap()
-}
-
-fn driven(dir: &Path) -> usize {
-    std::fs::read_to_string(dir.join("driven.log")).map_or(0, |t| t.lines().count())
 }
 
 /// Three workers of `method` on one PostgreSQL study, started at once before it exists; one
@@ -248,35 +212,15 @@ fn three_workers(trials: usize, method: &str) {
     let dir = fresh_dir_with_demo(&format!("workers{trials}"));
     let storage = format!("{}#workers", server.url());
     let start = Instant::now();
-    let spawn = || {
-        optimize(&storage, trials, method)
-            .current_dir(&dir)
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap()
-    };
-    let workers: Vec<Child> = (0..3).map(|_| spawn()).collect();
-    while driven(&dir) < trials / 2 {
-        assert!(
-            start.elapsed() < Duration::from_secs(600),
-            "too few laps driven"
-        );
-        std::thread::sleep(Duration::from_millis(20));
-    }
+    let workers: Vec<Child> = (0..3)
+        .map(|_| spawn(worker(&storage, trials, method), &dir))
+        .collect();
+    wait_until("half the laps driven", Duration::from_secs(600), || {
+        driven(&dir) >= trials / 2
+    });
     kill_first_and_reap(workers);
     let h = history(&dir, "workers", &server.url());
-    assert_eq!(h.len(), trials, "{h:?}");
-    assert!(h.iter().all(|t| t["reward"].is_number()), "{h:?}");
-    for (i, a) in h.iter().enumerate() {
-        for b in &h[..i] {
-            assert_ne!(
-                a["weights"], b["weights"],
-                "trials {} and {}",
-                a["id"], b["id"]
-            );
-        }
-    }
+    every_trial_told_once_and_distinct(&h, trials);
     let laps = driven(&dir);
     eprintln!(
         "3 {method} workers, one killed at {}: {laps} laps driven, {} trials told, {:.1} s",
@@ -314,7 +258,7 @@ fn sqlite_and_postgres_agree_bit_for_bit() {
     let pg = format!("{}#same", server.url());
     let laps = 12;
     for storage in ["a.db", pg.as_str()] {
-        let out = optimize(storage, laps, "cdbo")
+        let out = worker(storage, laps, "cdbo")
             .current_dir(&dir)
             .output()
             .unwrap();
@@ -386,7 +330,7 @@ fn sqlite_and_postgres_agree_bit_for_bit() {
     }
     // The copy goes on as the original would: one more lap each, the same trial.
     for storage in ["a.db".to_owned(), format!("{}#copied", server.url())] {
-        let out = optimize(&storage, laps + 1, "cdbo")
+        let out = worker(&storage, laps + 1, "cdbo")
             .current_dir(&dir)
             .output()
             .unwrap();
@@ -411,22 +355,7 @@ fn a_trial_told_twice_is_refused() {
     let dir = fresh_dir_with_demo("twice");
     let url = server.url();
     let study = ["--storage", url.as_str()];
-    ok(
-        &dir,
-        &[
-            &[
-                "study",
-                "create",
-                "hand",
-                "--kernels",
-                "6",
-                "--demo",
-                "demo.csv",
-            ][..],
-            &study,
-        ]
-        .concat(),
-    );
+    ok(&dir, &create_study("hand", &study));
     let asked: serde_json::Value =
         serde_json::from_str(&ok(&dir, &[&["study", "ask", "hand"][..], &study].concat())).unwrap();
     let trial = asked["trial"].to_string();
@@ -462,24 +391,12 @@ fn bad_databases_are_one_line_and_write_nothing() {
     };
     let dir = fresh_dir_with_demo("bad");
     let create = |storage: &str| -> Vec<String> {
-        [
-            "study",
-            "create",
-            "s",
-            "--kernels",
-            "6",
-            "--demo",
-            "demo.csv",
-            "--storage",
-            storage,
-        ]
-        .map(String::from)
-        .to_vec()
+        create_study("s", &["--storage", storage])
+            .into_iter()
+            .map(String::from)
+            .collect()
     };
-    let run = |args: Vec<String>, needles: &[&str]| {
-        let args: Vec<&str> = args.iter().map(String::as_str).collect();
-        refused(&dir, &args, needles);
-    };
+    let run = |args: Vec<String>, needles: &[&str]| refused(&dir, &args, needles);
     // Nothing listens on a port just freed.
     let closed = std::net::TcpListener::bind("127.0.0.1:0")
         .unwrap()
@@ -555,13 +472,7 @@ fn bad_databases_are_one_line_and_write_nothing() {
     };
     assert_eq!(tables(&mut client), 0);
     // A newer cdbo's schema: refused, the database left as it was.
-    ok(
-        &dir,
-        &create(&server.url())
-            .iter()
-            .map(String::as_str)
-            .collect::<Vec<_>>(),
-    );
+    ok(&dir, &create(&server.url()));
     client
         .execute(
             "UPDATE cdbo_meta SET value = '99' WHERE key = 'schema_version'",
@@ -627,24 +538,20 @@ fn two_workers_fill_the_quick_grid_one_killed() {
     );
     ok(&dir, &["report", "one", "--out", "report-one"]);
     let storage = format!("{}#quick", server.url());
-    let spawn = || {
-        Command::new(CDBO)
-            .args([
-                "experiment",
-                "quick",
-                "--storage",
-                &storage,
-                "--worker",
-                "--jobs",
-                "1",
-            ])
-            .current_dir(&dir)
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap()
+    let worker = || {
+        let mut c = Command::new(CDBO);
+        c.args([
+            "experiment",
+            "quick",
+            "--storage",
+            &storage,
+            "--worker",
+            "--jobs",
+            "1",
+        ]);
+        spawn(c, &dir)
     };
-    let workers: Vec<Child> = (0..2).map(|_| spawn()).collect();
+    let workers: Vec<Child> = (0..2).map(|_| worker()).collect();
     let victim = workers[0].id();
     let mut client = server.client();
     // Kill the first worker while it holds an unfinished cell, once a few cells are done.

@@ -4,11 +4,15 @@
 //! documented behaviour, and never a panic (exit 101).
 
 use std::process::{Child, Command, Output, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 mod common;
 
-use common::{CDBO, cdbo, demo, fresh_dir, history, kill_first_and_reap, ok, refused};
+use common::{
+    CDBO, cdbo, create_study, demo, driven, every_trial_told_once_and_distinct, fresh_dir,
+    fresh_dir_with_demo, history, kill_first_and_reap, ok, optimize, optimize_args, refused, spawn,
+    wait_until,
+};
 
 #[test]
 fn every_size_has_a_bound_and_every_number_a_domain() {
@@ -298,77 +302,26 @@ fn a_legal_but_slow_study_says_so_first() {
     }
 }
 
-/// `cdbo optimize` on study `db` to `laps` told trials, every lap driven appended to
-/// `driven.log`.
-fn optimize(db: &str, laps: &str) -> Command {
-    let evaluator =
-        format!("echo {{policy}} >> driven.log; sleep 0.1; {CDBO} lap --policy {{policy}} --json");
-    let mut c = Command::new(CDBO);
-    c.args([
-        "optimize",
-        "--evaluator",
-        &evaluator,
-        "--kernels",
-        "6",
-        "--laps",
-        laps,
-        "--db",
-        db,
-        "--demo",
-        "demo.csv",
-        "--lease",
-        "2",
-    ]);
-    c
-}
-
-/// Every trial told once, with weights of its own.
-fn every_trial_told_once_and_distinct(h: &[serde_json::Value], trials: usize) {
-    assert_eq!(h.len(), trials, "{h:?}");
-    assert!(h.iter().all(|t| t["reward"].is_number()), "{h:?}");
-    for (i, a) in h.iter().enumerate() {
-        for b in &h[..i] {
-            assert_ne!(
-                a["weights"], b["weights"],
-                "trials {} and {}",
-                a["id"], b["id"]
-            );
-        }
-    }
-}
-
 /// Three workers started at once on a study that does not exist yet all join it; one is
 /// killed (SIGKILL) mid-way; the others finish. Every trial is told once, with distinct
 /// weights, and at most trials + 3 laps are driven in all.
 #[test]
 fn three_workers_one_killed_drive_each_trial_once() {
-    let dir = fresh_dir("workers");
-    demo(&dir);
+    let dir = fresh_dir_with_demo("workers");
     let trials = 24;
-    let spawn = || {
-        optimize("w.db", &trials.to_string())
-            .current_dir(&dir)
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap()
-    };
-    let workers: Vec<Child> = (0..3).map(|_| spawn()).collect();
+    let workers: Vec<Child> = (0..3)
+        .map(|_| spawn(optimize("w.db", trials, 0.1), &dir))
+        .collect();
     // Kill the first once a few trials are told.
-    let start = Instant::now();
-    while std::fs::read_to_string(dir.join("driven.log")).map_or(0, |t| t.lines().count()) < 6 {
-        assert!(start.elapsed() < Duration::from_secs(60), "no laps driven");
-        std::thread::sleep(Duration::from_millis(20));
-    }
+    wait_until("6 laps driven", Duration::from_secs(60), || {
+        driven(&dir) >= 6
+    });
     kill_first_and_reap(workers);
-    every_trial_told_once_and_distinct(&history(&dir, "w.db"), trials);
-    let driven = std::fs::read_to_string(dir.join("driven.log"))
-        .unwrap()
-        .lines()
-        .count();
+    every_trial_told_once_and_distinct(&history(&dir, "s", "w.db"), trials);
+    let laps = driven(&dir);
     assert!(
-        (trials..=trials + 3).contains(&driven),
-        "{driven} laps driven for {trials} trials"
+        (trials..=trials + 3).contains(&laps),
+        "{laps} laps driven for {trials} trials"
     );
 }
 
@@ -376,24 +329,10 @@ fn three_workers_one_killed_drive_each_trial_once() {
 /// uninterrupted run, whatever the lease.
 #[test]
 fn a_single_worker_is_unchanged_by_claims() {
-    let dir = fresh_dir("single");
-    demo(&dir);
-    let out = optimize("a.db", "8").current_dir(&dir).output().unwrap();
+    let dir = fresh_dir_with_demo("single");
+    let out = optimize("a.db", 8, 0.1).current_dir(&dir).output().unwrap();
     assert!(out.status.success());
-    ok(
-        &dir,
-        &[
-            "study",
-            "create",
-            "s",
-            "--db",
-            "b.db",
-            "--kernels",
-            "6",
-            "--demo",
-            "demo.csv",
-        ],
-    );
+    ok(&dir, &create_study("s", &["--db", "b.db"]));
     for _ in 0..8 {
         let asked: serde_json::Value =
             serde_json::from_str(&ok(&dir, &["study", "ask", "s", "--db", "b.db"])).unwrap();
@@ -413,7 +352,7 @@ fn a_single_worker_is_unchanged_by_claims() {
             ],
         );
     }
-    let (a, b) = (history(&dir, "a.db"), history(&dir, "b.db"));
+    let (a, b) = (history(&dir, "s", "a.db"), history(&dir, "s", "b.db"));
     assert_eq!(a, b);
 }
 
@@ -421,25 +360,11 @@ fn a_single_worker_is_unchanged_by_claims() {
 /// `--laps` is a total.
 #[test]
 fn resuming_with_other_settings_is_refused() {
-    let dir = fresh_dir("resume");
-    demo(&dir);
-    let out = optimize("r.db", "3").current_dir(&dir).output().unwrap();
+    let dir = fresh_dir_with_demo("resume");
+    let out = optimize("r.db", 3, 0.1).current_dir(&dir).output().unwrap();
     assert!(out.status.success());
     let base = |extra: &[&str]| -> Vec<String> {
-        let mut v: Vec<String> = [
-            "optimize",
-            "--evaluator",
-            "true",
-            "--kernels",
-            "6",
-            "--laps",
-            "5",
-            "--db",
-            "r.db",
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
+        let mut v = optimize_args("true", "r.db", 5);
         v.extend(extra.iter().map(|s| s.to_string()));
         v
     };
@@ -451,15 +376,12 @@ fn resuming_with_other_settings_is_refused() {
         (&["--seed", "3"][..], "created with --seed 0, not 3"),
         (&["--beta", "2"][..], "created with --beta 1, not 2"),
     ] {
-        let args = base(extra);
-        let args: Vec<&str> = args.iter().map(String::as_str).collect();
-        refused(&dir, &args, &["r.db", needle]);
+        refused(&dir, &base(extra), &["r.db", needle]);
     }
-    let args = base(&[]);
-    let mut args: Vec<&str> = args.iter().map(String::as_str).collect();
-    args[4] = "7";
+    let mut args = base(&[]);
+    args[4] = "7".into();
     refused(&dir, &args, &["created with --kernels 6, not 7"]);
-    let out = optimize("r.db", "2").current_dir(&dir).output().unwrap();
+    let out = optimize("r.db", 2, 0.1).current_dir(&dir).output().unwrap();
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(
         text.contains("3 trials told already, --laps 2 is the total to reach: nothing to drive"),
@@ -471,9 +393,11 @@ fn resuming_with_other_settings_is_refused() {
 /// or its folder. Empty and foreign files are refused and left byte for byte.
 #[test]
 fn read_only_and_foreign_studies() {
-    let dir = fresh_dir("readonly");
-    demo(&dir);
-    let out = optimize("ro.db", "3").current_dir(&dir).output().unwrap();
+    let dir = fresh_dir_with_demo("readonly");
+    let out = optimize("ro.db", 3, 0.1)
+        .current_dir(&dir)
+        .output()
+        .unwrap();
     assert!(out.status.success());
     let locked = dir.join("locked");
     std::fs::create_dir_all(&locked).unwrap();
@@ -578,30 +502,15 @@ fn read_only_and_foreign_studies() {
 /// A failure reason of megabytes is kept as a bounded tail.
 #[test]
 fn evaluator_output_is_bounded_in_the_study() {
-    let dir = fresh_dir("output");
-    demo(&dir);
-    let out = cdbo(
-        &dir,
-        &[
-            "optimize",
-            "--evaluator",
-            r#"printf '{"failed": true, "reason": "'; head -c 3000000 /dev/zero | tr '\0' x; printf 'the end"}'"#,
-            "--kernels",
-            "6",
-            "--laps",
-            "1",
-            "--db",
-            "o.db",
-            "--demo",
-            "demo.csv",
-        ],
-    );
+    let dir = fresh_dir_with_demo("output");
+    let evaluator = r#"printf '{"failed": true, "reason": "'; head -c 3000000 /dev/zero | tr '\0' x; printf 'the end"}'"#;
+    let out = cdbo(&dir, &optimize_args(evaluator, "o.db", 1));
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let h = history(&dir, "o.db");
+    let h = history(&dir, "s", "o.db");
     let reason = h[0]["failure"].as_str().unwrap();
     assert!(reason.len() <= 4096, "{}", reason.len());
     assert!(
@@ -647,7 +556,7 @@ fn cut_run_records_and_leftover_files() {
     demo(&dir);
     let leftover = dir.join("l.db.trial-1.pid-999999999.json");
     std::fs::write(&leftover, "{}").unwrap();
-    let out = optimize("l.db", "1").current_dir(&dir).output().unwrap();
+    let out = optimize("l.db", 1, 0.1).current_dir(&dir).output().unwrap();
     assert!(out.status.success());
     assert!(!leftover.exists());
 }

@@ -8,7 +8,7 @@ use std::time::Duration;
 
 mod common;
 
-use common::{CDBO, Service, cdbo, demo, fresh_dir, history, ok};
+use common::{CDBO, Service, cdbo, fresh_dir_with_demo, history, ok};
 
 /// Expects failure with one clear error line containing `needle`.
 fn fails(dir: &Path, args: &[&str], needle: &str) {
@@ -23,53 +23,27 @@ fn fails(dir: &Path, args: &[&str], needle: &str) {
 
 const EVALUATOR: &str = "{cdbo} lap --policy {policy} --json";
 
-fn optimize_args<'a>(db: &'a str, laps: &'a str, evaluator: &'a str) -> Vec<&'a str> {
-    vec![
-        "optimize",
-        "--evaluator",
-        evaluator,
-        "--kernels",
-        "6",
-        "--laps",
-        laps,
-        "--db",
-        db,
-        "--demo",
-        "demo.csv",
-        "--seed",
-        "4",
-    ]
+/// [`common::optimize_args`] of seed 4 on the SQLite file `db`.
+fn optimize_args(db: &str, laps: usize, evaluator: &str) -> Vec<String> {
+    let mut args = common::optimize_args(evaluator, db, laps);
+    args.extend(["--seed".into(), "4".into()]);
+    args
 }
 
 #[test]
 fn ask_tell_workflow_and_bad_input() {
-    let dir = fresh_dir("workflow");
-    demo(&dir);
-    ok(
-        &dir,
-        &[
-            "study",
-            "create",
-            "car",
-            "--kernels",
-            "8",
-            "--demo",
-            "demo.csv",
-        ],
-    );
-    fails(
-        &dir,
-        &[
-            "study",
-            "create",
-            "car",
-            "--kernels",
-            "8",
-            "--demo",
-            "demo.csv",
-        ],
-        "already exists",
-    );
+    let dir = fresh_dir_with_demo("workflow");
+    let create = [
+        "study",
+        "create",
+        "car",
+        "--kernels",
+        "8",
+        "--demo",
+        "demo.csv",
+    ];
+    ok(&dir, &create);
+    fails(&dir, &create, "already exists");
     let ask: serde_json::Value = serde_json::from_str(&ok(&dir, &["study", "ask", "car"])).unwrap();
     assert_eq!(ask["trial"], 1);
     assert_eq!(ask["weights"].as_array().unwrap().len(), 8);
@@ -188,13 +162,12 @@ fn ask_tell_workflow_and_bad_input() {
 
 #[test]
 fn optimize_records_failed_commands_with_their_reason() {
-    let dir = fresh_dir("failing");
-    demo(&dir);
+    let dir = fresh_dir_with_demo("failing");
     let out = ok(
         &dir,
         &optimize_args(
             "f.db",
-            "3",
+            3,
             "case $(wc -c < {policy}) in *) echo crashed >&2; exit 4;; esac",
         ),
     );
@@ -203,13 +176,13 @@ fn optimize_records_failed_commands_with_their_reason() {
         3,
         "{out}"
     );
-    let out = ok(&dir, &optimize_args("g.db", "2", "echo fast"));
+    let out = ok(&dir, &optimize_args("g.db", 2, "echo fast"));
     assert_eq!(out.matches("unparsable output").count(), 2, "{out}");
     let out = ok(
         &dir,
         &[
-            optimize_args("h.db", "1", "sleep 3"),
-            vec!["--timeout", "0.2"],
+            optimize_args("h.db", 1, "sleep 3"),
+            vec!["--timeout".into(), "0.2".into()],
         ]
         .concat(),
     );
@@ -220,8 +193,7 @@ fn optimize_records_failed_commands_with_their_reason() {
 /// saved, and continues exactly as an uninterrupted run.
 #[test]
 fn sigkill_at_random_moments_loses_nothing() {
-    let dir = fresh_dir("sigkill");
-    demo(&dir);
+    let dir = fresh_dir_with_demo("sigkill");
     let evaluator = EVALUATOR.replace("{cdbo}", CDBO);
     let mut seed: u64 = 0x2545_f491_4f6c_dd1d;
     let mut random_ms = |max: u64| {
@@ -234,7 +206,7 @@ fn sigkill_at_random_moments_loses_nothing() {
     // A target that is never reached: every session ends by SIGKILL.
     for _ in 0..50 {
         let mut child = Command::new(CDBO)
-            .args(optimize_args("killed.db", "100000", &evaluator))
+            .args(optimize_args("killed.db", 100000, &evaluator))
             .current_dir(&dir)
             .stdout(Stdio::piped())
             .stderr(Stdio::null())
@@ -259,7 +231,7 @@ fn sigkill_at_random_moments_loses_nothing() {
         saved.extend(reader.join().unwrap());
         // Everything reported as saved is in the study, with the reported reward.
         if dir.join("killed.db").exists() {
-            let h = history(&dir, "killed.db");
+            let h = history(&dir, "s", "killed.db");
             for (id, reward) in &saved {
                 let t = h
                     .iter()
@@ -271,17 +243,20 @@ fn sigkill_at_random_moments_loses_nothing() {
     }
     // On a loaded machine every kill may come before the study is made: make it now.
     if !dir.join("killed.db").exists() {
-        ok(&dir, &optimize_args("killed.db", "0", &evaluator));
+        ok(&dir, &optimize_args("killed.db", 0, &evaluator));
     }
     // Finish a few more laps undisturbed, then compare with a run never interrupted.
-    let told = history(&dir, "killed.db")
+    let told = history(&dir, "s", "killed.db")
         .iter()
         .filter(|t| t["reward"].is_number())
         .count();
-    let laps = (told + 3).to_string();
-    ok(&dir, &optimize_args("killed.db", &laps, &evaluator));
-    ok(&dir, &optimize_args("reference.db", &laps, &evaluator));
-    let (killed, reference) = (history(&dir, "killed.db"), history(&dir, "reference.db"));
+    let laps = told + 3;
+    ok(&dir, &optimize_args("killed.db", laps, &evaluator));
+    ok(&dir, &optimize_args("reference.db", laps, &evaluator));
+    let (killed, reference) = (
+        history(&dir, "s", "killed.db"),
+        history(&dir, "s", "reference.db"),
+    );
     assert_eq!(killed.len(), told + 3);
     assert_eq!(killed.len(), reference.len());
     for (a, b) in killed.iter().zip(&reference) {

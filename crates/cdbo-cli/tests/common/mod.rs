@@ -1,16 +1,20 @@
 //! Helpers shared by the command-line tests: the binary run in a folder, fresh folders, a
-//! recorded demonstration, a study's history.
+//! recorded demonstration, the study and optimize commands of the tests, a study's history,
+//! workers started and waited for.
 #![allow(dead_code)]
 
+use std::ffi::OsStr;
+use std::fmt::Debug;
 use std::io::{BufRead, BufReader, Lines, Write};
 use std::path::{Path, PathBuf};
 use std::process::{Child, ChildStdin, ChildStdout, Command, ExitStatus, Output, Stdio};
+use std::time::{Duration, Instant};
 
 /// The `cdbo` binary under test.
 pub const CDBO: &str = env!("CARGO_BIN_EXE_cdbo");
 
 /// Runs `cdbo ARGS` in `dir`.
-pub fn cdbo(dir: &Path, args: &[&str]) -> Output {
+pub fn cdbo<S: AsRef<OsStr>>(dir: &Path, args: &[S]) -> Output {
     Command::new(CDBO)
         .args(args)
         .current_dir(dir)
@@ -19,7 +23,7 @@ pub fn cdbo(dir: &Path, args: &[&str]) -> Output {
 }
 
 /// Runs `cdbo ARGS` in `dir`, expects success and returns its standard output.
-pub fn ok(dir: &Path, args: &[&str]) -> String {
+pub fn ok<S: AsRef<OsStr> + Debug>(dir: &Path, args: &[S]) -> String {
     let out = cdbo(dir, args);
     assert!(
         out.status.success(),
@@ -43,7 +47,7 @@ pub fn fresh_dir(name: &str) -> PathBuf {
 }
 
 /// Expects exit status 2 and exactly one line on stderr, `error: …` containing every needle.
-pub fn refused(dir: &Path, args: &[&str], needles: &[&str]) {
+pub fn refused<S: AsRef<OsStr> + Debug>(dir: &Path, args: &[S], needles: &[&str]) {
     let out = cdbo(dir, args);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
@@ -63,10 +67,112 @@ pub fn demo(dir: &Path) {
     );
 }
 
-/// The told trials of study `s` in `db`, as `cdbo study history --json` lists them.
-pub fn history(dir: &Path, db: &str) -> Vec<serde_json::Value> {
-    let text = ok(dir, &["study", "history", "s", "--db", db, "--json"]);
+/// A fresh scratch folder ([`fresh_dir`]) holding a demonstration, `demo.csv` ([`demo`]).
+pub fn fresh_dir_with_demo(name: &str) -> PathBuf {
+    let dir = fresh_dir(name);
+    demo(&dir);
+    dir
+}
+
+/// `cdbo study create NAME` of 6 kernels fitted to `demo.csv` ([`demo`]), then `more` (such
+/// as `--storage URL`).
+pub fn create_study<'a>(name: &'a str, more: &[&'a str]) -> Vec<&'a str> {
+    let mut args = vec![
+        "study",
+        "create",
+        name,
+        "--kernels",
+        "6",
+        "--demo",
+        "demo.csv",
+    ];
+    args.extend(more);
+    args
+}
+
+/// `cdbo optimize` of 6 kernels fitted to `demo.csv` ([`demo`]) on `storage`, to `laps` told
+/// trials, each lap driven by `evaluator`.
+pub fn optimize_args(evaluator: &str, storage: &str, laps: usize) -> Vec<String> {
+    let laps = laps.to_string();
+    [
+        "optimize",
+        "--evaluator",
+        evaluator,
+        "--kernels",
+        "6",
+        "--laps",
+        &laps,
+        "--storage",
+        storage,
+        "--demo",
+        "demo.csv",
+    ]
+    .map(String::from)
+    .to_vec()
+}
+
+/// A worker: [`optimize_args`] with 2 s leases, each lap a `cdbo lap` that first appends its
+/// policy to `driven.log` ([`driven`]) and, `pause_s` > 0, sleeps that long.
+pub fn optimize(storage: &str, laps: usize, pause_s: f64) -> Command {
+    let pause = if pause_s > 0.0 {
+        format!("sleep {pause_s}; ")
+    } else {
+        String::new()
+    };
+    let evaluator =
+        format!("echo {{policy}} >> driven.log; {pause}{CDBO} lap --policy {{policy}} --json");
+    let mut c = Command::new(CDBO);
+    c.args(optimize_args(&evaluator, storage, laps))
+        .args(["--lease", "2"]);
+    c
+}
+
+/// Laps driven so far by the workers of [`optimize`] in `dir`.
+pub fn driven(dir: &Path) -> usize {
+    std::fs::read_to_string(dir.join("driven.log")).map_or(0, |t| t.lines().count())
+}
+
+/// The trials of study `study` at `storage`, as `cdbo study history --json` lists them.
+pub fn history(dir: &Path, study: &str, storage: &str) -> Vec<serde_json::Value> {
+    let text = ok(
+        dir,
+        &["study", "history", study, "--storage", storage, "--json"],
+    );
     serde_json::from_str(&text).unwrap()
+}
+
+/// Every trial of history `h` told, `trials` of them, each with weights of its own.
+pub fn every_trial_told_once_and_distinct(h: &[serde_json::Value], trials: usize) {
+    assert_eq!(h.len(), trials, "{h:?}");
+    assert!(h.iter().all(|t| t["reward"].is_number()), "{h:?}");
+    for (i, a) in h.iter().enumerate() {
+        for b in &h[..i] {
+            assert_ne!(
+                a["weights"], b["weights"],
+                "trials {} and {}",
+                a["id"], b["id"]
+            );
+        }
+    }
+}
+
+/// `command` started in `dir`, its output piped (kept for [`kill_first_and_reap`]).
+pub fn spawn(mut command: Command, dir: &Path) -> Child {
+    command
+        .current_dir(dir)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+/// Waits until `done()`, checking every 20 ms; fails naming `what` after `timeout`.
+pub fn wait_until(what: &str, timeout: Duration, mut done: impl FnMut() -> bool) {
+    let start = Instant::now();
+    while !done() {
+        assert!(start.elapsed() < timeout, "{what}: not within {timeout:?}");
+        std::thread::sleep(Duration::from_millis(20));
+    }
 }
 
 /// Kills the first of `workers` (SIGKILL, mid-lap) and waits for them all: none panicked, and
