@@ -34,6 +34,8 @@ pub mod limit;
 pub mod optimizers;
 pub mod params;
 pub mod policy;
+#[cfg(test)]
+mod scratch;
 pub mod serve;
 pub mod sim;
 mod simd;

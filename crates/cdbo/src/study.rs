@@ -522,10 +522,7 @@ mod tests {
     }
 
     pub(crate) fn temp(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("cdbo-study-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        dir.join("s.db")
+        crate::scratch::dir(&format!("study-{name}")).join("s.db")
     }
 
     #[test]

@@ -269,15 +269,10 @@ pub fn from_params(p: &Params) -> Result<Car> {
 mod tests {
     use super::*;
 
-    fn scratch() -> PathBuf {
-        std::env::temp_dir().join(format!("cdbo-car-category-{}", std::process::id()))
-    }
-
     /// A category file (TORCS layout: `categories/CAT.xml`) with `category_extra` in its `Car`
     /// section, and a car `cars/NAME/NAME.xml` over it with `car_extra` in its own.
     fn car_over_category(tag: &str, category_extra: &str, car_extra: &str) -> (PathBuf, PathBuf) {
-        let dir = scratch().join(tag);
-        let _ = std::fs::remove_dir_all(&dir);
+        let dir = crate::scratch::dir(&format!("car-category-{tag}"));
         std::fs::create_dir_all(dir.join("categories")).unwrap();
         std::fs::create_dir_all(dir.join("cars/test-car")).unwrap();
         let category = dir.join("categories/test-cat.xml");
@@ -357,6 +352,5 @@ mod tests {
         let e = read(&car, None).unwrap_err().to_string();
         let car_line_3 = format!("{}:3: Car/mass: missing required attribute", car.display());
         assert!(e.starts_with(&car_line_3), "{e}");
-        let _ = std::fs::remove_dir_all(scratch());
     }
 }

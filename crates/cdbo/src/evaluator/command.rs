@@ -254,8 +254,7 @@ mod tests {
 
     #[test]
     fn exit_codes_and_timeouts_are_failed_laps() {
-        let dir = std::env::temp_dir().join(format!("cdbo-cmd-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::scratch::dir("command");
         let mut e = CommandEvaluator {
             template: "test -s {policy} && echo 3.25".into(),
             timeout: Duration::from_secs(5),
