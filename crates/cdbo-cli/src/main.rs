@@ -45,7 +45,7 @@ enum Command {
     /// The quasi-steady-state minimum lap time of a car on a track.
     Limit(commands::limit::LimitArgs),
     /// The ceiling: the fastest completed lap tracking k x the limit's speed profile, and the
-    /// best M-kernel policy fitted to its pedal.
+    /// M-kernel policy fitted to its pedal and repaired where it fails.
     Ceiling(commands::ceiling::CeilingArgs),
     /// A live local web page over studies and experiment folders (read-only).
     Dashboard(commands::dashboard::DashboardArgs),

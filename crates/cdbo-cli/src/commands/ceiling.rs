@@ -29,8 +29,18 @@ pub fn run(args: &CeilingArgs, data: &DataPath) -> CliResult {
         return print_json(&c);
     }
     let pct = |v: f64| 100.0 * v / c.limit_mps;
+    let policy = if c.policy.is_some() {
+        format!(
+            "{:.2} m/s ({:.1} %) after {} repairs",
+            c.policy_mps,
+            pct(c.policy_mps),
+            c.repairs
+        )
+    } else {
+        format!("none completes within {} laps", cdbo::ceiling::REPAIR_LAPS)
+    };
     println!(
-        "{} on {}: limit {:.2} m/s; tracking {:.3} x the limit's speed profile {:.2} m/s ({:.1} % of the limit); best {}-kernel policy fitted to its pedal {:.2} m/s ({:.1} %)",
+        "{} on {}: limit {:.2} m/s; tracking {:.3} x the limit's speed profile {:.2} m/s ({:.1} % of the limit); {}-kernel policy fitted to its pedal, repaired where it fails: {}",
         car.name,
         name,
         c.limit_mps,
@@ -38,8 +48,7 @@ pub fn run(args: &CeilingArgs, data: &DataPath) -> CliResult {
         c.tracked_mps,
         pct(c.tracked_mps),
         c.kernels,
-        c.policy_mps,
-        pct(c.policy_mps)
+        policy
     );
     Ok(())
 }
