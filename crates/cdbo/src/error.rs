@@ -57,6 +57,7 @@ pub enum Error {
     },
     /// A PostgreSQL error on a study's database: unreachable, credentials refused, or a
     /// statement that failed.
+    #[cfg(feature = "postgres")]
     #[error("{}: {}", path.display(), postgres_message(source))]
     Postgres {
         /// The database URL (without its password) and study name.
@@ -285,6 +286,7 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 /// A PostgreSQL error on one line: the server's severity and message, or what failed on the
 /// way to it and why (the client's own `Display` leaves the cause out).
+#[cfg(feature = "postgres")]
 fn postgres_message(e: &postgres::Error) -> String {
     if let Some(db) = e.as_db_error() {
         return format!("{}: {}", db.severity(), db.message());

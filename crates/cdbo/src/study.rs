@@ -17,6 +17,7 @@
 //! [`Study::open_read_only`], which writes nothing.
 
 pub mod claim;
+#[cfg(feature = "postgres")]
 pub mod postgres;
 pub(crate) mod rows;
 pub mod run;
@@ -189,10 +190,13 @@ impl Study {
                 let (s, c) = sqlite::Sqlite::open(path, writable)?;
                 (Box::new(s), c)
             }
+            #[cfg(feature = "postgres")]
             Location::Postgres { url, study } => {
                 let (s, c) = postgres::Postgres::open(url, study, &location.label(), writable)?;
                 (Box::new(s), c)
             }
+            #[cfg(not(feature = "postgres"))]
+            Location::Postgres { .. } => return Err(location.without_postgres()),
         };
         let label = storage.label().to_owned();
         let config: StudyConfig =
@@ -405,9 +409,12 @@ impl Study {
 fn create_from(location: &Location, dump: &Dump) -> Result<()> {
     match location {
         Location::Sqlite(path) => sqlite::Sqlite::create(path, dump),
+        #[cfg(feature = "postgres")]
         Location::Postgres { url, study } => {
             postgres::Postgres::create(url, study, &location.label(), dump)
         }
+        #[cfg(not(feature = "postgres"))]
+        Location::Postgres { .. } => Err(location.without_postgres()),
     }
 }
 

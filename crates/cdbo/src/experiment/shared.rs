@@ -13,6 +13,7 @@
 //! suggested. A finished cell is never run again, and a cell finished twice (a worker whose
 //! lease ran out while it ran) keeps its first record.
 
+#[cfg(feature = "postgres")]
 mod postgres;
 mod sqlite;
 
@@ -345,12 +346,17 @@ pub fn work(
 
 /// The storage `location` names, opened to write (tables created where missing) or to read.
 fn open_storage(location: &Location, writable: bool) -> Result<Box<dyn GridStorage>> {
-    let label = location.label();
     Ok(match location {
         Location::Sqlite(path) => Box::new(sqlite::SqliteGrid::open(path, writable)?),
-        Location::Postgres { url, study } => {
-            Box::new(postgres::PostgresGrid::open(url, study, &label, writable)?)
-        }
+        #[cfg(feature = "postgres")]
+        Location::Postgres { url, study } => Box::new(postgres::PostgresGrid::open(
+            url,
+            study,
+            &location.label(),
+            writable,
+        )?),
+        #[cfg(not(feature = "postgres"))]
+        Location::Postgres { .. } => return Err(location.without_postgres()),
     })
 }
 

@@ -7,6 +7,7 @@
 //! every error. What each stores beside is its own ([`super::sqlite`], [`super::postgres`],
 //! [`crate::experiment::shared`]).
 
+#[cfg(feature = "postgres")]
 pub(crate) mod postgres;
 pub(crate) mod sqlite;
 
@@ -15,6 +16,7 @@ use std::path::PathBuf;
 use crate::error::Error;
 
 /// A table of claimed rows, by its names in each back end.
+#[cfg_attr(not(feature = "postgres"), allow(dead_code))]
 pub(crate) struct ClaimedRows {
     /// The table in an SQLite file (one study or grid per file).
     pub sqlite: &'static str,

@@ -67,6 +67,17 @@ impl Location {
         }
     }
 
+    /// The error of a PostgreSQL location in a cdbo built without PostgreSQL (its `postgres`
+    /// feature off, as in the fuzz build).
+    #[cfg(not(feature = "postgres"))]
+    pub(crate) fn without_postgres(&self) -> Error {
+        Error::InvalidValue {
+            what: "the storage".into(),
+            value: self.label().display().to_string(),
+            expected: "a file path or sqlite://PATH: this cdbo was built without PostgreSQL (cargo feature `postgres`)".into(),
+        }
+    }
+
     /// How messages name it: the file, or `URL#STUDY` with any password replaced by `***`.
     pub fn label(&self) -> PathBuf {
         match self {
