@@ -260,27 +260,18 @@ fn a_legal_but_slow_study_says_so_first() {
         assert!(!dir.join("s.db").exists());
     }
     // The paper's sizes say nothing, nor do methods without a GP at the largest sizes.
-    let quiet: [&[&str]; 3] = [
-        &["study", "create", "s", "--kernels", "30"],
-        &[
+    let mut quiet = vec![vec!["study", "create", "s", "--kernels", "30"]];
+    for method in ["random", "pattern-search"] {
+        quiet.push(vec![
             "optimize",
             "--kernels",
             "1000",
             "--laps",
             "10000",
             "--method",
-            "random",
-        ],
-        &[
-            "optimize",
-            "--kernels",
-            "1000",
-            "--laps",
-            "10000",
-            "--method",
-            "pattern-search",
-        ],
-    ];
+            method,
+        ]);
+    }
     for args in quiet {
         let more = [
             "--db",
@@ -295,7 +286,7 @@ fn a_legal_but_slow_study_says_so_first() {
         } else {
             &more[..]
         };
-        let out = cdbo(&dir, &[args, more].concat());
+        let out = cdbo(&dir, &[&args[..], more].concat());
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(!err.contains("warning"), "{args:?}: {err}");
         assert!(err.contains("gone.csv"), "{args:?}: {err}");
