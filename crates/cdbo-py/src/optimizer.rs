@@ -48,7 +48,7 @@ impl PyOptimizer {
         sigma0: Option<f64>,
     ) -> PyResult<Self> {
         let w0 = vector(w0, "w0")?;
-        let race = Settings::race(seed, beta);
+        let race = Settings::race(method.parse().py()?, seed, beta);
         let settings = Settings {
             box_radius: bounds,
             sigma0: sigma0.unwrap_or(race.sigma0),

@@ -118,9 +118,10 @@ impl Study {
             ));
         }
         // Fails on a bad method or w₀ before anything is written.
-        let optimizer = config
-            .method
-            .optimizer(config.w0.clone(), &Settings::race(config.seed, config.beta))?;
+        let optimizer = config.method.optimizer(
+            config.w0.clone(),
+            &Settings::race(config.method, config.seed, config.beta),
+        )?;
         let dump = Dump {
             config: serde_json::to_string(&config).map_err(|e| Error::json("study settings", e))?,
             optimizer: serde_json::to_string(&optimizer.save())

@@ -2,7 +2,7 @@
 //! places, and a lap with a cliff on which it must beat random search.
 
 use cdbo::optimizers::pattern_search::{PatternSearch, PatternSearchConfig};
-use cdbo::optimizers::{Optimizer, Saved, Settings, by_name};
+use cdbo::optimizers::{Method, Optimizer, Saved, Settings, by_name};
 
 /// A toy lap with a cliff: D segments driven in order at speeds wᵢ; segment i takes at most
 /// cᵢ = 0.5 + 0.4·sin²(i). Too fast (wᵢ > cᵢ) or stopped (wᵢ ≤ 0.05), the car fails there, at
@@ -38,7 +38,12 @@ fn drive(opt: &mut dyn Optimizer, evals: usize) -> Vec<Vec<f64>> {
 
 /// The best reward of a method on the 20-segment cliff from wᵢ = 0.2, 200 laps.
 fn best_on_cliff(method: &str, seed: u64) -> f64 {
-    let mut opt = by_name(method, vec![0.2; 20], &Settings::race(seed, 2.0)).unwrap();
+    let mut opt = by_name(
+        method,
+        vec![0.2; 20],
+        &Settings::race(method.parse().unwrap(), seed, 2.0),
+    )
+    .unwrap();
     drive(opt.as_mut(), 200);
     opt.best().unwrap().1
 }
@@ -173,7 +178,14 @@ fn sweeps_narrow_their_blocks() {
 /// Same seed, same laps; a search saved mid-run (failure places told) resumes bit for bit.
 #[test]
 fn pattern_search_is_deterministic_and_resumes_exactly() {
-    let new = || by_name("pattern-search", vec![0.2; 12], &Settings::race(3, 2.0)).unwrap();
+    let new = || {
+        by_name(
+            "pattern-search",
+            vec![0.2; 12],
+            &Settings::race(Method::PatternSearch, 3, 2.0),
+        )
+        .unwrap()
+    };
     let (mut a, mut b) = (new(), new());
     assert_eq!(drive(a.as_mut(), 40), drive(b.as_mut(), 40));
     let pending = a.ask().unwrap();
@@ -187,11 +199,64 @@ fn pattern_search_is_deterministic_and_resumes_exactly() {
 /// A failure place outside [0, 1] is refused and changes nothing.
 #[test]
 fn a_bad_failure_place_is_refused() {
-    let mut ps = by_name("pattern-search", vec![0.2; 4], &Settings::race(0, 2.0)).unwrap();
+    let mut ps = by_name(
+        "pattern-search",
+        vec![0.2; 4],
+        &Settings::race(Method::PatternSearch, 0, 2.0),
+    )
+    .unwrap();
     let w = ps.ask().unwrap();
     let before = ps.save();
     for at in [-0.1, 1.5, f64::NAN] {
         assert!(ps.tell_lap(&w, 0.0, Some(at)).is_err());
     }
     assert_eq!(ps.save(), before);
+}
+
+/// A lap that fails past a step of less pedal is not repaired (braking more did not make the
+/// car too fast for what follows): the step reverses and halves, and the next block is tried.
+#[test]
+fn a_failure_after_less_pedal_is_not_repaired() {
+    let mut checked = 0;
+    for seed in 0..8 {
+        let mut ps = PatternSearch::new(
+            vec![0.0; 5],
+            PatternSearchConfig {
+                seed,
+                sigma0: 0.1,
+                block: 1,
+                ..PatternSearchConfig::default()
+            },
+        )
+        .unwrap();
+        let start = ps.ask().unwrap();
+        ps.tell_lap(&start, 1.0, None).unwrap();
+        // A slower lap on every weight: each step reverses to −σ₀/2 for the next sweep.
+        for _ in 0..5 {
+            let w = ps.ask().unwrap();
+            ps.tell_lap(&w, 0.5, None).unwrap();
+        }
+        let w = ps.ask().unwrap();
+        let moved = w.iter().position(|&v| v != 0.0).unwrap();
+        assert_eq!(w[moved], -0.05);
+        if moved >= 3 {
+            continue;
+        }
+        checked += 1;
+        // It fails at x = 1, in kernel 4's span and past the moved weight, where a step of
+        // more pedal would be given back at kernel 3: no give-back, the next weight moves.
+        ps.tell_lap(&w, 0.0, Some(1.0)).unwrap();
+        let next = ps.ask().unwrap();
+        assert_eq!(
+            next.iter().filter(|&&v| v != 0.0).count(),
+            1,
+            "seed {seed}: {next:?}"
+        );
+        assert_eq!(next[moved], 0.0, "seed {seed}: {next:?}");
+        assert!(
+            next.iter().all(|&v| v == 0.0 || v == -0.05),
+            "seed {seed}: {next:?}"
+        );
+    }
+    assert!(checked > 0, "no seed moved a weight before kernel 3 first");
 }

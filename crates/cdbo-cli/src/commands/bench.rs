@@ -233,7 +233,7 @@ fn suggest(args: &SuggestArgs) -> CliResult {
     }
     times.sort_by(f64::total_cmp);
     let pick = |q: f64| times[((times.len() - 1) as f64 * q).round() as usize];
-    let settings = cdbo::optimizers::Settings::race(7, 1.0);
+    let settings = cdbo::optimizers::Settings::race(Method::PatternSearch, 7, 1.0);
     let mut ps = Method::PatternSearch.optimizer(vec![0.0; args.dims], &settings)?;
     for _ in 0..args.observations {
         let w = ps.ask()?;

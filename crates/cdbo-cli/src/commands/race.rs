@@ -35,8 +35,9 @@ pub struct RaceArgs {
     /// Speed of the demonstrator (m/s).
     #[arg(long, default_value_t = 15.0, allow_negative_numbers = true, value_parser = super::value::positive)]
     demo_speed: f64,
-    /// The exploration scale σ₀ every method is given (CDBO's initial design, the evolution
-    /// strategies' and random search's σ, pattern search's first step); default 0.03.
+    /// The exploration scale σ₀ (CDBO's initial design, the evolution strategies' and random
+    /// search's σ, pattern search's first step); default: the method's tuned knob (random
+    /// 0.01, pattern-search 0.15), 0.03 for the others.
     #[arg(long)]
     sigma0: Option<f64>,
     /// Output folder (default: runs/race-TRACK-METHOD-mM-sSEED).

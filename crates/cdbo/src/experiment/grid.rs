@@ -68,22 +68,12 @@ fn default_beta() -> f64 {
 /// The presets [`ExperimentConfig::preset`] knows.
 pub const PRESETS: &[&str] = &["paper", "paper-plus", "quick"];
 
-/// The main knobs tuned on the training tracks (docs/results/beyond): random search's σ and
-/// the pattern search's first step swept on ridgeway-30, forza-30, e-track-2-30 and forza-50
-/// (seeds 100–105) and re-checked with session 8's final physics on ridgeway-30 and
-/// e-track-2-30 (seeds 100–101), which decided; CMA-ES's σ₀ swept over 0.003–0.1 on the same
-/// four panels with the final physics (seeds 100–105, session 9). `paper-plus` runs them;
-/// `paper` keeps every method at the race default 0.03.
-pub const TUNED_SIGMA0: [(Method, f64); 3] = [
-    (Method::Random, 0.01),
-    (Method::Cmaes, 0.03),
-    (Method::PatternSearch, 0.1),
-];
-
 impl ExperimentConfig {
     /// `paper`: Forza with 10/50/100 kernels and Allondaz with 10/30/50; CDBO, CMA-ES,
     /// BO-CMA-ES, REMBO-5d and -10d; 4 repeats of 300 laps. `paper-plus`: the same with
-    /// TuRBO, LineBO, random search and the pattern search, with the [`TUNED_SIGMA0`] knobs.
+    /// TuRBO, LineBO, random search and the pattern search, with the main knobs
+    /// tuned on the training tracks ([`Method::TUNED`] at their [`Method::sigma0`]); `paper` keeps
+    /// every method at the paper's 0.03.
     /// `quick`: the built-in track, 10 and 20 kernels, four
     /// methods, 2 repeats of 25 laps (for CI).
     pub fn preset(name: &str) -> Option<ExperimentConfig> {
@@ -117,7 +107,7 @@ impl ExperimentConfig {
                     Method::Random,
                     Method::PatternSearch,
                 ]),
-                sigma0: TUNED_SIGMA0.into_iter().collect(),
+                sigma0: Method::TUNED.map(|m| (m, m.sigma0())).into_iter().collect(),
                 ..ExperimentConfig::preset("paper")?
             },
             "quick" => ExperimentConfig {
@@ -330,6 +320,8 @@ mod tests {
         assert_eq!(plus.runs().len(), 6 * 9 * 4);
         assert_eq!(plus.sigma0.get(&Method::Random), Some(&0.01));
         assert_eq!(plus.sigma0.get(&Method::Cmaes), Some(&0.03));
+        assert_eq!(plus.sigma0.get(&Method::PatternSearch), Some(&0.15));
+        assert_eq!(plus.sigma0.get(&Method::Cdbo), None);
         for p in PRESETS {
             ExperimentConfig::preset(p).unwrap().check().unwrap();
         }

@@ -31,8 +31,8 @@ pub struct RaceConfig {
     pub beta: f64,
     /// Demonstration speed (m/s).
     pub demo_speed: f64,
-    /// The exploration scale σ₀ of every method ([`Settings::sigma0`]); `None`: the race
-    /// default, 0.03.
+    /// The exploration scale σ₀ ([`Settings::sigma0`]); `None`: the method's own
+    /// ([`Method::sigma0`]).
     ///
     /// [`Settings::sigma0`]: crate::optimizers::Settings::sigma0
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -154,7 +154,7 @@ pub fn race_with(
     }
     let lengthscale = default_lengthscale(config.kernels);
     let initial = RkhsPolicy::fit(&demo_pairs, config.kernels, lengthscale, DEFAULT_RIDGE)?;
-    let mut settings = crate::optimizers::Settings::race(config.seed, config.beta);
+    let mut settings = crate::optimizers::Settings::race(config.method, config.seed, config.beta);
     if let Some(sigma0) = config.sigma0 {
         if !(sigma0.is_finite() && sigma0 > 0.0) {
             return Err(Error::invalid_value("σ₀", sigma0, "positive"));

@@ -110,15 +110,16 @@ pub struct Settings {
 }
 
 impl Settings {
-    /// For a race: the policy box (r = 1.5) and σ₀ = 0.03 for every method (CDBO's initial
-    /// samples; with σ = 0.1, most perturbations of a cruising demonstration brake the car to
-    /// a stop on Forza, and a search whose every lap fails learns nothing).
-    pub fn race(seed: u64, beta: f64) -> Settings {
+    /// For a race of `method`: the policy box (r = 1.5) and the method's σ₀
+    /// ([`Method::sigma0`]: 0.03, CDBO's initial samples, unless tuned; with σ = 0.1, most
+    /// perturbations of a cruising demonstration brake the car to a stop on Forza, and a search
+    /// whose every lap fails learns nothing).
+    pub fn race(method: Method, seed: u64, beta: f64) -> Settings {
         Settings {
             seed,
             beta,
             box_radius: DEFAULT_BOX_RADIUS,
-            sigma0: 0.03,
+            sigma0: method.sigma0(),
         }
     }
 

@@ -8,14 +8,15 @@
 //! pedal), reset to +σ₀ when the width changes. A trial moves one block from the best point
 //! w*: w = clamp(w* + sᵢΣ_{k∈B} eₖ) (Rosenbrock's method on the blocks):
 //! - a faster lap is accepted and the step grows, sᵢ ← 2sᵢ, on the same block;
-//! - a lap that **fails at x_f past the moved block** was too fast for what follows: the
-//!   **repair** gives the step back at the kernel j = ⌊x_f(M − 1)⌋ − 1 just before the
-//!   failure, w* + sᵢΣ_{k∈B} eₖ − sᵢeⱼ (brake earlier for the corner the car could not take);
-//!   a repaired lap that fails again at or past j is repaired again there (up to 3 give-backs,
-//!   the same kernel twice brakes twice as hard); if a repaired lap is faster, it is accepted
-//!   and sᵢ doubles;
-//! - otherwise (slower, or failed before the repair could reach) the step reverses and
-//!   halves, sᵢ ← −sᵢ/2, and the search moves to the next block.
+//! - a lap that **fails at x_f past the moved block after more pedal** (sᵢ > 0) was too fast
+//!   for what follows: the **repair** gives the step back at the kernel
+//!   j = ⌊x_f(M − 1)⌋ − 1 just before the failure, w* + sᵢΣ_{k∈B} eₖ − sᵢeⱼ (brake earlier for
+//!   the corner the car could not take); a repaired lap that fails again at or past j is
+//!   repaired again there (up to 3 give-backs, the same kernel twice brakes twice as hard); if
+//!   a repaired lap is faster, it is accepted and sᵢ doubles;
+//! - otherwise (slower, failed before the repair could reach, or failed after less pedal: a
+//!   car that brakes more was not too fast) the step reverses and halves, sᵢ ← −sᵢ/2, and the
+//!   search moves to the next block.
 //!
 //! The blocks are visited in a fresh random order each sweep; a step that has shrunk below
 //! σ₀/16 starts the next sweep at ±σ₀ again. Only the lap's reward and where it failed are
@@ -276,8 +277,9 @@ impl Optimizer for PatternSearch {
             }
             Trial::Step { weight } => {
                 let past = self.block(weight).end;
+                let more_pedal = self.state.steps[weight] > 0.0;
                 match failed_at
-                    .filter(|_| repair)
+                    .filter(|_| repair && more_pedal)
                     .and_then(|at| self.before_failure(past, at))
                 {
                     Some(j) => {

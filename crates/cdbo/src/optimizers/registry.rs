@@ -56,6 +56,25 @@ impl Method {
         Method::Rembo10d,
     ];
 
+    /// The methods whose main knob, σ₀, was tuned on the training tracks: ridgeway-30,
+    /// forza-30, e-track-2-30 and forza-50, 300 laps, seeds 100–105 (not the results' seeds),
+    /// session 9's physics, chosen by the mean best reward of the four (docs/results/beyond).
+    pub const TUNED: [Method; 3] = [Method::Random, Method::Cmaes, Method::PatternSearch];
+
+    /// The method's exploration scale σ₀ in a race ([`Settings::sigma0`]): for the
+    /// [`TUNED`](Method::TUNED) methods their tuned knob — random search's σ 0.01 (of 0.003,
+    /// 0.01, 0.03), CMA-ES's σ₀ 0.03 (of 0.003–0.1), the pattern search's first step 0.15 (of
+    /// 0.1, 0.15, 0.2) — and the paper's 0.03 for the others (CDBO's initial samples).
+    ///
+    /// [`Settings::sigma0`]: super::Settings::sigma0
+    pub fn sigma0(self) -> f64 {
+        match self {
+            Method::Random => 0.01,
+            Method::PatternSearch => 0.15,
+            _ => 0.03,
+        }
+    }
+
     /// The method's name: `cdbo`, `cmaes`, `bo-cmaes`, ….
     pub fn name(self) -> &'static str {
         match self {

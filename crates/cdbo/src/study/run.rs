@@ -280,7 +280,7 @@ fn with_heartbeat(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::optimizers::{Settings, by_name};
+    use crate::optimizers::{Method, Settings, by_name};
 
     /// Rewards from a closed form: −‖w − w*‖², a failed lap where w₀ > 1.
     struct Bowl;
@@ -302,7 +302,8 @@ mod tests {
     /// The in-memory loop asks, drives and tells exactly as a hand-written ask/tell loop does.
     #[test]
     fn in_memory_runs_are_the_hand_written_loop() {
-        let optimizer = || by_name("cdbo", vec![0.0; 3], &Settings::race(4, 2.0)).unwrap();
+        let optimizer =
+            || by_name("cdbo", vec![0.0; 3], &Settings::race(Method::Cdbo, 4, 2.0)).unwrap();
         let mut told = Vec::new();
         let mut source = InMemory::new(optimizer(), 12);
         run(&mut source, &mut Bowl, &mut |e| {
