@@ -9,11 +9,12 @@
 //! w*: w = clamp(w* + sᵢΣ_{k∈B} eₖ) (Rosenbrock's method on the blocks):
 //! - a faster lap is accepted and the step grows, sᵢ ← 2sᵢ, on the same block;
 //! - a lap that **fails at x_f past the moved block after more pedal** (sᵢ > 0) was too fast
-//!   for what follows: the **repair** gives the step back at the kernel
-//!   j = ⌊x_f(M − 1)⌋ − 1 just before the failure, w* + sᵢΣ_{k∈B} eₖ − sᵢeⱼ (brake earlier for
-//!   the corner the car could not take); a repaired lap that fails again at or past j is
-//!   repaired again there (up to 3 give-backs, the same kernel twice brakes twice as hard); if
-//!   a repaired lap is faster, it is accepted and sᵢ doubles;
+//!   for what follows: the **repair** gives half the step back at the kernel
+//!   j = ⌊x_f(M − 1)⌋ − 1 just before the failure, w* + sᵢΣ_{k∈B} eₖ − c·sᵢeⱼ with c = ½
+//!   (brake earlier for the corner the car could not take, keeping half the gain); a repaired
+//!   lap that fails again at or past j is repaired again there (up to 3 give-backs, the same
+//!   kernel twice gives back twice as much); if a repaired lap is faster, it is accepted and
+//!   sᵢ doubles;
 //! - otherwise (slower, failed before the repair could reach, or failed after less pedal: a
 //!   car that brakes more was not too fast) the step reverses and halves, sᵢ ← −sᵢ/2, and the
 //!   search moves to the next block.
@@ -45,11 +46,19 @@ pub struct PatternSearchConfig {
     /// Give-backs at most on one step (a repaired lap that fails again is repaired again).
     #[serde(default = "single_weight")]
     pub repairs: usize,
+    /// The fraction c of the step a repair gives back at the kernel before the failure.
+    #[serde(default = "whole_step")]
+    pub give_back: f64,
 }
 
 /// Blocks of one weight and one repair: the settings of a search saved before they existed.
 fn single_weight() -> usize {
     1
+}
+
+/// A repair that gives the whole step back: the settings of a search saved before `give_back`.
+fn whole_step() -> f64 {
+    1.0
 }
 
 impl Default for PatternSearchConfig {
@@ -61,6 +70,7 @@ impl Default for PatternSearchConfig {
             repair: true,
             block: 8,
             repairs: 3,
+            give_back: 0.5,
         }
     }
 }
@@ -75,7 +85,8 @@ pub enum Trial {
         /// The first moved weight i.
         weight: usize,
     },
-    /// The step with sᵢ given back at the weights before the failures, w* + sᵢΣeₖ − sᵢΣⱼeⱼ.
+    /// The step with c·sᵢ given back at the weights before the failures,
+    /// w* + sᵢΣeₖ − c·sᵢΣⱼeⱼ.
     Repair {
         /// The first moved weight i.
         weight: usize,
@@ -126,6 +137,13 @@ impl PatternSearch {
         }
         if !(config.sigma0.is_finite() && config.sigma0 > 0.0) {
             return Err(Error::invalid_value("σ₀", config.sigma0, "positive"));
+        }
+        if !(config.give_back.is_finite() && config.give_back > 0.0) {
+            return Err(Error::invalid_value(
+                "the repair's give-back",
+                config.give_back,
+                "a positive fraction of the step",
+            ));
         }
         let n = start.len();
         PatternSearch::resume(PatternSearchState {
@@ -247,7 +265,7 @@ impl Optimizer for PatternSearch {
                     w[k] += s.steps[*weight];
                 }
                 for &j in before {
-                    w[j] -= s.steps[*weight];
+                    w[j] -= s.config.give_back * s.steps[*weight];
                 }
             }
         }
