@@ -36,6 +36,14 @@ fn drive(opt: &mut dyn Optimizer, evals: usize) -> Vec<Vec<f64>> {
         .collect()
 }
 
+/// A search from w = 0 (`n` weights) whose start lap was told a reward of 1.
+fn started(n: usize, config: PatternSearchConfig) -> PatternSearch {
+    let mut ps = PatternSearch::new(vec![0.0; n], config).unwrap();
+    let start = ps.ask().unwrap();
+    ps.tell_lap(&start, 1.0, None).unwrap();
+    ps
+}
+
 /// The best reward of a method on the 20-segment cliff from wᵢ = 0.2, 200 laps.
 fn best_on_cliff(method: &str, seed: u64) -> f64 {
     let mut opt = by_name(
@@ -71,16 +79,13 @@ fn a_failed_lap_is_repaired_before_where_it_failed() {
         ..PatternSearchConfig::default()
     };
     for seed in 0..8 {
-        let mut ps = PatternSearch::new(
-            vec![0.0; 5],
+        let mut ps = started(
+            5,
             PatternSearchConfig {
                 seed,
                 ..config.clone()
             },
-        )
-        .unwrap();
-        let start = ps.ask().unwrap();
-        ps.tell_lap(&start, 1.0, None).unwrap();
+        );
         let w = ps.ask().unwrap();
         let moved = w.iter().position(|&v| v != 0.0).unwrap();
         assert_eq!(w[moved], 0.1);
@@ -110,16 +115,13 @@ fn a_repair_that_fails_again_is_repaired_again() {
     };
     let mut checked = 0;
     for seed in 0..8 {
-        let mut ps = PatternSearch::new(
-            vec![0.0; 10],
+        let mut ps = started(
+            10,
             PatternSearchConfig {
                 seed,
                 ..config.clone()
             },
-        )
-        .unwrap();
-        let start = ps.ask().unwrap();
-        ps.tell_lap(&start, 1.0, None).unwrap();
+        );
         let w = ps.ask().unwrap();
         let moved = w.iter().position(|&v| v != 0.0).unwrap();
         if moved >= 6 {
@@ -152,17 +154,14 @@ fn a_repair_that_fails_again_is_repaired_again() {
 /// wide, down to single weights.
 #[test]
 fn sweeps_narrow_their_blocks() {
-    let mut ps = PatternSearch::new(
-        vec![0.0; 16],
+    let mut ps = started(
+        16,
         PatternSearchConfig {
             sigma0: 0.1,
             block: 4,
             ..PatternSearchConfig::default()
         },
-    )
-    .unwrap();
-    let start = ps.ask().unwrap();
-    ps.tell_lap(&start, 1.0, None).unwrap();
+    );
     // Every trial slower: each block is tried once per sweep, 4 + 8 + 16 trials.
     let mut widths = Vec::new();
     for _ in 0..28 {
@@ -219,18 +218,15 @@ fn a_bad_failure_place_is_refused() {
 fn a_failure_after_less_pedal_is_not_repaired() {
     let mut checked = 0;
     for seed in 0..8 {
-        let mut ps = PatternSearch::new(
-            vec![0.0; 5],
+        let mut ps = started(
+            5,
             PatternSearchConfig {
                 seed,
                 sigma0: 0.1,
                 block: 1,
                 ..PatternSearchConfig::default()
             },
-        )
-        .unwrap();
-        let start = ps.ask().unwrap();
-        ps.tell_lap(&start, 1.0, None).unwrap();
+        );
         // A slower lap on every weight: each step reverses to −σ₀/2 for the next sweep.
         for _ in 0..5 {
             let w = ps.ask().unwrap();
