@@ -8,7 +8,7 @@ use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyType};
 
-use cdbo::optimizers::{DEFAULT_BOX_RADIUS, Optimizer, Saved, Settings, by_name};
+use cdbo::optimizers::{DEFAULT_BOX_RADIUS, Method, Optimizer, Saved, Settings};
 
 use crate::convert::{IntoPy, array, lock, vector};
 
@@ -48,13 +48,14 @@ impl PyOptimizer {
         sigma0: Option<f64>,
     ) -> PyResult<Self> {
         let w0 = vector(w0, "w0")?;
-        let race = Settings::race(method.parse().py()?, seed, beta);
+        let method: Method = method.parse().py()?;
+        let race = Settings::race(method, seed, beta);
         let settings = Settings {
             box_radius: bounds,
             sigma0: sigma0.unwrap_or(race.sigma0),
             ..race
         };
-        let inner = py.detach(|| by_name(method, w0, &settings)).py()?;
+        let inner = py.detach(|| method.optimizer(w0, &settings)).py()?;
         Ok(PyOptimizer::wrap(inner))
     }
 

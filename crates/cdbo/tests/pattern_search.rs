@@ -256,3 +256,26 @@ fn a_failure_after_less_pedal_is_not_repaired() {
     }
     assert!(checked > 0, "no seed moved a weight before kernel 3 first");
 }
+
+/// A saved search whose settings are out of range (a corrupt or hand-edited study) is refused
+/// when it resumes, naming the setting, as a new one would be.
+#[test]
+fn a_saved_search_with_a_bad_setting_is_refused() {
+    let ps = started(4, PatternSearchConfig::default());
+    let Saved::PatternSearch(state) = ps.save() else {
+        panic!("not a pattern search's state");
+    };
+    assert!(PatternSearch::resume((*state).clone()).is_ok());
+    for (sigma0, give_back) in [
+        (f64::NAN, 0.5),
+        (-0.1, 0.5),
+        (0.1, f64::INFINITY),
+        (0.1, 0.0),
+    ] {
+        let mut bad = (*state).clone();
+        bad.config.sigma0 = sigma0;
+        bad.config.give_back = give_back;
+        let e = PatternSearch::resume(bad).unwrap_err().to_string();
+        assert!(e.contains("σ₀") || e.contains("give-back"), "{e}");
+    }
+}

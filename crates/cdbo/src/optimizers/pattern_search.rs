@@ -135,16 +135,6 @@ impl PatternSearch {
                 "finite, of at least one weight",
             ));
         }
-        if !(config.sigma0.is_finite() && config.sigma0 > 0.0) {
-            return Err(Error::invalid_value("σ₀", config.sigma0, "positive"));
-        }
-        if !(config.give_back.is_finite() && config.give_back > 0.0) {
-            return Err(Error::invalid_value(
-                "the repair's give-back",
-                config.give_back,
-                "a positive fraction of the step",
-            ));
-        }
         let n = start.len();
         PatternSearch::resume(PatternSearchState {
             steps: vec![config.sigma0; n],
@@ -161,6 +151,16 @@ impl PatternSearch {
 
     /// Rebuilds a search from its state.
     pub fn resume(state: PatternSearchState) -> Result<PatternSearch> {
+        if !(state.config.sigma0.is_finite() && state.config.sigma0 > 0.0) {
+            return Err(Error::invalid_value("σ₀", state.config.sigma0, "positive"));
+        }
+        if !(state.config.give_back.is_finite() && state.config.give_back > 0.0) {
+            return Err(Error::invalid_value(
+                "the repair's give-back",
+                state.config.give_back,
+                "a positive fraction of the step",
+            ));
+        }
         let n = state.start.len();
         if state.steps.len() != n || state.order.iter().any(|&i| i >= n) {
             return Err(Error::CorruptState {
