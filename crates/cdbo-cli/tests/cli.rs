@@ -205,6 +205,24 @@ fn bad_track_files_give_one_clear_error() {
     fails_with(&["lap", "--demo", "-5"], &["--demo"]);
 }
 
+/// A knob a method cannot take is refused before any lap, naming the method and its knob; the
+/// older `--sigma0` is refused where the method's knob is not σ₀.
+#[test]
+fn bad_race_knobs_are_refused_in_one_line() {
+    fails_with(
+        &["race", "--method", "turbo", "--knob", "3"],
+        &["turbo", "length", "(0, 1.6]"],
+    );
+    fails_with(
+        &["race", "--method", "random", "--knob", "-1"],
+        &["random", "sigma0"],
+    );
+    fails_with(
+        &["race", "--method", "rembo-5d", "--sigma0", "0.1"],
+        &["--sigma0", "rembo-5d", "box", "--knob"],
+    );
+}
+
 #[test]
 fn a_short_race_writes_its_results() {
     // 20 kernels: since the gearbox shifts at the current throttle, the 10-kernel fit of the

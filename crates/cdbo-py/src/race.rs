@@ -111,7 +111,7 @@ pub fn race(
         seed,
         beta,
         demo_speed,
-        sigma0: None,
+        knob: None,
     };
     let mut callback_error: Option<PyErr> = None;
     let outcome = py

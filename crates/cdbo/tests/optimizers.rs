@@ -260,3 +260,91 @@ fn cmaes_follows_the_failure_places_while_every_lap_fails() {
     // (Σw = 5 is x = 1: the end of the lap.)
     assert!(without < 1.5, "{without}");
 }
+
+/// The largest |wᵢ − w₀ᵢ| (max norm) and Euclidean distance from w₀ over `laps` laps scored
+/// by `reward`.
+fn reach(
+    method: Method,
+    settings: &Settings,
+    w0: &[f64],
+    laps: usize,
+    reward: impl Fn(&[f64]) -> f64,
+) -> (f64, f64) {
+    let mut opt = method.optimizer(w0.to_vec(), settings).unwrap();
+    let (mut max_norm, mut euclid) = (0.0f64, 0.0f64);
+    for _ in 0..laps {
+        let w = opt.ask().unwrap();
+        let d: Vec<f64> = w.iter().zip(w0).map(|(a, b)| a - b).collect();
+        max_norm = max_norm.max(d.iter().fold(0.0, |m, x| m.max(x.abs())));
+        euclid = euclid.max(d.iter().map(|x| x * x).sum::<f64>().sqrt());
+        opt.tell(&w, reward(&w)).unwrap();
+    }
+    (max_norm, euclid)
+}
+
+/// Each method's main knob reaches its optimiser and bounds how far it moves from w₀, against
+/// the published setting in the same box (r = 1.5, 12 weights): TuRBO's initial design lies in
+/// its first region, w₀ ± L_init·r; LineBO's laps lie within the step of the line's origin (w₀,
+/// while every lap fails); REMBO's y lie in [−b, b]^d, so |Δwᵢ| ≤ r·b·Σⱼ|Aᵢⱼ| (on a reward
+/// rising with Σw, whose EI maximum lies on the box's edge).
+#[test]
+fn each_methods_knob_reaches_its_optimiser() {
+    let w0: Vec<f64> = (0..12).map(|i| 0.1 * i as f64 - 0.4).collect();
+    let race = |m| Settings::race(m, 3, 1.0);
+    let with = |m, v| race(m).with_knob(m, v).unwrap();
+    let failing = |_: &[f64]| 0.0;
+    let rising = |w: &[f64]| 10.0 + w.iter().sum::<f64>();
+    // TuRBO: 10 design points (w₀ and 9 in the region) at L_init 0.1: within 0.15 of w₀.
+    let (tuned, _) = reach(Method::Turbo, &with(Method::Turbo, 0.1), &w0, 10, failing);
+    let (published, _) = reach(Method::Turbo, &race(Method::Turbo), &w0, 10, failing);
+    assert!(
+        tuned <= 0.1 * 1.5 + 1e-12 && tuned > 0.05,
+        "TuRBO at L_init 0.1: {tuned}"
+    );
+    assert!(published > 0.5, "TuRBO at 0.8: {published}");
+    // LineBO at step 0.05: every lap within 0.05 of w₀.
+    let (_, tuned) = reach(
+        Method::Linebo,
+        &with(Method::Linebo, 0.05),
+        &w0,
+        12,
+        failing,
+    );
+    let (_, published) = reach(Method::Linebo, &race(Method::Linebo), &w0, 12, failing);
+    assert!(
+        tuned <= 0.05 + 1e-12 && tuned > 0.01,
+        "LineBO at step 0.05: {tuned}"
+    );
+    assert!(published > 0.5, "LineBO on the whole line: {published}");
+    // REMBO-5d at b = 0.002: |Δwᵢ| ≤ 1.5·0.002·Σⱼ|Aᵢⱼ| (5 standard normals: well under 0.1).
+    for m in [Method::Rembo5d, Method::Rembo10d] {
+        let (tuned, _) = reach(m, &with(m, 0.002), &w0, 15, rising);
+        let (published, _) = reach(m, &race(m), &w0, 15, rising);
+        assert!(tuned < 0.1 && tuned > 0.0, "{m} at b 0.002: {tuned}");
+        assert!(published > 0.5, "{m} at √d: {published}");
+    }
+    // The σ₀ methods: the knob is σ₀.
+    assert_eq!(with(Method::Random, 0.2).sigma0, 0.2);
+    assert_eq!(race(Method::Random).sigma0, Method::Random.knob().value);
+}
+
+/// A value a method cannot take is refused naming the method, its knob and the range.
+#[test]
+fn bad_knob_values_are_refused_naming_the_knob() {
+    let s = Settings::race(Method::Turbo, 0, 1.0);
+    for (m, v) in [
+        (Method::Turbo, 2.0),
+        (Method::Turbo, 0.0),
+        (Method::Linebo, -0.1),
+        (Method::Rembo5d, f64::NAN),
+        (Method::Random, f64::INFINITY),
+    ] {
+        let e = s.with_knob(m, v).unwrap_err().to_string();
+        assert!(
+            e.contains(m.name()) && e.contains(m.knob().kind.name()),
+            "{m} {v}: {e}"
+        );
+    }
+    let e = s.with_knob(Method::Turbo, 1.7).unwrap_err().to_string();
+    assert!(e.contains("(0, 1.6]"), "{e}");
+}

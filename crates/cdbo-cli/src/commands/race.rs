@@ -10,7 +10,7 @@ use serde::Serialize;
 use super::{CliResult, Setup, Simulator, from_flag, print_json};
 use cdbo::data_path::DataPath;
 use cdbo::experiment::race::{RaceConfig, RaceOutcome, race};
-use cdbo::optimizers::Method;
+use cdbo::optimizers::{KnobKind, Method};
 use cdbo::policy::RkhsPolicy;
 
 #[derive(Debug, Args)]
@@ -35,10 +35,14 @@ pub struct RaceArgs {
     /// Speed of the demonstrator (m/s).
     #[arg(long, default_value_t = 15.0, allow_negative_numbers = true, value_parser = super::value::positive)]
     demo_speed: f64,
-    /// The exploration scale σ₀ (CDBO's initial design, the evolution strategies' and random
-    /// search's σ, pattern search's first step); default: the method's tuned knob (random
-    /// 0.01, pattern-search 0.15), 0.03 for the others.
-    #[arg(long)]
+    /// The method's main knob: σ₀ (CDBO's initial samples, CMA-ES's and random search's σ, the
+    /// pattern search's first step), TuRBO's initial trust-region side L_init, LineBO's step
+    /// (each line's half-length), REMBO's box half-width b; default: its race value, tuned on
+    /// the training tracks where swept (`cdbo race --help` lists them in the methods).
+    #[arg(long, allow_negative_numbers = true)]
+    knob: Option<f64>,
+    /// The knob of the methods whose knob is σ₀, by its older name (the same as `--knob`).
+    #[arg(long, conflicts_with = "knob", allow_negative_numbers = true)]
     sigma0: Option<f64>,
     /// Output folder (default: runs/race-TRACK-METHOD-mM-sSEED).
     #[arg(long, value_name = "DIR")]
@@ -71,6 +75,20 @@ struct Summary {
 }
 
 pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult {
+    let knob = args.method.knob();
+    if args.sigma0.is_some() && knob.kind != KnobKind::Sigma0 {
+        return Err(format!(
+            "--sigma0: {}'s main knob is not σ₀ but its {} ({}); give it with --knob",
+            args.method,
+            knob.kind.name(),
+            knob.meaning
+        )
+        .into());
+    }
+    let knob_value = match args.knob.or(args.sigma0) {
+        Some(v) => Some(knob.check(args.method, v)?),
+        None => None,
+    };
     if let Some(w) = cdbo::sizes::slow_race_warning(args.method, args.kernels, args.laps) {
         eprintln!("warning: {w}");
     }
@@ -112,7 +130,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         seed: args.seed,
         beta: args.beta,
         demo_speed: args.demo_speed,
-        sigma0: args.sigma0,
+        knob: knob_value,
     };
     let bar = if args.json {
         ProgressBar::hidden()

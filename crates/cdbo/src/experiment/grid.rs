@@ -51,10 +51,15 @@ pub struct ExperimentConfig {
     pub methods: Vec<Method>,
     /// Tracks and their policy sizes.
     pub tracks: Vec<TrackGrid>,
-    /// A method's own σ₀ (its main knob, tuned on training tracks), by method name; the
-    /// others get the race default, 0.03 (`[sigma0]` table: `random = 0.01`).
-    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
-    pub sigma0: std::collections::BTreeMap<Method, f64>,
+    /// A method's main knob ([`Method::knob`]: σ₀, TuRBO's L_init, LineBO's step, REMBO's
+    /// box), by method name; a method not listed gets the published setting (σ₀ 0.03).
+    /// `[knob]` table: `random = 0.01`; `[sigma0]`, its name in older grids, reads the same.
+    #[serde(
+        default,
+        alias = "sigma0",
+        skip_serializing_if = "std::collections::BTreeMap::is_empty"
+    )]
+    pub knob: std::collections::BTreeMap<Method, f64>,
 }
 
 fn default_demo_speed() -> f64 {
@@ -71,9 +76,9 @@ pub const PRESETS: &[&str] = &["paper", "paper-plus", "quick"];
 impl ExperimentConfig {
     /// `paper`: Forza with 10/50/100 kernels and Allondaz with 10/30/50; CDBO, CMA-ES,
     /// BO-CMA-ES, REMBO-5d and -10d; 4 repeats of 300 laps. `paper-plus`: the same with
-    /// TuRBO, LineBO, random search and the pattern search, with the main knobs
-    /// tuned on the training tracks ([`Method::TUNED`] at their [`Method::sigma0`]); `paper` keeps
-    /// every method at the paper's 0.03.
+    /// TuRBO, LineBO, random search and the pattern search, every method's main knob at its
+    /// race value where it was tuned on the training tracks ([`Method::knob`]); `paper` keeps
+    /// every method at the paper's σ₀ 0.03 and the published settings.
     /// `quick`: the built-in track, 10 and 20 kernels, four
     /// methods, 2 repeats of 25 laps (for CI).
     pub fn preset(name: &str) -> Option<ExperimentConfig> {
@@ -98,7 +103,7 @@ impl ExperimentConfig {
                 beta: default_beta(),
                 methods: methods(&[]),
                 tracks: paper_tracks,
-                sigma0: Default::default(),
+                knob: Default::default(),
             },
             "paper-plus" => ExperimentConfig {
                 methods: methods(&[
@@ -107,7 +112,11 @@ impl ExperimentConfig {
                     Method::Random,
                     Method::PatternSearch,
                 ]),
-                sigma0: Method::TUNED.map(|m| (m, m.sigma0())).into_iter().collect(),
+                knob: Method::ALL
+                    .into_iter()
+                    .filter(|m| m.knob().tuned())
+                    .map(|m| (m, m.knob().value))
+                    .collect(),
                 ..ExperimentConfig::preset("paper")?
             },
             "quick" => ExperimentConfig {
@@ -120,7 +129,7 @@ impl ExperimentConfig {
                     track: crate::track::builtin::DEFAULT.into(),
                     kernels: vec![10, 20],
                 }],
-                sigma0: Default::default(),
+                knob: Default::default(),
             },
             _ => return None,
         })
@@ -193,16 +202,15 @@ impl ExperimentConfig {
                 })?;
             }
         }
-        if let Some((m, v)) = self
-            .sigma0
-            .iter()
-            .find(|(m, v)| !(self.methods.contains(m) && v.is_finite() && **v > 0.0))
-        {
-            return Err(Error::invalid_value(
-                format!("sigma0 of {:?}", m.name()),
-                v,
-                "a positive number, for a method of the grid",
-            ));
+        for (&m, &v) in &self.knob {
+            if !self.methods.contains(&m) {
+                return Err(Error::invalid_value(
+                    "the knob table's method",
+                    m,
+                    "a method of the grid",
+                ));
+            }
+            m.knob().check(m, v)?;
         }
         if !(self.demo_speed.is_finite() && self.demo_speed > 0.0) {
             return Err(Error::invalid_value(
@@ -318,13 +326,46 @@ mod tests {
         assert_eq!(paper.runs().len(), 6 * 5 * 4);
         let plus = ExperimentConfig::preset("paper-plus").unwrap();
         assert_eq!(plus.runs().len(), 6 * 9 * 4);
-        assert_eq!(plus.sigma0.get(&Method::Random), Some(&0.01));
-        assert_eq!(plus.sigma0.get(&Method::Cmaes), Some(&0.03));
-        assert_eq!(plus.sigma0.get(&Method::PatternSearch), Some(&0.15));
-        assert_eq!(plus.sigma0.get(&Method::Cdbo), None);
+        assert_eq!(plus.knob.get(&Method::Random), Some(&0.01));
+        assert_eq!(plus.knob.get(&Method::Cmaes), Some(&0.03));
+        assert_eq!(plus.knob.get(&Method::PatternSearch), Some(&0.15));
+        assert_eq!(plus.knob.get(&Method::Cdbo), None);
         for p in PRESETS {
             ExperimentConfig::preset(p).unwrap().check().unwrap();
         }
+    }
+
+    /// A grid's `[knob]` table reaches each method's knob; `[sigma0]`, its name in older grids
+    /// (docs/results/experiment.toml), reads the same; a bad value or a method not in the grid
+    /// is refused naming the file, the method and its knob.
+    #[test]
+    fn the_knob_table_and_its_older_name() {
+        let head = "laps = 3\nrepeats = 1\nmethods = [\"turbo\", \"random\"]\ntracks = [{track = \"x\", kernels = [5]}]\n";
+        let new = ExperimentConfig::from_toml(
+            &format!("{head}[knob]\nturbo = 0.1\nrandom = 0.01\n"),
+            "g",
+        )
+        .unwrap();
+        assert_eq!(new.knob.get(&Method::Turbo), Some(&0.1));
+        let old = ExperimentConfig::from_toml(
+            &format!("{head}[sigma0]\nrandom = 0.01\nturbo = 0.1\n"),
+            "g",
+        )
+        .unwrap();
+        assert_eq!(old, new);
+        let saved = toml::to_string(&new).unwrap();
+        assert!(saved.contains("[knob]"), "{saved}");
+        assert_eq!(ExperimentConfig::from_toml(&saved, "g").unwrap(), new);
+        for (table, what) in [("turbo = 1.7", "turbo"), ("cdbo = 0.03", "cdbo")] {
+            let e = ExperimentConfig::from_toml(&format!("{head}[knob]\n{table}\n"), "g.toml")
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("g.toml") && e.contains(what), "{e}");
+        }
+        let e = ExperimentConfig::from_toml(&format!("{head}[knob]\nturbo = 1.7\n"), "g.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("length"), "{e}");
     }
 
     #[test]

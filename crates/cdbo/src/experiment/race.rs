@@ -31,12 +31,10 @@ pub struct RaceConfig {
     pub beta: f64,
     /// Demonstration speed (m/s).
     pub demo_speed: f64,
-    /// The exploration scale σ₀ ([`Settings::sigma0`]); `None`: the method's own
-    /// ([`Method::sigma0`]).
-    ///
-    /// [`Settings::sigma0`]: crate::optimizers::Settings::sigma0
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub sigma0: Option<f64>,
+    /// The method's main knob ([`Method::knob`]: σ₀, TuRBO's L_init, LineBO's step, REMBO's
+    /// box); `None`: its race value. Older configs name it `sigma0`.
+    #[serde(default, alias = "sigma0", skip_serializing_if = "Option::is_none")]
+    pub knob: Option<f64>,
 }
 
 impl Default for RaceConfig {
@@ -48,7 +46,7 @@ impl Default for RaceConfig {
             seed: 0,
             beta: crate::acquisition::ucb::DEFAULT_BETA,
             demo_speed: 15.0,
-            sigma0: None,
+            knob: None,
         }
     }
 }
@@ -155,11 +153,8 @@ pub fn race_with(
     let lengthscale = default_lengthscale(config.kernels);
     let initial = RkhsPolicy::fit(&demo_pairs, config.kernels, lengthscale, DEFAULT_RIDGE)?;
     let mut settings = crate::optimizers::Settings::race(config.method, config.seed, config.beta);
-    if let Some(sigma0) = config.sigma0 {
-        if !(sigma0.is_finite() && sigma0 > 0.0) {
-            return Err(Error::invalid_value("σ₀", sigma0, "positive"));
-        }
-        settings.sigma0 = sigma0;
+    if let Some(value) = config.knob {
+        settings = settings.with_knob(config.method, value)?;
     }
     let optimizer = config
         .method

@@ -4,8 +4,14 @@
 //! the search moves along one line at a time, ℓ(t) = w_line + t·d, through the best weights
 //! when the line begins. Directions alternate between a random coordinate axis
 //! (CoordinateLineBO) and a uniformly random unit vector (RandomLineBO). On a line, each lap
-//! maximises UCB μ + βσ over `grid` evenly spaced t where ℓ(t) is inside the box (one
-//! batched GP query); after `laps_per_line` laps a new line begins. The first lap is w₀.
+//! maximises UCB μ + βσ over `grid` evenly spaced t where ℓ(t) is inside the box and |t| is at
+//! most the step s (one batched GP query); after `laps_per_line` laps a new line begins. The
+//! first lap is w₀.
+//!
+//! The step s, the line's half-length, is the method's main knob: it sets how far a lap moves
+//! from the best point (β only weighs the GP's uncertainty along the same segment, and where
+//! every sample fails the GP is flat, so the UCB's choice is the segment's far end). Kirschner
+//! et al. search the whole line in the domain: s = ∞, the default.
 
 use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
@@ -26,6 +32,10 @@ pub struct LineBoConfig {
     pub box_radius: f64,
     /// UCB exploration weight β.
     pub beta: f64,
+    /// The step s, each line's half-length: a lap moves at most s from the line's origin;
+    /// `None`: the whole line in the box (Kirschner et al.).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub step: Option<f64>,
     /// Laps on each line.
     pub laps_per_line: usize,
     /// Values of t scored per lap.
@@ -42,6 +52,7 @@ impl Default for LineBoConfig {
             seed: 0,
             box_radius: super::DEFAULT_BOX_RADIUS,
             beta: DEFAULT_BETA,
+            step: None,
             laps_per_line: 4,
             grid: 200,
             refit_every: 5,
@@ -108,6 +119,13 @@ impl LineBo {
                 "at least 1 and 2",
             ));
         }
+        if let Some(step) = saved.config.step.filter(|s| !(s.is_finite() && *s > 0.0)) {
+            return Err(Error::invalid_value(
+                "LineBO's step (the line's half-length)",
+                step,
+                "a finite positive number",
+            ));
+        }
         let r = saved.config.box_radius;
         let hyper = Hyper {
             kernel: Kernel::Matern52,
@@ -172,7 +190,7 @@ impl LineBo {
         }
     }
 
-    /// The range of t keeping origin + t·d inside the box.
+    /// The range of t keeping origin + t·d inside the box, and |t| within the step.
     fn t_range(&self) -> (f64, f64) {
         let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
         for (i, d) in self.line.direction.iter().enumerate() {
@@ -183,6 +201,9 @@ impl LineBo {
             let b = (self.bounds.upper[i] - self.line.origin[i]) / d;
             lo = lo.max(a.min(b));
             hi = hi.min(a.max(b));
+        }
+        if let Some(step) = self.state.config.step {
+            (lo, hi) = (lo.max(-step), hi.min(step));
         }
         (lo.min(0.0), hi.max(0.0))
     }

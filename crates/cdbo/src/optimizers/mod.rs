@@ -15,7 +15,7 @@ pub mod registry;
 pub mod rembo;
 pub mod turbo;
 
-pub use registry::Method;
+pub use registry::{Knob, KnobKind, Method};
 
 use serde::{Deserialize, Serialize};
 
@@ -105,21 +105,49 @@ pub struct Settings {
     pub beta: f64,
     /// Half-width r of the search box around w₀.
     pub box_radius: f64,
-    /// The exploration scale around w₀: CDBO's initial σ₀ and the evolution strategies' σ.
+    /// The exploration scale around w₀: CDBO's and REMBO's initial σ₀, and the main knob of the
+    /// methods whose knob is σ₀ ([`KnobKind::Sigma0`]: CMA-ES, random and pattern search).
     pub sigma0: f64,
+    /// The main knob of the other methods ([`Method::knob`]: TuRBO's L_init, LineBO's line
+    /// half-length, REMBO's box half-width); `None`: the method's published setting.
+    pub knob: Option<f64>,
 }
 
 impl Settings {
-    /// For a race of `method`: the policy box (r = 1.5) and the method's σ₀
-    /// ([`Method::sigma0`]: 0.03, CDBO's initial samples, unless tuned; with σ = 0.1, most
-    /// perturbations of a cruising demonstration brake the car to a stop on Forza, and a search
-    /// whose every lap fails learns nothing).
+    /// For a race of `method`: the policy box (r = 1.5), σ₀ = 0.03 (CDBO's initial samples;
+    /// with σ = 0.1, most perturbations of a cruising demonstration brake the car to a stop on
+    /// Forza, and a search whose every lap fails learns nothing) and the method's main knob at
+    /// its race value ([`Knob::value`]: tuned on the training panels where swept).
     pub fn race(method: Method, seed: u64, beta: f64) -> Settings {
+        let knob = method.knob();
         Settings {
             seed,
             beta,
             box_radius: DEFAULT_BOX_RADIUS,
-            sigma0: method.sigma0(),
+            sigma0: registry::PAPER_SIGMA0,
+            knob: None,
+        }
+        .with_knob_unchecked(method, knob.value)
+    }
+
+    /// These settings with `method`'s main knob at `value`, refused with the knob's name and
+    /// range if the method cannot take it ([`Knob::check`]).
+    pub fn with_knob(self, method: Method, value: f64) -> Result<Settings> {
+        let value = method.knob().check(method, value)?;
+        Ok(self.with_knob_unchecked(method, value))
+    }
+
+    fn with_knob_unchecked(self, method: Method, value: f64) -> Settings {
+        let knob = method.knob();
+        match knob.kind {
+            KnobKind::Sigma0 => Settings {
+                sigma0: value,
+                ..self
+            },
+            _ => Settings {
+                knob: (value != knob.published).then_some(value),
+                ..self
+            },
         }
     }
 
@@ -130,6 +158,7 @@ impl Settings {
             beta: crate::acquisition::ucb::DEFAULT_BETA,
             box_radius,
             sigma0: box_radius / 15.0,
+            knob: None,
         }
     }
 }
@@ -147,6 +176,7 @@ impl Method {
             beta,
             box_radius,
             sigma0,
+            knob,
         } = *settings;
         let bo = |maximiser| bo::BoConfig {
             seed,
@@ -161,6 +191,7 @@ impl Method {
             embedding_dim,
             box_radius,
             sigma0,
+            embedding_box: knob,
         };
         Ok(match self {
             Method::Cdbo => Box::new(bo::Bo::new(
@@ -187,6 +218,7 @@ impl Method {
                 turbo::TurboConfig {
                     seed,
                     box_radius,
+                    length_init: knob.unwrap_or(turbo::LENGTH_INIT),
                     ..turbo::TurboConfig::default()
                 },
             )?),
@@ -196,6 +228,7 @@ impl Method {
                     seed,
                     box_radius,
                     beta,
+                    step: knob,
                     ..linebo::LineBoConfig::default()
                 },
             )?),

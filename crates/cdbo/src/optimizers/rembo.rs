@@ -1,7 +1,7 @@
 //! REMBO, Bayesian optimisation in a random embedding (Wang et al. 2016).
 //!
 //! A matrix A ∈ ℝ^{D×d} with N(0, 1) entries, drawn from the seed, embeds the low-dimensional
-//! box Y = [−√d, √d]^d in the weights: w(y) = w₀ + r·P(Ay), with P the projection onto
+//! box Y = [−b, b]^d (REMBO's b = √d; b is the method's main knob) in the weights: w(y) = w₀ + r·P(Ay), with P the projection onto
 //! [−1, 1]^D (REMBO's map into its normalised box X = [−1, 1]^D, here the search box
 //! [w₀ − r, w₀ + r]) and y = 0 giving the demonstration. After y = 0 and S initial samples
 //! that move w by σ₀ as CDBO's do, a GP (Matérn-5/2 ARD as in REMBO, CDBO's hyperparameter scheme)
@@ -33,6 +33,9 @@ pub struct RemboConfig {
     /// y ~ N(0, σ_y²I) with σ_y = σ₀/(r√d), since each wᵢ − w₀ᵢ = r·Σⱼ Aᵢⱼyⱼ then has
     /// standard deviation σ₀ (before the projection).
     pub sigma0: f64,
+    /// Half-width b of the embedding's box Y = [−b, b]^d; `None`: REMBO's √d.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub embedding_box: Option<f64>,
 }
 
 /// Everything needed to resume a run.
@@ -78,12 +81,20 @@ impl Rembo {
                 1,
             ));
         }
+        let half_width = config.embedding_box.unwrap_or((d as f64).sqrt());
+        if !(half_width.is_finite() && half_width > 0.0) {
+            return Err(Error::invalid_value(
+                "REMBO's box half-width b",
+                half_width,
+                "a finite positive number",
+            ));
+        }
         let inner = BoConfig {
             seed: config.seed,
             acquisition: Acquisition::Ei { xi: 0.0 },
             initial_sigma: config.sigma0 / (config.box_radius * (d as f64).sqrt()),
             kernel: Kernel::Matern52,
-            box_radius: (d as f64).sqrt(),
+            box_radius: half_width,
             // In d ≤ 10 dimensions a thorough ascent costs little: three sweeps, a finer scan
             // and a longer polish than CDBO's in 100 (Branin-100D: 9 of 10 seeds within 0.5 of
             // the optimum in 150 evaluations, against 7 with CDBO's settings).

@@ -1,15 +1,17 @@
 //! TuRBO-1, trust-region Bayesian optimisation (Eriksson et al. 2019), in the search box
 //! mapped to the unit cube u = (w − w₀ + r)/(2r).
 //!
-//! - A trust region of base side L (initially 0.8) is centred on the best point of the current
+//! - A trust region of base side L (initially L_init, TuRBO's 0.8, the method's main knob) is centred on the best point of the current
 //!   restart; its side along axis i is L·λᵢ/(∏λⱼ)^(1/D), with λ the GP's ARD length-scales,
 //!   clipped to the cube.
 //! - Each lap is the maximiser of one Thompson sample ([`crate::acquisition::thompson`]) of a
 //!   Matérn-5/2 ARD GP over `candidates` points that copy the centre and redraw each
 //!   coordinate uniformly in the region with probability min(20/D, 1) (at least one).
 //! - A lap beating the restart's best by 1e-3·|best| is a success. After 3 successes in a row
-//!   L doubles (at most 1.6); after max(4, D) failures in a row it halves; below 0.5⁷ the run
-//!   restarts: a fresh GP and initial design.
+//!   L doubles (at most 2·L_init); after max(4, D) failures in a row it halves; below
+//!   L_init·0.5⁷/0.8 the run restarts: a fresh GP and initial design. (TuRBO's bounds 1.6 and
+//!   0.5⁷ at its L_init 0.8, kept relative to L_init so that a smaller region halves and
+//!   doubles as often before a restart.)
 //! - The initial design of each restart is w₀ (the paper informs every method with it) and
 //!   a Latin hypercube in the initial region around it, `initial_samples` points in all.
 //!
@@ -27,11 +29,11 @@ use crate::error::{Error, Result};
 use crate::gp::likelihood::{Bounds, fit};
 use crate::gp::{GaussianProcess, Hyper, Kernel, Mean};
 
-/// Initial base side of the trust region.
+/// TuRBO's initial base side of the trust region (the default L_init).
 pub const LENGTH_INIT: f64 = 0.8;
-/// Largest base side.
+/// TuRBO's largest base side, at L_init 0.8; the largest L_init taken.
 pub const LENGTH_MAX: f64 = 1.6;
-/// Below this base side the run restarts.
+/// Below this base side TuRBO restarts, at L_init 0.8.
 pub const LENGTH_MIN: f64 = 0.0078125;
 /// Successes in a row that double the side.
 pub const SUCCESS_TOLERANCE: usize = 3;
@@ -43,6 +45,10 @@ pub struct TurboConfig {
     pub seed: u64,
     /// Half-width r of the search box around w₀.
     pub box_radius: f64,
+    /// Initial base side L_init of the trust region, a fraction of the box's side 2r (the
+    /// unit cube's); TuRBO's 0.8.
+    #[serde(default = "default_length_init")]
+    pub length_init: f64,
     /// Points of each restart's initial design, w₀ (first restart) included.
     pub initial_samples: usize,
     /// Candidates per Thompson sample (0: min(100·D, 1000)).
@@ -53,11 +59,16 @@ pub struct TurboConfig {
     pub fit_iterations: usize,
 }
 
+fn default_length_init() -> f64 {
+    LENGTH_INIT
+}
+
 impl Default for TurboConfig {
     fn default() -> Self {
         TurboConfig {
             seed: 0,
             box_radius: super::DEFAULT_BOX_RADIUS,
+            length_init: LENGTH_INIT,
             initial_samples: 10,
             candidates: 0,
             refit_every: 5,
@@ -92,9 +103,9 @@ struct Region {
 }
 
 impl Region {
-    fn fresh(restart: u64) -> Region {
+    fn fresh(restart: u64, length_init: f64) -> Region {
         Region {
-            length: LENGTH_INIT,
+            length: length_init,
             successes: 0,
             failures: 0,
             restart,
@@ -148,10 +159,18 @@ impl Turbo {
         if saved.config.initial_samples == 0 {
             return Err(Error::too_small("TuRBO's initial design points", 0, 1));
         }
+        let length_init = saved.config.length_init;
+        if !(length_init > 0.0 && length_init <= LENGTH_MAX) {
+            return Err(Error::invalid_value(
+                "TuRBO's initial trust-region side L_init",
+                length_init,
+                format!("in (0, {LENGTH_MAX}]"),
+            ));
+        }
         let mut run = Turbo {
             bounds: SearchBox::around(&saved.w0, saved.config.box_radius)?,
             gp: GaussianProcess::new(dim, initial_hyper(dim))?,
-            region: Region::fresh(0),
+            region: Region::fresh(0, length_init),
             best: Best::default(),
             pending: None,
             state: TurboState {
@@ -211,9 +230,10 @@ impl Turbo {
         let n = self.state.config.initial_samples;
         let mut rng = rng_for(self.state.config.seed, (1 << 40) + self.region.restart);
         let centre = self.unit_point(&self.state.w0);
+        let side = self.state.config.length_init;
         let (lo, hi) = (
-            centre.iter().map(|c| (c - 0.5 * LENGTH_INIT).max(0.0)),
-            centre.iter().map(|c| (c + 0.5 * LENGTH_INIT).min(1.0)),
+            centre.iter().map(|c| (c - 0.5 * side).max(0.0)),
+            centre.iter().map(|c| (c + 0.5 * side).min(1.0)),
         );
         let mut u = Vec::with_capacity(dim);
         for (lo, hi) in lo.zip(hi) {
@@ -261,6 +281,8 @@ impl Turbo {
     /// Counts a lap of the current restart against its best, resizes or restarts the region.
     fn update_region(&mut self, u: Vec<f64>, reward: f64) -> Result<()> {
         let (dim, initial) = (self.dim(), self.state.config.initial_samples);
+        let length_init = self.state.config.length_init;
+        let scale = length_init / LENGTH_INIT;
         let region = &mut self.region;
         region.told += 1;
         let previous = region.best.as_ref().map(|b| b.1);
@@ -279,15 +301,15 @@ impl Turbo {
             region.failures += 1;
         }
         if region.successes == SUCCESS_TOLERANCE {
-            region.length = (2.0 * region.length).min(LENGTH_MAX);
+            region.length = (2.0 * region.length).min(LENGTH_MAX * scale);
             region.successes = 0;
         }
         if region.failures >= dim.max(4) {
             region.length *= 0.5;
             region.failures = 0;
         }
-        if region.length < LENGTH_MIN {
-            self.region = Region::fresh(region.restart + 1);
+        if region.length < LENGTH_MIN * scale {
+            self.region = Region::fresh(region.restart + 1, length_init);
             self.gp = GaussianProcess::new(dim, initial_hyper(dim))?;
         }
         Ok(())
