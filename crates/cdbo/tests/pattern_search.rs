@@ -224,6 +224,7 @@ fn a_failure_after_less_pedal_is_not_repaired() {
                 seed,
                 sigma0: 0.1,
                 block: 1,
+                sharpen: false,
                 ..PatternSearchConfig::default()
             },
         );
@@ -278,4 +279,76 @@ fn a_saved_search_with_a_bad_setting_is_refused() {
         let e = PatternSearch::resume(bad).unwrap_err().to_string();
         assert!(e.contains("σ₀") || e.contains("give-back"), "{e}");
     }
+}
+
+/// Once the blocks are single weights, every second sweep moves along
+/// dᵢ = eᵢ − ½(eᵢ₋₁ + eᵢ₊₁), each direction once, with its own first step +σ₀.
+#[test]
+fn every_second_sweep_of_single_weights_sharpens() {
+    let n = 6;
+    let mut ps = started(
+        n,
+        PatternSearchConfig {
+            sigma0: 0.1,
+            block: 2,
+            ..PatternSearchConfig::default()
+        },
+    );
+    // Every trial slower: blocks of 2 (3 trials), single weights (6), sharpening (6), single (6).
+    let mut sweeps: Vec<Vec<Vec<f64>>> = Vec::new();
+    for trials in [3, 6, 6, 6] {
+        let sweep = (0..trials)
+            .map(|_| {
+                let w = ps.ask().unwrap();
+                ps.tell_lap(&w, 0.5, None).unwrap();
+                w
+            })
+            .collect();
+        sweeps.push(sweep);
+    }
+    let mut centres: Vec<usize> = sweeps[2]
+        .iter()
+        .map(|w| {
+            let i = w.iter().position(|&v| v == 0.1).unwrap();
+            let mut d = vec![0.0; n];
+            d[i] = 0.1;
+            for k in [i.wrapping_sub(1), i + 1] {
+                if k < n {
+                    d[k] = -0.05;
+                }
+            }
+            assert_eq!(*w, d, "sharpening along d_{i}");
+            i
+        })
+        .collect();
+    centres.sort();
+    assert_eq!(centres, (0..n).collect::<Vec<_>>());
+    // The single weights' steps reversed and halved in their own sweep.
+    for w in &sweeps[3] {
+        assert_eq!(w.iter().filter(|&&v| v != 0.0).count(), 1, "{w:?}");
+        assert!(w.iter().all(|&v| v == 0.0 || v == -0.05), "{w:?}");
+    }
+}
+
+/// A search saved before sharpening sweeps existed (no `sharpen`, `sharpening`, `sharp_steps`)
+/// resumes as it was: with single-weight sweeps only, lap for lap as a search without them.
+#[test]
+fn a_search_saved_before_sharpening_resumes_without_it() {
+    let config = PatternSearchConfig {
+        sigma0: 0.1,
+        block: 1,
+        sharpen: false,
+        ..PatternSearchConfig::default()
+    };
+    let mut old = started(10, config.clone());
+    let mut json = serde_json::to_value(old.save()).unwrap();
+    let state = json["state"].as_object_mut().unwrap();
+    for key in ["sharpening", "sharp_steps"] {
+        assert!(state.remove(key).is_some(), "no {key} in {state:?}");
+    }
+    let config_json = state["config"].as_object_mut().unwrap();
+    assert!(config_json.remove("sharpen").is_some());
+    let saved: Saved = serde_json::from_value(json).unwrap();
+    let mut resumed = saved.resume().unwrap();
+    assert_eq!(drive(&mut old, 60), drive(resumed.as_mut(), 60));
 }

@@ -22,6 +22,16 @@
 //! The blocks are visited in a fresh random order each sweep; a step that has shrunk below
 //! σ₀/16 starts the next sweep at ±σ₀ again. Only the lap's reward and where it failed are
 //! used: what a car's lap timer gives.
+//!
+//! **Sharpening sweeps.** One weight's pedal, wᵢφᵢ(x), is a bump two kernel spacings wide: a
+//! braking point sharper than that needs neighbours of opposite signs (the ceiling's fitted
+//! policies alternate signs; a sum of single-weight steps seldom gets there). Once the blocks
+//! are single weights, every second sweep moves instead along
+//! dᵢ = eᵢ − ½(eᵢ₋₁ + eᵢ₊₁) (the ends drop the missing neighbour): pedal at x̂ᵢ taken from
+//! either side, the pedal's sum over the lap about unchanged, with its own signed steps and the
+//! same rules (grow on a faster lap, repair past eᵢ₊₁ after more pedal at x̂ᵢ, else reverse and
+//! halve). Measured on the training panels (docs/results/beyond): the same best laps with
+//! about an eighth fewer failed laps.
 
 use rand::seq::SliceRandom;
 use serde::{Deserialize, Serialize};
@@ -49,6 +59,9 @@ pub struct PatternSearchConfig {
     /// The fraction c of the step a repair gives back at the kernel before the failure.
     #[serde(default = "whole_step")]
     pub give_back: f64,
+    /// Every second sweep of single weights moves along dᵢ = eᵢ − ½(eᵢ₋₁ + eᵢ₊₁) instead.
+    #[serde(default)]
+    pub sharpen: bool,
 }
 
 /// Blocks of one weight and one repair: the settings of a search saved before they existed.
@@ -71,6 +84,7 @@ impl Default for PatternSearchConfig {
             block: 8,
             repairs: 3,
             give_back: 0.5,
+            sharpen: true,
         }
     }
 }
@@ -110,6 +124,12 @@ pub struct PatternSearchState {
     pub cursor: usize,
     /// Sweeps begun.
     pub sweeps: u64,
+    /// Whether this sweep moves along the sharpening directions dᵢ rather than blocks.
+    #[serde(default)]
+    pub sharpening: bool,
+    /// The signed step of every sharpening direction dᵢ.
+    #[serde(default)]
+    pub sharp_steps: Vec<f64>,
     /// The next trial.
     pub next: Trial,
     /// Rewards told.
@@ -138,6 +158,8 @@ impl PatternSearch {
         let n = start.len();
         PatternSearch::resume(PatternSearchState {
             steps: vec![config.sigma0; n],
+            sharp_steps: vec![config.sigma0; n],
+            sharpening: false,
             order: Vec::new(),
             cursor: 0,
             sweeps: 0,
@@ -162,12 +184,21 @@ impl PatternSearch {
             ));
         }
         let n = state.start.len();
-        if state.steps.len() != n || state.order.iter().any(|&i| i >= n) {
+        let mut state = state;
+        if state.sharp_steps.is_empty() {
+            // Saved before sharpening sweeps existed.
+            state.sharp_steps = vec![state.config.sigma0; n];
+        }
+        if state.steps.len() != n
+            || state.sharp_steps.len() != n
+            || state.order.iter().any(|&i| i >= n)
+        {
             return Err(Error::CorruptState {
                 method: "pattern search",
                 reason: format!(
-                    "{n} weights but {} steps and order {:?}",
+                    "{n} weights but {} steps, {} sharpening steps and order {:?}",
                     state.steps.len(),
+                    state.sharp_steps.len(),
                     state.order
                 ),
             });
@@ -189,21 +220,26 @@ impl PatternSearch {
         self.state.best.get().map_or(&self.state.start[..], |b| b.0)
     }
 
-    /// Begins a new sweep: a fresh order of the blocks, steps shrunk below σ₀/16 back at σ₀.
+    /// Begins a new sweep: a fresh order of the blocks, steps shrunk below σ₀/16 back at σ₀;
+    /// once the blocks are single weights, every second sweep sharpens.
     fn begin_sweep(&mut self) {
         let old_width = self.width();
         self.state.sweeps += 1;
         let width = self.width();
         let n = self.state.start.len();
         let sigma0 = self.state.config.sigma0;
+        // The first sweep of single weights: b₀ >> (k − 1) ≤ 1 from k = 1 + ⌊log₂ b₀⌋.
+        let singles_from = 1 + u64::from(self.state.config.block.max(1).ilog2());
         let s = &mut self.state;
+        s.sharpening =
+            s.config.sharpen && width == 1 && (s.sweeps.saturating_sub(singles_from)) % 2 == 1;
         s.order = (0..n).step_by(width).collect();
         s.order.shuffle(&mut rng_for(s.config.seed, s.sweeps - 1));
         s.cursor = 0;
         if width != old_width {
             s.steps.iter_mut().for_each(|v| *v = sigma0);
         }
-        for step in &mut s.steps {
+        for step in s.steps.iter_mut().chain(&mut s.sharp_steps) {
             if step.abs() < sigma0 / 16.0 {
                 *step = sigma0.copysign(*step);
             }
@@ -220,9 +256,39 @@ impl PatternSearch {
         }
     }
 
-    /// The weights moved by the block starting at `weight`.
-    fn block(&self, weight: usize) -> std::ops::Range<usize> {
-        weight..(weight + self.width()).min(self.state.start.len())
+    /// The direction of the trial at `weight`, as (weight, coefficient) pairs in lap order:
+    /// the block starting there, or the sharpening direction dᵢ.
+    fn direction(&self, weight: usize) -> Vec<(usize, f64)> {
+        let n = self.state.start.len();
+        if self.state.sharpening {
+            let before = weight.checked_sub(1).map(|k| (k, -0.5));
+            let after = (weight + 1 < n).then_some((weight + 1, -0.5));
+            before
+                .into_iter()
+                .chain([(weight, 1.0)])
+                .chain(after)
+                .collect()
+        } else {
+            (weight..(weight + self.width()).min(n))
+                .map(|k| (k, 1.0))
+                .collect()
+        }
+    }
+
+    /// The first weight past the trial's direction at `weight`.
+    fn past(&self, weight: usize) -> usize {
+        self.direction(weight).last().map_or(weight, |&(k, _)| k) + 1
+    }
+
+    /// The signed step of the trial at `weight`, in this sweep's kind of direction.
+    fn step(&mut self, weight: usize) -> &mut f64 {
+        let s = &mut self.state;
+        let steps = if s.sharpening {
+            &mut s.sharp_steps
+        } else {
+            &mut s.steps
+        };
+        &mut steps[weight]
     }
 
     /// The kernel just before a failure at lap fraction `at`, if it lies at or past `after`.
@@ -235,7 +301,7 @@ impl PatternSearch {
 
     /// The step on `weight` failed: reverse and halve it, move to the next block.
     fn give_up(&mut self, weight: usize) {
-        self.state.steps[weight] *= -0.5;
+        *self.step(weight) *= -0.5;
         self.advance();
     }
 }
@@ -250,24 +316,23 @@ impl Optimizer for PatternSearch {
     }
 
     fn ask(&mut self) -> Result<Vec<f64>> {
+        let (weight, before) = match &self.state.next {
+            Trial::Start => return Ok(self.state.start.clone()),
+            Trial::Step { weight } => (*weight, &[][..]),
+            Trial::Repair { weight, before } => (*weight, &before[..]),
+        };
         let s = &self.state;
-        let centre = self.centre();
-        let mut w = centre.to_vec();
-        match &s.next {
-            Trial::Start => return Ok(s.start.clone()),
-            Trial::Step { weight } => {
-                for k in self.block(*weight) {
-                    w[k] += s.steps[*weight];
-                }
-            }
-            Trial::Repair { weight, before } => {
-                for k in self.block(*weight) {
-                    w[k] += s.steps[*weight];
-                }
-                for &j in before {
-                    w[j] -= s.config.give_back * s.steps[*weight];
-                }
-            }
+        let step = if s.sharpening {
+            s.sharp_steps[weight]
+        } else {
+            s.steps[weight]
+        };
+        let mut w = self.centre().to_vec();
+        for (k, coefficient) in self.direction(weight) {
+            w[k] += coefficient * step;
+        }
+        for &j in before {
+            w[j] -= s.config.give_back * step;
         }
         self.bounds.clamp(&mut w);
         Ok(w)
@@ -290,12 +355,12 @@ impl Optimizer for PatternSearch {
         match self.state.next.clone() {
             Trial::Start => self.begin_sweep(),
             Trial::Step { weight } | Trial::Repair { weight, .. } if better => {
-                self.state.steps[weight] *= 2.0;
+                *self.step(weight) *= 2.0;
                 self.state.next = Trial::Step { weight };
             }
             Trial::Step { weight } => {
-                let past = self.block(weight).end;
-                let more_pedal = self.state.steps[weight] > 0.0;
+                let past = self.past(weight);
+                let more_pedal = *self.step(weight) > 0.0;
                 match failed_at
                     .filter(|_| repair && more_pedal)
                     .and_then(|at| self.before_failure(past, at))
