@@ -31,7 +31,7 @@
 //! either side, the pedal's sum over the lap about unchanged, with its own signed steps and the
 //! same rules (grow on a faster lap, repair past eᵢ₊₁ after more pedal at x̂ᵢ, else reverse and
 //! halve). Measured on the training panels (docs/results/beyond): the same best laps with
-//! about an eighth fewer failed laps.
+//! 8 % fewer failed laps (165 → 151 a run).
 
 use rand::seq::SliceRandom;
 use serde::{Deserialize, Serialize};
