@@ -44,11 +44,12 @@ pub fn run(args: &DashboardArgs, data: &DataPath) -> CliResult {
     for storage in &args.studies {
         let found = Files::storage(storage)?;
         if found.is_empty() {
-            return Err(format!(
-                "{}: no study or grid in this database yet",
+            // Only a whole database can name nothing: its studies and grids join the page as
+            // they are created.
+            println!(
+                "{}: no study or grid in this database yet; they are listed as they are created",
                 Location::parse(storage, Some("*"))?.label().display()
-            )
-            .into());
+            );
         }
         sources.extend(found);
         if is_database(storage) {
