@@ -273,7 +273,7 @@ impl Turbo {
             }
         }
         let (means, cov) = self.gp.predict_joint(&candidates);
-        let sample = thompson::draw(&means, &cov, &mut rng)?;
+        let sample = thompson::draw(&means, &cov, self.gp.hyper().signal_var, &mut rng)?;
         let k = crate::acquisition::argmax(&sample);
         Ok(self.weights_at(&candidates[k * dim..(k + 1) * dim]))
     }
