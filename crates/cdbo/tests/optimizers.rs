@@ -292,11 +292,21 @@ fn each_methods_knob_reaches_its_optimiser() {
     let w0: Vec<f64> = (0..12).map(|i| 0.1 * i as f64 - 0.4).collect();
     let race = |m| Settings::race(m, 3, 1.0);
     let with = |m, v| race(m).with_knob(m, v).unwrap();
+    let as_published = |m| Settings {
+        knob: None,
+        ..race(m)
+    };
     let failing = |_: &[f64]| 0.0;
     let rising = |w: &[f64]| 10.0 + w.iter().sum::<f64>();
     // TuRBO: 10 design points (w₀ and 9 in the region) at L_init 0.1: within 0.15 of w₀.
     let (tuned, _) = reach(Method::Turbo, &with(Method::Turbo, 0.1), &w0, 10, failing);
-    let (published, _) = reach(Method::Turbo, &race(Method::Turbo), &w0, 10, failing);
+    let (published, _) = reach(
+        Method::Turbo,
+        &as_published(Method::Turbo),
+        &w0,
+        10,
+        failing,
+    );
     assert!(
         tuned <= 0.1 * 1.5 + 1e-12 && tuned > 0.05,
         "TuRBO at L_init 0.1: {tuned}"
@@ -310,7 +320,13 @@ fn each_methods_knob_reaches_its_optimiser() {
         12,
         failing,
     );
-    let (_, published) = reach(Method::Linebo, &race(Method::Linebo), &w0, 12, failing);
+    let (_, published) = reach(
+        Method::Linebo,
+        &as_published(Method::Linebo),
+        &w0,
+        12,
+        failing,
+    );
     assert!(
         tuned <= 0.05 + 1e-12 && tuned > 0.01,
         "LineBO at step 0.05: {tuned}"
@@ -319,13 +335,14 @@ fn each_methods_knob_reaches_its_optimiser() {
     // REMBO-5d at b = 0.002: |Δwᵢ| ≤ 1.5·0.002·Σⱼ|Aᵢⱼ| (5 standard normals: well under 0.1).
     for m in [Method::Rembo5d, Method::Rembo10d] {
         let (tuned, _) = reach(m, &with(m, 0.002), &w0, 15, rising);
-        let (published, _) = reach(m, &race(m), &w0, 15, rising);
+        let (published, _) = reach(m, &as_published(m), &w0, 15, rising);
         assert!(tuned < 0.1 && tuned > 0.0, "{m} at b 0.002: {tuned}");
         assert!(published > 0.5, "{m} at √d: {published}");
     }
     // The σ₀ methods: the knob is σ₀.
     assert_eq!(with(Method::Random, 0.2).sigma0, 0.2);
     assert_eq!(race(Method::Random).sigma0, Method::Random.knob().value);
+    assert_eq!(race(Method::Turbo).knob, Some(Method::Turbo.knob().value));
 }
 
 /// A value a method cannot take is refused naming the method, its knob and the range.

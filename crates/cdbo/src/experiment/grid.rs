@@ -329,6 +329,10 @@ mod tests {
         assert_eq!(plus.knob.get(&Method::Random), Some(&0.01));
         assert_eq!(plus.knob.get(&Method::Cmaes), Some(&0.03));
         assert_eq!(plus.knob.get(&Method::PatternSearch), Some(&0.15));
+        assert_eq!(plus.knob.get(&Method::Turbo), Some(&0.03));
+        assert_eq!(plus.knob.get(&Method::Linebo), Some(&0.3));
+        assert_eq!(plus.knob.get(&Method::Rembo5d), Some(&0.1));
+        assert_eq!(plus.knob.get(&Method::Rembo10d), Some(&0.03));
         assert_eq!(plus.knob.get(&Method::Cdbo), None);
         for p in PRESETS {
             ExperimentConfig::preset(p).unwrap().check().unwrap();

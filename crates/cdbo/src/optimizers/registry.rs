@@ -58,8 +58,11 @@ impl Method {
 
     /// The method's one main knob (issue 15: every peer's is chosen by the same small sweep on
     /// the training panels ridgeway-30, forza-30, e-track-2-30 and forza-50, 300 laps, seeds
-    /// from 100, by the mean best reward of the four; docs/results/beyond). CDBO and BO-CMA-ES
-    /// keep the paper's σ₀.
+    /// from 100, by the mean best reward of the four; docs/results/beyond): random search's σ
+    /// 0.01, CMA-ES's σ₀ 0.03, the pattern search's first step 0.15 (seeds 100–105); TuRBO's
+    /// L_init 0.03 (TuRBO: 0.8), LineBO's step 0.3 (LineBO: the whole line), REMBO-5d's box
+    /// 0.1 and REMBO-10d's 0.03 (REMBO: √d) (seeds 100–102). CDBO and BO-CMA-ES keep the
+    /// paper's σ₀.
     pub fn knob(self) -> Knob {
         let sigma0 = |meaning, value, swept| Knob {
             kind: KnobKind::Sigma0,
@@ -69,12 +72,12 @@ impl Method {
             swept,
             max: f64::INFINITY,
         };
-        let rembo_box = |d: f64| Knob {
+        let rembo_box = |d: f64, value, swept| Knob {
             kind: KnobKind::EmbeddingBox,
             meaning: "half-width b of the embedding's box [-b, b]^d",
             published: d.sqrt(),
-            value: d.sqrt(),
-            swept: &[],
+            value,
+            swept,
             max: f64::INFINITY,
         };
         match self {
@@ -88,22 +91,22 @@ impl Method {
                 &[0.003, 0.01, 0.03],
             ),
             Method::PatternSearch => sigma0("first step σ₀", 0.15, &[0.1, 0.15, 0.2]),
-            Method::Rembo5d => rembo_box(5.0),
-            Method::Rembo10d => rembo_box(10.0),
+            Method::Rembo5d => rembo_box(5.0, 0.1, &[0.01, 0.03, 0.1, 2.236]),
+            Method::Rembo10d => rembo_box(10.0, 0.03, &[0.01, 0.03, 0.1, 3.162]),
             Method::Turbo => Knob {
                 kind: KnobKind::TrustRegionLength,
                 meaning: "initial trust-region side L_init, a fraction of the box's side",
                 published: super::turbo::LENGTH_INIT,
-                value: super::turbo::LENGTH_INIT,
-                swept: &[],
+                value: 0.03,
+                swept: &[0.01, 0.03, 0.1, 0.8],
                 max: super::turbo::LENGTH_MAX,
             },
             Method::Linebo => Knob {
                 kind: KnobKind::LineStep,
                 meaning: "half-length of each line: the farthest a lap moves from its origin (inf: the box)",
                 published: f64::INFINITY,
-                value: f64::INFINITY,
-                swept: &[],
+                value: 0.3,
+                swept: &[0.03, 0.1, 0.3, f64::INFINITY],
                 max: f64::INFINITY,
             },
         }
