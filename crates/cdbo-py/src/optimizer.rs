@@ -14,10 +14,13 @@ use crate::convert::{IntoPy, array, lock, vector};
 
 /// An ask/tell optimiser of rewards over weights, started from w0.
 ///
-/// `Optimizer(method, w0, seed=0, beta=1.0, bounds=1.5, sigma0=0.03)`: `method` is one of
-/// `cdbo.METHODS`; the weights are searched in the box [w0 - bounds, w0 + bounds]; `sigma0`
-/// is the exploration scale around w0 (CDBO's initial samples, the evolution strategies'
-/// step). The defaults are `cdbo race`'s, so the same seed asks the same weights.
+/// `Optimizer(method, w0, seed=0, beta=1.0, bounds=1.5, sigma0=None, knob=None)`: `method` is
+/// one of `cdbo.METHODS`; the weights are searched in the box [w0 - bounds, w0 + bounds];
+/// `sigma0` is the exploration scale around w0 (CDBO's initial samples, the evolution
+/// strategies' step); `knob` is the method's main knob (`cdbo race --knob`: σ₀ for CMA-ES,
+/// random and pattern search, TuRBO's initial trust-region side, LineBO's step, REMBO's box),
+/// checked against its range. The defaults are `cdbo race`'s (each knob at its tuned value),
+/// so the same seed asks the same weights.
 #[pyclass(name = "Optimizer", module = "cdbo")]
 pub struct PyOptimizer {
     inner: Mutex<Box<dyn Optimizer + Send>>,
@@ -37,7 +40,8 @@ impl PyOptimizer {
 #[pymethods]
 impl PyOptimizer {
     #[new]
-    #[pyo3(signature = (method, w0, *, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, bounds = DEFAULT_BOX_RADIUS, sigma0 = None))]
+    #[pyo3(signature = (method, w0, *, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, bounds = DEFAULT_BOX_RADIUS, sigma0 = None, knob = None))]
+    #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
         method: &str,
@@ -46,15 +50,19 @@ impl PyOptimizer {
         beta: f64,
         bounds: f64,
         sigma0: Option<f64>,
+        knob: Option<f64>,
     ) -> PyResult<Self> {
         let w0 = vector(w0, "w0")?;
         let method: Method = method.parse().py()?;
         let race = Settings::race(method, seed, beta);
-        let settings = Settings {
+        let mut settings = Settings {
             box_radius: bounds,
             sigma0: sigma0.unwrap_or(race.sigma0),
             ..race
         };
+        if let Some(value) = knob {
+            settings = settings.with_knob(method, value).py()?;
+        }
         let inner = py.detach(|| method.optimizer(w0, &settings)).py()?;
         Ok(PyOptimizer::wrap(inner))
     }

@@ -84,10 +84,11 @@ impl PyRaceResult {
 
 /// Learns a policy for a track exactly as `cdbo race` does (the same laps, bit for bit, for
 /// the same settings): drive the demonstration, fit w0, then `laps` laps of `method`.
-/// `track` and `car` are objects or names; `progress(record)` is called after every lap with
-/// the lap's record (a dict).
+/// `track` and `car` are objects or names; `knob` is the method's main knob (`cdbo race
+/// --knob`; None: its tuned value); `progress(record)` is called after every lap with the
+/// lap's record (a dict).
 #[pyfunction]
-#[pyo3(signature = (track = None, car = None, *, method = "cdbo", kernels = 30, laps = 300, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, demo_speed = 15.0, data_dir = None, progress = None))]
+#[pyo3(signature = (track = None, car = None, *, method = "cdbo", kernels = 30, laps = 300, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, demo_speed = 15.0, knob = None, data_dir = None, progress = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn race(
     py: Python<'_>,
@@ -99,6 +100,7 @@ pub fn race(
     seed: u64,
     beta: f64,
     demo_speed: f64,
+    knob: Option<f64>,
     data_dir: Option<&Bound<'_, PyAny>>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<PyRaceResult> {
@@ -111,7 +113,7 @@ pub fn race(
         seed,
         beta,
         demo_speed,
-        knob: None,
+        knob,
     };
     let mut callback_error: Option<PyErr> = None;
     let outcome = py

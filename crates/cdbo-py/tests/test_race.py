@@ -18,15 +18,28 @@ def test_race_ridgeway_300_laps_is_the_clis_race_bit_for_bit(cli, tmp_path):
     assert sum(lap["failure"] is not None for lap in result.laps) == summary["failed_laps"]
 
 
-@pytest.mark.parametrize("method", ["cdbo", "pattern-search"])
-def test_a_python_loop_over_optimizer_and_env_is_the_librarys_race(method):
+def test_a_knob_is_the_clis_knob_and_changes_the_race(cli, tmp_path):
+    args = ("race", "--json", "--laps", 40, "--kernels", 10, "--method", "linebo")
+    summary = json.loads(cli(*args, "--knob", 0.1, "--out", tmp_path))
+    result = cdbo.race("ridgeway", method="linebo", kernels=10, laps=40, seed=0, knob=0.1)
+    assert result.best_reward == summary["best_reward_mps"]
+    tuned = cdbo.race("ridgeway", method="linebo", kernels=10, laps=40, seed=0)
+    assert [lap["reward"] for lap in tuned.laps] != [lap["reward"] for lap in result.laps]
+    with pytest.raises(ValueError, match="linebo"):
+        cdbo.race("ridgeway", method="linebo", kernels=10, laps=2, knob=-1.0)
+
+
+@pytest.mark.parametrize(
+    ("method", "knob"), [("cdbo", None), ("pattern-search", None), ("turbo", 0.1)]
+)
+def test_a_python_loop_over_optimizer_and_env_is_the_librarys_race(method, knob):
     if method not in cdbo.METHODS:
         pytest.skip(f"{method} is not in this build")
     laps = 40
-    result = cdbo.race("ridgeway", method=method, kernels=20, laps=laps, seed=5)
+    result = cdbo.race("ridgeway", method=method, kernels=20, laps=laps, seed=5, knob=knob)
     env = cdbo.RaceEnv("ridgeway", kernels=20)
     assert np.array_equal(env.w0, result.initial.weights)
-    opt = cdbo.Optimizer(method, env.w0, seed=5)
+    opt = cdbo.Optimizer(method, env.w0, seed=5, knob=knob)
     rewards = []
     for _ in range(laps):
         env.reset()
