@@ -216,9 +216,11 @@ impl Knob {
         !self.swept.is_empty()
     }
 
-    /// `value` if the method can take it: finite, positive and at most [`max`](Knob::max).
+    /// `value` if the method can take it: positive, at most [`max`](Knob::max), and finite
+    /// unless the published value is infinite (LineBO's whole line: `--knob inf`).
     pub fn check(&self, method: Method, value: f64) -> Result<f64> {
-        if value.is_finite() && value > 0.0 && value <= self.max {
+        let finite = value.is_finite() || value == self.published;
+        if finite && value > 0.0 && value <= self.max {
             Ok(value)
         } else {
             Err(Error::invalid_value(
@@ -226,6 +228,8 @@ impl Knob {
                 value,
                 if self.max.is_finite() {
                     format!("in (0, {}]", self.max)
+                } else if self.published.is_infinite() {
+                    "a positive number (inf: the published whole line)".into()
                 } else {
                     "a finite positive number".into()
                 },
@@ -296,6 +300,31 @@ impl clap::ValueEnum for Method {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A knob takes positive values up to its maximum; infinity only where it is the published
+    /// setting (LineBO's whole line), which then leaves the method as published.
+    #[test]
+    fn knobs_take_their_range_and_linebo_its_whole_line() {
+        let linebo = Method::Linebo.knob();
+        assert_eq!(
+            linebo.check(Method::Linebo, f64::INFINITY).unwrap(),
+            f64::INFINITY
+        );
+        let settings = crate::optimizers::Settings::race(Method::Linebo, 0, 1.0);
+        assert_eq!(settings.knob, Some(0.3));
+        let whole = settings.with_knob(Method::Linebo, f64::INFINITY).unwrap();
+        assert_eq!(whole.knob, None);
+        for m in [Method::Turbo, Method::Rembo5d, Method::Random] {
+            let e = m.knob().check(m, f64::INFINITY).unwrap_err().to_string();
+            assert!(e.contains(m.name()), "{e}");
+        }
+        for bad in [0.0, -0.1, f64::NAN] {
+            assert!(linebo.check(Method::Linebo, bad).is_err(), "{bad}");
+        }
+        let turbo = Method::Turbo.knob();
+        assert!(turbo.check(Method::Turbo, turbo.max).is_ok());
+        assert!(turbo.check(Method::Turbo, 1.01 * turbo.max).is_err());
+    }
 
     /// Every method's name parses back to it, in serde as on the command line; others are
     /// refused naming the choices.
