@@ -83,6 +83,43 @@ fn results_do_not_depend_on_jobs_and_shards_merge() {
         .collect();
     shards.sort_by(|a, b| a.0.cmp(&b.0));
     assert_eq!(shards, one);
+    // One method's cells, then the rest into the same folder: the same runs.
+    let out = ok(
+        &dir,
+        &[
+            "experiment",
+            "grid.toml",
+            "--out",
+            "m",
+            "--methods",
+            "random",
+        ],
+    );
+    assert!(out.contains("4 runs in the grid, 2 selected"), "{out}");
+    assert!(
+        laps(&dir.join("m"))
+            .iter()
+            .all(|(f, _)| f.contains("-random-"))
+    );
+    let out = ok(&dir, &["experiment", "grid.toml", "--out", "m"]);
+    assert!(out.contains("2 already done, 2 to run"), "{out}");
+    assert_eq!(laps(&dir.join("m")), one);
+    let out = cdbo(
+        &dir,
+        &[
+            "experiment",
+            "grid.toml",
+            "--out",
+            "m",
+            "--methods",
+            "turbo",
+        ],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("turbo is not a method of the grid"),
+        "{err}"
+    );
     let out = ok(&dir, &["report", "s0", "s1", "s2", "--out", "merged"]);
     assert!(out.contains("4 runs from 3 folder(s)"), "{out}");
     let results = std::fs::read_to_string(dir.join("merged/results.md")).unwrap();

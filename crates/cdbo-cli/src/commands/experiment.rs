@@ -50,6 +50,15 @@ pub struct ExperimentArgs {
     /// Run only shard I of N (0 ≤ I < N), e.g. --shard $SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT.
     #[arg(long, value_name = "I/N", conflicts_with = "storage")]
     shard: Option<String>,
+    /// Run only these methods' cells (comma-separated), e.g. one method again after a change,
+    /// into the folder that holds the others' runs: the grid stays whole.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        value_name = "METHOD,...",
+        conflicts_with = "storage"
+    )]
+    methods: Vec<cdbo::optimizers::Method>,
     /// Car: built-in spirit-300, a car .xml, or a car name in the data folders.
     #[arg(long, default_value = cars::DEFAULT)]
     car: String,
@@ -181,6 +190,21 @@ pub fn run_grid(args: &ExperimentArgs, data: &DataPath, simulator: Simulator) ->
     if let Some(s) = &args.shard {
         runs = Shard::parse(s).map_err(from_flag("--shard"))?.select(runs);
     }
+    if let Some(m) = args.methods.iter().find(|m| !config.methods.contains(m)) {
+        return Err(format!(
+            "--methods: {m} is not a method of the grid {name} ({})",
+            config
+                .methods
+                .iter()
+                .map(|m| m.name())
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+        .into());
+    }
+    if !args.methods.is_empty() {
+        runs.retain(|r| args.methods.iter().any(|m| m.name() == r.method));
+    }
     let shard_size = runs.len();
     // A run is done when its record reads back; one cut short (a kill, a full disk) runs again.
     runs.retain(|r| {
@@ -203,7 +227,7 @@ pub fn run_grid(args: &ExperimentArgs, data: &DataPath, simulator: Simulator) ->
         .jobs
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     println!(
-        "{} runs in the grid, {shard_size} in this shard: {skipped} already done, {} to run on {jobs} threads into {}",
+        "{} runs in the grid, {shard_size} selected: {skipped} already done, {} to run on {jobs} threads into {}",
         total,
         runs.len(),
         out.display()
