@@ -84,17 +84,17 @@ fn results_do_not_depend_on_jobs_and_shards_merge() {
     shards.sort_by(|a, b| a.0.cmp(&b.0));
     assert_eq!(shards, one);
     // One method's cells, then the rest into the same folder: the same runs.
-    let out = ok(
-        &dir,
-        &[
+    let only = |methods| {
+        [
             "experiment",
             "grid.toml",
             "--out",
             "m",
             "--methods",
-            "random",
-        ],
-    );
+            methods,
+        ]
+    };
+    let out = ok(&dir, &only("random"));
     assert!(out.contains("4 runs in the grid, 2 selected"), "{out}");
     assert!(
         laps(&dir.join("m"))
@@ -104,17 +104,7 @@ fn results_do_not_depend_on_jobs_and_shards_merge() {
     let out = ok(&dir, &["experiment", "grid.toml", "--out", "m"]);
     assert!(out.contains("2 already done, 2 to run"), "{out}");
     assert_eq!(laps(&dir.join("m")), one);
-    let out = cdbo(
-        &dir,
-        &[
-            "experiment",
-            "grid.toml",
-            "--out",
-            "m",
-            "--methods",
-            "turbo",
-        ],
-    );
+    let out = cdbo(&dir, &only("turbo"));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
         !out.status.success() && err.contains("turbo is not a method of the grid"),
