@@ -74,6 +74,17 @@ fn default_beta() -> f64 {
 pub const PRESETS: &[&str] = &["paper", "paper-plus", "quick"];
 
 impl ExperimentConfig {
+    /// The main knob `method` runs at in this grid: its entry in the `[knob]` table, else its
+    /// published setting ([`Knob::published`](crate::optimizers::Knob::published): σ₀ 0.03,
+    /// TuRBO's 0.8, LineBO's whole line, REMBO's √d), so that a grid names every tuned value
+    /// it uses and reads the same whatever the race defaults become.
+    pub fn knob_of(&self, method: Method) -> f64 {
+        self.knob
+            .get(&method)
+            .copied()
+            .unwrap_or(method.knob().published)
+    }
+
     /// `paper`: Forza with 10/50/100 kernels and Allondaz with 10/30/50; CDBO, CMA-ES,
     /// BO-CMA-ES, REMBO-5d and -10d; 4 repeats of 300 laps. `paper-plus`: the same with
     /// TuRBO, LineBO, random search and the pattern search, every method's main knob at its
@@ -334,6 +345,13 @@ mod tests {
         assert_eq!(plus.knob.get(&Method::Rembo5d), Some(&0.1));
         assert_eq!(plus.knob.get(&Method::Rembo10d), Some(&0.03));
         assert_eq!(plus.knob.get(&Method::Cdbo), None);
+        let paper = ExperimentConfig::preset("paper").unwrap();
+        assert_eq!(paper.knob_of(Method::Rembo5d), 5f64.sqrt());
+        assert_eq!(paper.knob_of(Method::Cmaes), 0.03);
+        assert_eq!(plus.knob_of(Method::Rembo5d), 0.1);
+        assert_eq!(plus.knob_of(Method::Cdbo), 0.03);
+        assert_eq!(plus.knob_of(Method::Linebo), 0.3);
+        assert_eq!(paper.knob_of(Method::Linebo), f64::INFINITY);
         for p in PRESETS {
             ExperimentConfig::preset(p).unwrap().check().unwrap();
         }

@@ -173,7 +173,7 @@ pub fn run_at(
         seed: spec.seed(),
         beta: grid.beta,
         demo_speed: grid.demo_speed,
-        knob: grid.knob.get(&method).copied(),
+        knob: Some(grid.knob_of(method)),
     };
     let (track_name, length_m) = (track.name.clone(), track.length);
     let (outcome, ceiling_reward_mps) = match venue {
