@@ -172,7 +172,7 @@ impl PatternSearch {
     }
 
     /// Rebuilds a search from its state.
-    pub fn resume(state: PatternSearchState) -> Result<PatternSearch> {
+    pub fn resume(mut state: PatternSearchState) -> Result<PatternSearch> {
         if !(state.config.sigma0.is_finite() && state.config.sigma0 > 0.0) {
             return Err(Error::invalid_value("σ₀", state.config.sigma0, "positive"));
         }
@@ -184,7 +184,6 @@ impl PatternSearch {
             ));
         }
         let n = state.start.len();
-        let mut state = state;
         if state.sharp_steps.is_empty() {
             // Saved before sharpening sweeps existed.
             state.sharp_steps = vec![state.config.sigma0; n];
@@ -280,6 +279,16 @@ impl PatternSearch {
         self.direction(weight).last().map_or(weight, |&(k, _)| k) + 1
     }
 
+    /// The signed steps of this sweep's kind of direction.
+    fn steps(&self) -> &[f64] {
+        let s = &self.state;
+        if s.sharpening {
+            &s.sharp_steps
+        } else {
+            &s.steps
+        }
+    }
+
     /// The signed step of the trial at `weight`, in this sweep's kind of direction.
     fn step(&mut self, weight: usize) -> &mut f64 {
         let s = &mut self.state;
@@ -321,18 +330,13 @@ impl Optimizer for PatternSearch {
             Trial::Step { weight } => (*weight, &[][..]),
             Trial::Repair { weight, before } => (*weight, &before[..]),
         };
-        let s = &self.state;
-        let step = if s.sharpening {
-            s.sharp_steps[weight]
-        } else {
-            s.steps[weight]
-        };
+        let step = self.steps()[weight];
         let mut w = self.centre().to_vec();
         for (k, coefficient) in self.direction(weight) {
             w[k] += coefficient * step;
         }
         for &j in before {
-            w[j] -= s.config.give_back * step;
+            w[j] -= self.state.config.give_back * step;
         }
         self.bounds.clamp(&mut w);
         Ok(w)
