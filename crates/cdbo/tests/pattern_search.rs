@@ -352,3 +352,62 @@ fn a_search_saved_before_sharpening_resumes_without_it() {
     let mut resumed = saved.resume().unwrap();
     assert_eq!(drive(&mut old, 60), drive(resumed.as_mut(), 60));
 }
+
+/// A direction whose step of more pedal failed sits out the next sweep, after a second such
+/// failure (no faster lap between) the next two; a slower lap or less pedal rests nothing.
+#[test]
+fn a_failed_step_of_more_pedal_rests_its_direction() {
+    let n = 6;
+    let mut ps = started(
+        n,
+        PatternSearchConfig {
+            sigma0: 0.1,
+            block: 1,
+            sharpen: false,
+            ..PatternSearchConfig::default()
+        },
+    );
+    // One sweep; weight 2's lap fails before it (no repair), every other lap is slower.
+    let mut sweep = |trials: usize| -> Vec<f64> {
+        (0..trials)
+            .filter_map(|_| {
+                let w = ps.ask().unwrap();
+                let moved = w.iter().position(|&v| v != 0.0).unwrap();
+                let fails = moved == 2 && w[2] > 0.0;
+                let (reward, at) = if fails { (0.0, Some(0.0)) } else { (0.5, None) };
+                ps.tell_lap(&w, reward, at).unwrap();
+                (moved == 2).then_some(w[2])
+            })
+            .collect()
+    };
+    assert_eq!(sweep(n), [0.1]); // fails: rests one sweep
+    assert_eq!(sweep(n - 1), [0.0; 0]);
+    assert_eq!(sweep(n), [-0.05]); // less pedal, slower: no rest
+    assert_eq!(sweep(n), [0.025]); // fails again: rests two sweeps
+    assert_eq!(sweep(n - 1), [0.0; 0]);
+    assert_eq!(sweep(n - 1), [0.0; 0]);
+    assert_eq!(sweep(n), [-0.0125]);
+}
+
+/// A search saved before rests existed (no `rest`, `rests`, `sharp_rests`) resumes as it was:
+/// without rests, lap for lap as a search without them.
+#[test]
+fn a_search_saved_before_rests_resumes_without_them() {
+    let config = PatternSearchConfig {
+        sigma0: 0.1,
+        block: 2,
+        rest: false,
+        ..PatternSearchConfig::default()
+    };
+    let mut old = started(10, config);
+    let mut json = serde_json::to_value(old.save()).unwrap();
+    let state = json["state"].as_object_mut().unwrap();
+    for key in ["rests", "sharp_rests"] {
+        assert!(state.remove(key).is_some(), "no {key} in {state:?}");
+    }
+    let config_json = state["config"].as_object_mut().unwrap();
+    assert!(config_json.remove("rest").is_some());
+    let saved: Saved = serde_json::from_value(json).unwrap();
+    let mut resumed = saved.resume().unwrap();
+    assert_eq!(drive(&mut old, 120), drive(resumed.as_mut(), 120));
+}
