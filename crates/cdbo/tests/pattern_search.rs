@@ -340,17 +340,28 @@ fn a_search_saved_before_sharpening_resumes_without_it() {
         sharpen: false,
         ..PatternSearchConfig::default()
     };
-    let mut old = started(10, config.clone());
+    resumes_as_saved_without(config, &["sharpening", "sharp_steps"], "sharpen", 60);
+}
+
+/// A search with `config` (whose newer feature is off), saved as an older version wrote it —
+/// without the `state_keys` and the `config_key` — resumes lap for lap as it was.
+fn resumes_as_saved_without(
+    config: PatternSearchConfig,
+    state_keys: &[&str],
+    config_key: &str,
+    laps: usize,
+) {
+    let mut old = started(10, config);
     let mut json = serde_json::to_value(old.save()).unwrap();
     let state = json["state"].as_object_mut().unwrap();
-    for key in ["sharpening", "sharp_steps"] {
-        assert!(state.remove(key).is_some(), "no {key} in {state:?}");
+    for key in state_keys {
+        assert!(state.remove(*key).is_some(), "no {key} in {state:?}");
     }
     let config_json = state["config"].as_object_mut().unwrap();
-    assert!(config_json.remove("sharpen").is_some());
+    assert!(config_json.remove(config_key).is_some(), "no {config_key}");
     let saved: Saved = serde_json::from_value(json).unwrap();
     let mut resumed = saved.resume().unwrap();
-    assert_eq!(drive(&mut old, 60), drive(resumed.as_mut(), 60));
+    assert_eq!(drive(&mut old, laps), drive(resumed.as_mut(), laps));
 }
 
 /// A direction whose step of more pedal failed sits out the next sweep, after a second such
@@ -399,15 +410,5 @@ fn a_search_saved_before_rests_resumes_without_them() {
         rest: false,
         ..PatternSearchConfig::default()
     };
-    let mut old = started(10, config);
-    let mut json = serde_json::to_value(old.save()).unwrap();
-    let state = json["state"].as_object_mut().unwrap();
-    for key in ["rests", "sharp_rests"] {
-        assert!(state.remove(key).is_some(), "no {key} in {state:?}");
-    }
-    let config_json = state["config"].as_object_mut().unwrap();
-    assert!(config_json.remove("rest").is_some());
-    let saved: Saved = serde_json::from_value(json).unwrap();
-    let mut resumed = saved.resume().unwrap();
-    assert_eq!(drive(&mut old, 120), drive(resumed.as_mut(), 120));
+    resumes_as_saved_without(config, &["rests", "sharp_rests"], "rest", 120);
 }
