@@ -449,6 +449,8 @@ impl Optimizer for PatternSearch {
         check_tell_lap(self.dim(), weights, reward, failed_at)?;
         self.state.evaluations += 1;
         let better = self.state.best.offer(weights, reward);
+        // A failed lap: where it failed is told, or its reward is a failure's 0.
+        let failed = failed_at.is_some() || reward == 0.0;
         let repair = self.state.config.repair;
         match self.state.next.clone() {
             Trial::Start => self.begin_sweep(),
@@ -470,7 +472,7 @@ impl Optimizer for PatternSearch {
                             before: vec![j],
                         }
                     }
-                    None => self.give_up(weight, failed_at.is_some() || reward == 0.0),
+                    None => self.give_up(weight, failed),
                 }
             }
             Trial::Repair { weight, mut before } => {
@@ -483,7 +485,7 @@ impl Optimizer for PatternSearch {
                         before.push(j);
                         self.state.next = Trial::Repair { weight, before };
                     }
-                    None => self.give_up(weight, failed_at.is_some() || reward == 0.0),
+                    None => self.give_up(weight, failed),
                 }
             }
         }
