@@ -292,6 +292,21 @@ fn a_short_race_writes_its_results() {
 }
 
 #[test]
+fn a_cdbo_race_points_to_the_learner_beyond_the_paper() {
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("cdbo-cli-race-hint-{}", std::process::id()));
+    let dir = out.to_str().unwrap();
+    let race = |method: &str| {
+        let args = ["race", "--laps", "3", "--method", method, "--out", dir];
+        String::from_utf8(succeed(&args).stdout).unwrap()
+    };
+    let hint = "--method pattern-search";
+    assert!(race("cdbo").contains(hint));
+    assert!(!race("pattern-search").contains(hint));
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
 fn policies_fit_to_a_trace_and_print_tables() {
     let trace = scratch("demo-trace.csv", "");
     succeed(&["lap", "--trace", trace.to_str().unwrap()]);
