@@ -8,19 +8,22 @@ use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyType};
 
-use cdbo::optimizers::{DEFAULT_BOX_RADIUS, Method, Optimizer, Saved, Settings};
+use cdbo::optimizers::{DEFAULT_BOX_RADIUS, FailedLap, Method, Optimizer, Saved, Settings};
 
 use crate::convert::{IntoPy, array, lock, vector};
 
 /// An ask/tell optimiser of rewards over weights, started from w0.
 ///
-/// `Optimizer(method, w0, seed=0, beta=1.0, bounds=1.5, sigma0=None, knob=None)`: `method` is
+/// `Optimizer(method, w0, seed=0, beta=1.0, bounds=1.5, sigma0=None, knob=None,
+/// lengthscale=None)`: `method` is
 /// one of `cdbo.METHODS`; the weights are searched in the box [w0 - bounds, w0 + bounds];
 /// `sigma0` is the exploration scale around w0 (CDBO's initial samples, the evolution
 /// strategies' step); `knob` is the method's main knob (`cdbo race --knob`: σ₀ for CMA-ES,
 /// random and pattern search, TuRBO's initial trust-region side, LineBO's step, REMBO's box),
-/// checked against its range. The defaults are `cdbo race`'s (each knob at its tuned value),
-/// so the same seed asks the same weights.
+/// checked against its range; `lengthscale`, when w0 are a lap policy's weights, is its
+/// kernels' length-scale (`RaceEnv.lengthscale`; pattern search then pushes the policy's
+/// pedal). With the defaults and the policy's length-scale, it is `cdbo race`'s optimiser
+/// (each knob at its tuned value), so the same seed asks the same weights.
 #[pyclass(name = "Optimizer", module = "cdbo")]
 pub struct PyOptimizer {
     inner: Mutex<Box<dyn Optimizer + Send>>,
@@ -40,7 +43,7 @@ impl PyOptimizer {
 #[pymethods]
 impl PyOptimizer {
     #[new]
-    #[pyo3(signature = (method, w0, *, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, bounds = DEFAULT_BOX_RADIUS, sigma0 = None, knob = None))]
+    #[pyo3(signature = (method, w0, *, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, bounds = DEFAULT_BOX_RADIUS, sigma0 = None, knob = None, lengthscale = None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -51,6 +54,7 @@ impl PyOptimizer {
         bounds: f64,
         sigma0: Option<f64>,
         knob: Option<f64>,
+        lengthscale: Option<f64>,
     ) -> PyResult<Self> {
         let w0 = vector(w0, "w0")?;
         let method: Method = method.parse().py()?;
@@ -58,6 +62,7 @@ impl PyOptimizer {
         let mut settings = Settings {
             box_radius: bounds,
             sigma0: sigma0.unwrap_or(race.sigma0),
+            policy_lengthscale: lengthscale,
             ..race
         };
         if let Some(value) = knob {
@@ -88,18 +93,21 @@ impl PyOptimizer {
     }
 
     /// Tells the reward of `w` (0 for a failed lap) and, for a failed lap whose place is
-    /// known, where it failed (`failed_at`, a lap fraction; methods that use it, such as
-    /// pattern-search, repair the policy there).
-    #[pyo3(signature = (w, reward, failed_at = None))]
+    /// known, where it failed (`failed_at`, a lap fraction) and whether the car was too slow
+    /// there (`too_slow`: it stalled or ran out of time, rather than leaving the road or
+    /// spinning); methods that use them, such as pattern-search, repair the policy there.
+    #[pyo3(signature = (w, reward, failed_at = None, too_slow = false))]
     fn tell(
         &self,
         py: Python<'_>,
         w: &Bound<'_, PyAny>,
         reward: f64,
         failed_at: Option<f64>,
+        too_slow: bool,
     ) -> PyResult<()> {
         let w = vector(w, "w")?;
-        py.detach(|| lock(&self.inner)?.tell_lap(&w, reward, failed_at).py())
+        let failure = failed_at.map(|at| FailedLap { at, too_slow });
+        py.detach(|| lock(&self.inner)?.tell_lap(&w, reward, failure).py())
     }
 
     /// The best (weights, reward) told so far, or None.

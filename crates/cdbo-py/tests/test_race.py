@@ -39,7 +39,7 @@ def test_a_python_loop_over_optimizer_and_env_is_the_librarys_race(method, knob)
     result = cdbo.race("ridgeway", method=method, kernels=20, laps=laps, seed=5, knob=knob)
     env = cdbo.RaceEnv("ridgeway", kernels=20)
     assert np.array_equal(env.w0, result.initial.weights)
-    opt = cdbo.Optimizer(method, env.w0, seed=5, knob=knob)
+    opt = cdbo.Optimizer(method, env.w0, seed=5, knob=knob, lengthscale=env.lengthscale)
     rewards = []
     for _ in range(laps):
         env.reset()
@@ -47,7 +47,7 @@ def test_a_python_loop_over_optimizer_and_env_is_the_librarys_race(method, knob)
         _, reward, terminated, truncated, info = env.step(w)
         assert terminated and not truncated
         assert (info["failure"] is None) == info["completed"]
-        opt.tell(w, reward, failed_at=info["x_fail"])
+        opt.tell(w, reward, failed_at=info["x_fail"], too_slow=info["too_slow"])
         rewards.append(reward)
     assert rewards == [lap["reward"] for lap in result.laps]
     assert opt.best[1] == result.best_reward

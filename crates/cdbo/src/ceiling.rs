@@ -32,7 +32,7 @@
 //! (limit → tracked profile) and the policy class's (tracked profile → fitted policy), and
 //! what is left to an optimiser.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::car::Car;
 use crate::drive::{Observation, Pedal};
@@ -41,7 +41,6 @@ use crate::limit::{Limit, limit_lap};
 use crate::policy::RkhsPolicy;
 use crate::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 use crate::sim::Simulator;
-use crate::sim::lap::FailureReason;
 use crate::track::Track;
 
 /// Proportional gain of the profile tracker (per m/s): full pedal at 1 m/s off the target.
@@ -124,7 +123,7 @@ pub struct Ceiling {
 
 /// The repairs of a fitted pedal's targets at the places its laps fail (step 2 of the
 /// ceiling): the step δ and the last failure's place and direction.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PedalRepair {
     /// The kernel spacing 1/(M − 1).
     pub spacing: f64,
@@ -144,21 +143,13 @@ impl PedalRepair {
         }
     }
 
-    /// The direction a lap failed for `reason` moves the pedal: −1 where the car was too fast
-    /// (off the road, spun, backwards), +1 where it was too slow (stalled, time limit).
-    pub fn direction(reason: FailureReason) -> f64 {
-        match reason {
-            FailureReason::OffTrack | FailureReason::Spun | FailureReason::Backwards => -1.0,
-            FailureReason::Stalled | FailureReason::TimeLimit => 1.0,
-        }
-    }
-
     /// Moves the targets (x, a) with x ∈ [x_f − [`REPAIR_SPACINGS`]·spacing, x_f] by ±δ for a
-    /// lap that failed at x_f for `reason`, halving δ first if the last failure lay within
-    /// one spacing and asked for the other direction, or restoring δ₀ if it lay more than
-    /// one spacing before x_f.
-    pub fn repair(&mut self, targets: &mut [(f64, f64)], x_fail: f64, reason: FailureReason) {
-        let direction = PedalRepair::direction(reason);
+    /// lap that failed at x_f: down where the car was too fast (off the road, spun,
+    /// backwards), up where it was `too_slow` (stalled, time limit); halving δ first if the
+    /// last failure lay within one spacing and asked for the other direction, or restoring δ₀
+    /// if it lay more than one spacing before x_f.
+    pub fn repair(&mut self, targets: &mut [(f64, f64)], x_fail: f64, too_slow: bool) {
+        let direction = if too_slow { 1.0 } else { -1.0 };
         match self.last {
             Some((x, d)) if (x_fail - x).abs() < self.spacing && d != direction => {
                 self.step *= 0.5;
@@ -233,7 +224,7 @@ pub fn ceiling_with(sim: &Simulator, limit: &Limit, kernels: usize) -> Result<Ce
                 ceiling.repairs = repairs;
                 break;
             }
-            Some(failure) => repair.repair(&mut targets, failure.x, failure.reason),
+            Some(failure) => repair.repair(&mut targets, failure.x, failure.reason.too_slow()),
         }
     }
     Ok(ceiling)
@@ -242,6 +233,7 @@ pub fn ceiling_with(sim: &Simulator, limit: &Limit, kernels: usize) -> Result<Ce
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sim::lap::FailureReason;
 
     /// The simulator on the built-in Ridgeway with the Spirit 300, and its limit lap.
     fn ridgeway() -> (Simulator, Limit) {
@@ -289,19 +281,19 @@ mod tests {
     fn a_repair_moves_the_targets_before_the_failure() {
         let mut repair = PedalRepair::new(11);
         let mut targets: Vec<(f64, f64)> = (0..=100).map(|i| (i as f64 / 100.0, 0.5)).collect();
-        repair.repair(&mut targets, 0.5, FailureReason::Spun);
+        repair.repair(&mut targets, 0.5, FailureReason::Spun.too_slow());
         let close = |a: f64, b: f64| (a - b).abs() < 1e-12;
         for (i, &(x, a)) in targets.iter().enumerate() {
             let moved = (30..=50).contains(&i);
             assert!(close(a, if moved { 0.4 } else { 0.5 }), "x {x}: {a}");
         }
-        repair.repair(&mut targets, 0.52, FailureReason::Stalled);
+        repair.repair(&mut targets, 0.52, FailureReason::Stalled.too_slow());
         assert_eq!(repair.step, REPAIR_STEP / 2.0);
         assert!(close(targets[51].1, 0.55) && close(targets[50].1, 0.45));
         assert!(close(targets[31].1, 0.4) && close(targets[32].1, 0.45));
-        repair.repair(&mut targets, 0.53, FailureReason::Stalled);
+        repair.repair(&mut targets, 0.53, FailureReason::Stalled.too_slow());
         assert_eq!(repair.step, REPAIR_STEP / 2.0);
-        repair.repair(&mut targets, 0.8, FailureReason::OffTrack);
+        repair.repair(&mut targets, 0.8, FailureReason::OffTrack.too_slow());
         assert_eq!(repair.step, REPAIR_STEP);
         assert!(close(targets[80].1, 0.4) && close(targets[57].1, 0.5));
     }

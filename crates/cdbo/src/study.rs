@@ -120,7 +120,7 @@ impl Study {
         // Fails on a bad method or w₀ before anything is written.
         let optimizer = config.method.optimizer(
             config.w0.clone(),
-            &Settings::race(config.method, config.seed, config.beta),
+            &Settings::race(config.method, config.seed, config.beta).for_policy(config.lengthscale),
         )?;
         let dump = Dump {
             config: serde_json::to_string(&config).map_err(|e| Error::json("study settings", e))?,
@@ -362,7 +362,7 @@ impl Study {
             let optimizer = load_optimizer(tx.as_mut(), label, &mut self.optimizer, told)?;
             // Re-establish the optimiser's pending suggestion (the trial's), then tell it.
             optimizer.ask()?;
-            optimizer.tell_lap(&trial.weights, reward, x_fail)?;
+            optimizer.tell_lap(&trial.weights, reward, outcome.failed_lap())?;
             let state = serde_json::to_string(&optimizer.save())
                 .map_err(|e| Error::json("optimiser state", e))?;
             tx.record(id, &record, &state)?;

@@ -2,7 +2,7 @@
 //! results of the papers that introduced the peers (TuRBO, LineBO, REMBO).
 
 use cdbo::benchmarks::Problem;
-use cdbo::optimizers::{Method, Optimizer, Saved, Settings, by_name};
+use cdbo::optimizers::{FailedLap, Method, Optimizer, Saved, Settings, by_name};
 
 fn optimiser(method: &str, problem: &Problem, seed: u64) -> Box<dyn Optimizer + Send> {
     by_name(
@@ -242,7 +242,7 @@ fn cmaes_follows_the_failure_places_while_every_lap_fails() {
             let w = es.ask().unwrap();
             let at = (0.5 + 0.1 * w.iter().sum::<f64>()).clamp(0.0, 1.0);
             if with_places {
-                es.tell_lap(&w, 0.0, Some(at)).unwrap();
+                es.tell_lap(&w, 0.0, Some(FailedLap::too_fast(at))).unwrap();
             } else {
                 es.tell(&w, 0.0).unwrap();
             }

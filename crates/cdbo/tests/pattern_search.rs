@@ -1,8 +1,10 @@
 //! The pattern search with failure repair: its repair move, its save/resume with failure
 //! places, and a lap with a cliff on which it must beat random search.
 
-use cdbo::optimizers::pattern_search::{PatternSearch, PatternSearchConfig};
-use cdbo::optimizers::{Method, Optimizer, Saved, Settings, by_name};
+use cdbo::optimizers::pattern_search::{PatternSearch, PatternSearchConfig, push};
+use cdbo::optimizers::{FailedLap, Method, Optimizer, Saved, Settings, by_name};
+use cdbo::policy::RkhsPolicy;
+use cdbo::policy::rkhs::default_lengthscale;
 
 /// A toy lap with a cliff: D segments driven in order at speeds wᵢ; segment i takes at most
 /// cᵢ = 0.5 + 0.4·sin²(i). Too fast (wᵢ > cᵢ) or stopped (wᵢ ≤ 0.05), the car fails there, at
@@ -30,7 +32,8 @@ fn drive(opt: &mut dyn Optimizer, evals: usize) -> Vec<Vec<f64>> {
         .map(|_| {
             let w = opt.ask().unwrap();
             let (reward, at) = cliff_lap(&w);
-            opt.tell_lap(&w, reward, at).unwrap();
+            opt.tell_lap(&w, reward, at.map(FailedLap::too_fast))
+                .unwrap();
             w
         })
         .collect()
@@ -90,7 +93,8 @@ fn a_failed_lap_is_repaired_before_where_it_failed() {
         let moved = w.iter().position(|&v| v != 0.0).unwrap();
         assert_eq!(w[moved], 0.1);
         // A failure at x = 1 lies in kernel 4's span: kernel 3 brakes before it.
-        ps.tell_lap(&w, 0.0, Some(1.0)).unwrap();
+        ps.tell_lap(&w, 0.0, Some(FailedLap::too_fast(1.0)))
+            .unwrap();
         let next = ps.ask().unwrap();
         if moved < 3 {
             let mut repair = w.clone();
@@ -129,20 +133,24 @@ fn a_repair_that_fails_again_is_repaired_again() {
         }
         checked += 1;
         // Kernel 7's span (x = 7/9): kernel 6 gives half the step back.
-        ps.tell_lap(&w, 0.0, Some(7.0 / 9.0)).unwrap();
+        ps.tell_lap(&w, 0.0, Some(FailedLap::too_fast(7.0 / 9.0)))
+            .unwrap();
         let mut expected = w.clone();
         expected[6] -= 0.05;
         assert_eq!(ps.ask().unwrap(), expected, "seed {seed}");
         // Failed again further on (x = 1): kernel 8 gives it back too.
-        ps.tell_lap(&expected, 0.0, Some(1.0)).unwrap();
+        ps.tell_lap(&expected, 0.0, Some(FailedLap::too_fast(1.0)))
+            .unwrap();
         expected[8] -= 0.05;
         assert_eq!(ps.ask().unwrap(), expected, "seed {seed}");
         // And again at the same place: kernel 8 brakes twice as hard.
-        ps.tell_lap(&expected, 0.0, Some(1.0)).unwrap();
+        ps.tell_lap(&expected, 0.0, Some(FailedLap::too_fast(1.0)))
+            .unwrap();
         expected[8] -= 0.05;
         assert_eq!(ps.ask().unwrap(), expected, "seed {seed}");
         // A fourth failure drops the step: the next trial leaves the moved weight alone.
-        ps.tell_lap(&expected, 0.0, Some(1.0)).unwrap();
+        ps.tell_lap(&expected, 0.0, Some(FailedLap::too_fast(1.0)))
+            .unwrap();
         let next = ps.ask().unwrap();
         assert_eq!(next[moved], 0.0, "seed {seed}: {next:?}");
         assert_eq!(next.iter().filter(|&&v| v != 0.0).count(), 1, "{next:?}");
@@ -207,7 +215,7 @@ fn a_bad_failure_place_is_refused() {
     let w = ps.ask().unwrap();
     let before = ps.save();
     for at in [-0.1, 1.5, f64::NAN] {
-        assert!(ps.tell_lap(&w, 0.0, Some(at)).is_err());
+        assert!(ps.tell_lap(&w, 0.0, Some(FailedLap::too_fast(at))).is_err());
     }
     assert_eq!(ps.save(), before);
 }
@@ -242,7 +250,8 @@ fn a_failure_after_less_pedal_is_not_repaired() {
         checked += 1;
         // It fails at x = 1, in kernel 4's span and past the moved weight, where a step of
         // more pedal would be given back at kernel 3: no give-back, the next weight moves.
-        ps.tell_lap(&w, 0.0, Some(1.0)).unwrap();
+        ps.tell_lap(&w, 0.0, Some(FailedLap::too_fast(1.0)))
+            .unwrap();
         let next = ps.ask().unwrap();
         assert_eq!(
             next.iter().filter(|&&v| v != 0.0).count(),
@@ -386,7 +395,8 @@ fn a_failed_step_of_more_pedal_rests_its_direction() {
                 let moved = w.iter().position(|&v| v != 0.0).unwrap();
                 let fails = moved == 2 && w[2] > 0.0;
                 let (reward, at) = if fails { (0.0, Some(0.0)) } else { (0.5, None) };
-                ps.tell_lap(&w, reward, at).unwrap();
+                ps.tell_lap(&w, reward, at.map(FailedLap::too_fast))
+                    .unwrap();
                 (moved == 2).then_some(w[2])
             })
             .collect()
@@ -411,4 +421,161 @@ fn a_search_saved_before_rests_resumes_without_them() {
         ..PatternSearchConfig::default()
     };
     resumes_as_saved_without(config, &["rests", "sharp_rests"], "rest", 120);
+}
+
+/// A toy lap over a policy's pedal: the speed integrates the pedal, v ← v + 0.01·π(x) over
+/// 400 steps from v = 1, and the car fails at the first x where v > c(x) = 1.6 + 0.5·sin(6πx)
+/// (too fast for the corner there) or v < 0.1 (stalled: too slow); a completed lap's reward is
+/// its mean speed, 400 / Σ 1/v. The best pedal brakes just enough before each corner.
+fn pedal_lap(w: &[f64], lengthscale: f64) -> (f64, Option<FailedLap>) {
+    let policy = RkhsPolicy::new(w.to_vec(), lengthscale).unwrap();
+    let n = 400;
+    let (mut v, mut time) = (1.0, 0.0);
+    for k in 0..n {
+        let x = k as f64 / (n - 1) as f64;
+        v += 0.01 * policy.action(x);
+        if v > 1.6 + 0.5 * (6.0 * std::f64::consts::PI * x).sin() {
+            return (0.0, Some(FailedLap::too_fast(x)));
+        }
+        if v < 0.1 {
+            return (
+                0.0,
+                Some(FailedLap {
+                    at: x,
+                    too_slow: true,
+                }),
+            );
+        }
+        time += 1.0 / v;
+    }
+    (n as f64 / time, None)
+}
+
+/// A race's pattern search on a 12-kernel policy (told its length-scale) from π = 0.
+fn pushing(seed: u64) -> (Box<dyn Optimizer + Send>, f64) {
+    let l = default_lengthscale(12);
+    let settings = Settings::race(Method::PatternSearch, seed, 2.0).for_policy(l);
+    (
+        Method::PatternSearch
+            .optimizer(vec![0.0; 12], &settings)
+            .unwrap(),
+        l,
+    )
+}
+
+fn drive_pedal(opt: &mut dyn Optimizer, l: f64, laps: usize) -> Vec<(Vec<f64>, f64)> {
+    (0..laps)
+        .map(|_| {
+            let w = opt.ask().unwrap();
+            let (reward, failure) = pedal_lap(&w, l);
+            opt.tell_lap(&w, reward, failure).unwrap();
+            (w, reward)
+        })
+        .collect()
+}
+
+/// Told the policy's length-scale, the search pushes the whole pedal after the start lap and
+/// repairs the pushed lap where it fails until it completes: on the pedal cliff, a lap faster
+/// than the start within the push's laps, whose pedal is raised nearly everywhere; without the
+/// length-scale its second lap moves one block only.
+#[test]
+fn the_push_raises_the_pedal_and_repairs_it_until_the_lap_completes() {
+    let (mut opt, l) = pushing(4);
+    let laps = drive_pedal(opt.as_mut(), l, 1 + push::LAPS);
+    let first = RkhsPolicy::new(laps[1].0.clone(), l).unwrap();
+    assert!(
+        (0..=20).all(|k| first.action(k as f64 / 20.0) > 0.25),
+        "the first push is not raised everywhere"
+    );
+    assert_eq!(laps[1].1, 0.0, "π = U₀ takes the first corner too fast");
+    let completed = laps
+        .iter()
+        .skip(1)
+        .position(|l| l.1 > 0.0)
+        .expect("no pushed lap completed");
+    assert!(
+        laps[1 + completed].1 > laps[0].1 + 0.1,
+        "{} against {}",
+        laps[1 + completed].1,
+        laps[0].1
+    );
+
+    let mut plain = by_name(
+        "pattern-search",
+        vec![0.0; 12],
+        &Settings::race(Method::PatternSearch, 4, 2.0),
+    )
+    .unwrap();
+    let laps = drive_pedal(plain.as_mut(), l, 2);
+    assert_eq!(
+        laps[1].0.iter().filter(|&&v| v != 0.0).count(),
+        8,
+        "blocks of 8 first"
+    );
+}
+
+/// After a kept push the sweeps begin at single weights: once the pushes are done, each step
+/// moves one weight of the best by σ₀.
+#[test]
+fn after_a_kept_push_the_sweeps_move_single_weights() {
+    let (mut opt, l) = pushing(2);
+    let laps = drive_pedal(opt.as_mut(), l, 200);
+    let sigma0 = Method::PatternSearch.knob().value;
+    // The first lap after the pushes that differs from the best lap before it in one weight
+    // by σ₀.
+    let mut best = laps[0].clone();
+    let single = laps.iter().skip(1).any(|(w, r)| {
+        let moved: Vec<f64> = w
+            .iter()
+            .zip(&best.0)
+            .map(|(a, b)| a - b)
+            .filter(|d| *d != 0.0)
+            .collect();
+        let is_single = moved.len() == 1 && (moved[0] - sigma0).abs() < 1e-12;
+        if *r > best.1 {
+            best = (w.clone(), *r);
+        }
+        is_single
+    });
+    assert!(single, "no single-weight step of σ₀ in 200 laps");
+    assert!(
+        best.1 > laps[0].1 + 0.08,
+        "{} against {}",
+        best.1,
+        laps[0].1
+    );
+}
+
+/// Saved in the middle of a push, the search resumes bit for bit.
+#[test]
+fn a_search_saved_mid_push_resumes_exactly() {
+    let (mut a, l) = pushing(9);
+    drive_pedal(a.as_mut(), l, 5);
+    let json = serde_json::to_string(&a.save()).unwrap();
+    assert!(
+        json.contains("\"next\":\"Push\""),
+        "not in a push after 5 laps"
+    );
+    let mut resumed = serde_json::from_str::<Saved>(&json)
+        .unwrap()
+        .resume()
+        .unwrap();
+    assert_eq!(
+        drive_pedal(a.as_mut(), l, 80),
+        drive_pedal(resumed.as_mut(), l, 80)
+    );
+    assert_eq!(a.best(), resumed.best());
+}
+
+/// A search saved before pushes existed (no `push` in its settings, no `push` or `pushed` in
+/// its state) resumes as it was.
+#[test]
+fn a_search_saved_before_pushes_resumes_without_them() {
+    let config = PatternSearchConfig {
+        sigma0: 0.1,
+        push: 0.0,
+        lengthscale: Some(default_lengthscale(10)),
+        ..PatternSearchConfig::default()
+    };
+    resumes_as_saved_without(config, &["push", "pushed"], "push", 80);
 }

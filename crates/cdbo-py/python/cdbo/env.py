@@ -96,6 +96,7 @@ class RaceEnv(_Base):
             "lap_time": lap.time,
             "failure": lap.failure,
             "x_fail": lap.x_fail,
+            "too_slow": lap.failure in ("stalled", "time_limit"),
         }
         return np.zeros(1), lap.reward, True, False, info
 

@@ -60,6 +60,24 @@ impl Outcome {
         }
     }
 
+    /// Where a failed lap failed and whether it was too slow there (a reason that names a stall
+    /// or the time limit), if its place is known.
+    pub fn failed_lap(&self) -> Option<crate::optimizers::FailedLap> {
+        match self {
+            Outcome::Failed {
+                at: Some(at),
+                reason,
+            } => Some(crate::optimizers::FailedLap {
+                at: *at,
+                too_slow: reason
+                    .as_deref()
+                    .and_then(crate::sim::lap::FailureReason::from_name)
+                    .is_some_and(crate::sim::lap::FailureReason::too_slow),
+            }),
+            _ => None,
+        }
+    }
+
     /// Where a failed lap failed (lap fraction), if known.
     pub fn failed_at(&self) -> Option<f64> {
         match self {

@@ -21,7 +21,7 @@ use faer::{Mat, Side};
 use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
 
-use super::{Best, Optimizer, SearchBox, check_tell, check_tell_lap, rng_for};
+use super::{Best, FailedLap, Optimizer, SearchBox, check_tell, check_tell_lap, rng_for};
 use crate::error::{Error, Result};
 
 /// Settings of a CMA-ES run.
@@ -486,9 +486,9 @@ impl Optimizer for Cmaes {
     /// A lap that failed at x ranks by how far it got, f = 1 − x (behind every completed lap,
     /// f = −reward < 0): when a whole generation fails, a fitness of zeros everywhere steers
     /// nothing, while the failure places still point the mean towards laps that got further.
-    fn tell_lap(&mut self, weights: &[f64], reward: f64, failed_at: Option<f64>) -> Result<()> {
-        check_tell_lap(self.dim(), weights, reward, failed_at)?;
-        let fitness = failed_at.map_or(-reward, |x| 1.0 - x);
+    fn tell_lap(&mut self, weights: &[f64], reward: f64, failure: Option<FailedLap>) -> Result<()> {
+        check_tell_lap(self.dim(), weights, reward, failure)?;
+        let fitness = failure.map_or(-reward, |f| 1.0 - f.at);
         self.tell_ranked(weights, reward, fitness)
     }
 

@@ -36,11 +36,11 @@ pub trait Optimizer {
     /// dimension, non-finite weights or reward — is refused and changes nothing.
     fn tell(&mut self, weights: &[f64], reward: f64) -> Result<()>;
 
-    /// [`tell`](Optimizer::tell) with where a failed lap failed (`failed_at`, a lap fraction in
-    /// [0, 1], for a failed lap whose place is known): all a car's lap timer gives besides the
-    /// time. Methods that read the place override it; the others are told the reward.
-    fn tell_lap(&mut self, weights: &[f64], reward: f64, failed_at: Option<f64>) -> Result<()> {
-        let _ = failed_at;
+    /// [`tell`](Optimizer::tell) with where and how a failed lap failed (for a failed lap whose
+    /// place is known): all a car's lap timer and driver give besides the time. Methods that
+    /// read it override this; the others are told the reward.
+    fn tell_lap(&mut self, weights: &[f64], reward: f64, failure: Option<FailedLap>) -> Result<()> {
+        let _ = failure;
         self.tell(weights, reward)
     }
 
@@ -59,6 +59,26 @@ pub trait Optimizer {
 
     /// The whole state, to resume the run later with [`Saved::resume`] exactly where it is.
     fn save(&self) -> Saved;
+}
+
+/// What a car's timer and driver tell of a failed lap.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FailedLap {
+    /// Where it failed, a lap fraction in [0, 1].
+    pub at: f64,
+    /// Whether the car was too slow there (it stalled or ran out of time) rather than too fast
+    /// (it left the road, spun or turned round).
+    pub too_slow: bool,
+}
+
+impl FailedLap {
+    /// A lap that failed at `at` for being too fast, the usual failure of a faster policy.
+    pub fn too_fast(at: f64) -> FailedLap {
+        FailedLap {
+            at,
+            too_slow: false,
+        }
+    }
 }
 
 /// The saved state of an optimiser of any method, tagged with its kind.
@@ -111,6 +131,10 @@ pub struct Settings {
     /// The main knob of the other methods ([`Method::knob`]: TuRBO's L_init, LineBO's line
     /// half-length, REMBO's box half-width); `None`: the method's published setting.
     pub knob: Option<f64>,
+    /// The length-scale ℓ of the policy's kernels when the weights are a lap policy's (races
+    /// and studies; the pattern search pushes that policy's pedal); `None` for any other
+    /// problem.
+    pub policy_lengthscale: Option<f64>,
 }
 
 impl Settings {
@@ -126,6 +150,7 @@ impl Settings {
             box_radius: DEFAULT_BOX_RADIUS,
             sigma0: registry::PAPER_SIGMA0,
             knob: None,
+            policy_lengthscale: None,
         }
         .with_knob_unchecked(method, knob.value)
     }
@@ -151,6 +176,14 @@ impl Settings {
         }
     }
 
+    /// These settings for the weights of a lap policy whose kernels have length-scale ℓ.
+    pub fn for_policy(self, lengthscale: f64) -> Settings {
+        Settings {
+            policy_lengthscale: Some(lengthscale),
+            ..self
+        }
+    }
+
     /// For a test problem on a box of half-width r: σ₀ = r/15.
     pub fn problem(seed: u64, box_radius: f64) -> Settings {
         Settings {
@@ -159,6 +192,7 @@ impl Settings {
             box_radius,
             sigma0: box_radius / 15.0,
             knob: None,
+            policy_lengthscale: None,
         }
     }
 }
@@ -177,6 +211,7 @@ impl Method {
             box_radius,
             sigma0,
             knob,
+            policy_lengthscale,
         } = *settings;
         let bo = |maximiser| bo::BoConfig {
             seed,
@@ -247,6 +282,7 @@ impl Method {
                     sigma0,
                     box_radius,
                     repair: true,
+                    lengthscale: policy_lengthscale,
                     ..pattern_search::PatternSearchConfig::default()
                 },
             )?),
@@ -337,10 +373,10 @@ pub(crate) fn check_tell_lap(
     dim: usize,
     weights: &[f64],
     reward: f64,
-    failed_at: Option<f64>,
+    failure: Option<FailedLap>,
 ) -> Result<()> {
     check_tell(dim, weights, reward)?;
-    match failed_at {
+    match failure.map(|f| f.at) {
         Some(x) if !(x.is_finite() && (0.0..=1.0).contains(&x)) => Err(Error::invalid_value(
             "the failure place",
             x,

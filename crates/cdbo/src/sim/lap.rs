@@ -49,6 +49,12 @@ impl FailureReason {
         }
     }
 
+    /// Whether the car failed for being too slow (it stalled or ran out of time) rather than
+    /// too fast (it left the road, spun or turned round).
+    pub fn too_slow(self) -> bool {
+        matches!(self, FailureReason::Stalled | FailureReason::TimeLimit)
+    }
+
     /// The reason named `name` ([`FailureReason::name`]), if it is one.
     pub fn from_name(name: &str) -> Option<FailureReason> {
         [

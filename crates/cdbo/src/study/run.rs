@@ -191,7 +191,7 @@ impl TrialSource for InMemory {
     fn tell(&mut self, trial: &Trial, outcome: &Outcome) -> Result<f64> {
         let reward = outcome.reward()?;
         self.optimizer
-            .tell_lap(&trial.weights, reward, outcome.failed_at())?;
+            .tell_lap(&trial.weights, reward, outcome.failed_lap())?;
         self.told += 1;
         Ok(reward)
     }
@@ -319,7 +319,7 @@ mod tests {
             assert_eq!(&w, weights);
             let outcome = Bowl.evaluate(*id, &w).unwrap();
             assert_eq!(outcome.reward().unwrap(), *reward);
-            by_hand.tell_lap(&w, *reward, outcome.failed_at()).unwrap();
+            by_hand.tell_lap(&w, *reward, outcome.failed_lap()).unwrap();
         }
         assert_eq!(told.len(), 12);
     }

@@ -1,0 +1,204 @@
+//! The push: the whole pedal raised at once, then repaired where its laps fail.
+//!
+//! Steps of one kernel climb a lap's speed one place at a time, and most of them fail at the
+//! corner just after the moved kernel. A push moves every place at once: pedal targets
+//! a(xₖ) = π_{w*}(xₖ) + U at G evenly spaced xₖ (π_{w*} the best lap's pedal), fitted by
+//! ridge regression with the policy's M kernels (paper eq. 9). The pushed lap is too fast for
+//! most corners; while it fails at x_f, the targets over the two kernel spacings before x_f
+//! move by ±δ (down where the car was too fast, up where it stalled) and are fitted again: the
+//! ceiling's repair ([`PedalRepair`]), which walks the failure round the lap corner by corner.
+//! The first lap that completes ends the push, kept if it is faster than the best lap; a kept
+//! push is followed by one of half the size.
+//!
+//! A push gives up when its repairs oscillate at one place (δ below [`GIVE_UP`]·δ₀: the car
+//! stalls there with less pedal and spins with more) or after [`LAPS`] laps. Its size is drawn
+//! around U₀ from the seed (±[`JITTER`]): where a failure lands moves from corner to corner
+//! with U, so runs with different seeds try different pushes and their mean measures the
+//! method rather than one push.
+
+use rand::Rng;
+use serde::{Deserialize, Serialize};
+
+use super::super::{FailedLap, SearchBox, rng_for};
+use crate::ceiling::{PedalRepair, REPAIR_STEP};
+use crate::error::Result;
+use crate::policy::RkhsPolicy;
+use crate::policy::rkhs::DEFAULT_RIDGE;
+
+/// The first push's size U₀ (pedal units), chosen by a sweep on the training panels
+/// (docs/results/beyond).
+pub const SIZE: f64 = 0.35;
+/// Pushes at most: U₀, then U₀/2 after a kept one.
+pub const PUSHES: u32 = 2;
+/// The relative spread of a push's size around its nominal value, drawn from the seed.
+pub const JITTER: f64 = 0.1;
+/// Laps of one push at most.
+pub const LAPS: usize = 60;
+/// A push gives up once its repair step δ falls below this fraction of δ₀.
+pub const GIVE_UP: f64 = 0.3;
+/// Policies of more kernels are not pushed: each lap's fit costs O(G·M²), G ≥ 10(M − 1).
+pub const MAX_KERNELS: usize = 200;
+/// Pedal targets per push at least (more for fine policies: ten per kernel spacing).
+const MIN_TARGETS: usize = 601;
+
+/// A push under way.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Push {
+    /// Which push this is: 1 for the first (size U₀), 2 for the second (U₀/2).
+    pub number: u32,
+    /// The pedal targets a(xₖ) at xₖ = k/(G − 1).
+    pub targets: Vec<f64>,
+    /// The repairs' step δ and last failure.
+    pub repair: PedalRepair,
+    /// Laps driven in this push.
+    pub laps: usize,
+}
+
+impl Push {
+    /// Push `number` from the best weights `best` of a policy with length-scale ℓ: the best
+    /// pedal raised by U₀/2^(number − 1)·(1 + J·(2u − 1)), u uniform from (`seed`, `number`).
+    pub fn begin(
+        number: u32,
+        best: &[f64],
+        lengthscale: f64,
+        size0: f64,
+        seed: u64,
+    ) -> Result<Push> {
+        let policy = RkhsPolicy::new(best.to_vec(), lengthscale)?;
+        let u: f64 = rng_for(seed, u64::MAX - u64::from(number)).random();
+        let size =
+            size0 / f64::from(1u32 << (number - 1).min(31)) * (1.0 + JITTER * (2.0 * u - 1.0));
+        let g = targets_for(best.len());
+        Ok(Push {
+            number,
+            targets: (0..g).map(|k| policy.action(x_of(k, g)) + size).collect(),
+            repair: PedalRepair::new(best.len()),
+            laps: 0,
+        })
+    }
+
+    /// The weights of the push's next lap: its targets fitted by ridge regression, in the box.
+    pub fn weights(&self, lengthscale: f64, bounds: &SearchBox) -> Result<Vec<f64>> {
+        let g = self.targets.len();
+        let pairs: Vec<(f64, f64)> = self
+            .targets
+            .iter()
+            .enumerate()
+            .map(|(k, &a)| (x_of(k, g), a))
+            .collect();
+        let mut w =
+            RkhsPolicy::fit(&pairs, bounds.lower.len(), lengthscale, DEFAULT_RIDGE)?.weights;
+        bounds.clamp(&mut w);
+        Ok(w)
+    }
+
+    /// Repairs the targets for a lap that failed as `failure` says; false if the push gives up
+    /// instead (its repairs oscillate or it has driven [`LAPS`] laps).
+    pub fn repair(&mut self, failure: FailedLap) -> bool {
+        if self.laps >= LAPS || self.repair.step < GIVE_UP * REPAIR_STEP {
+            return false;
+        }
+        let g = self.targets.len();
+        let mut pairs: Vec<(f64, f64)> = self
+            .targets
+            .iter()
+            .enumerate()
+            .map(|(k, &a)| (x_of(k, g), a))
+            .collect();
+        self.repair.repair(&mut pairs, failure.at, failure.too_slow);
+        self.targets = pairs.into_iter().map(|(_, a)| a).collect();
+        true
+    }
+}
+
+/// The number G of pedal targets of an M-kernel policy.
+pub fn targets_for(kernels: usize) -> usize {
+    MIN_TARGETS.max(10 * kernels.saturating_sub(1) + 1)
+}
+
+/// The place xₖ = k/(G − 1) of target k.
+fn x_of(k: usize, g: usize) -> f64 {
+    k as f64 / (g - 1) as f64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::policy::rkhs::default_lengthscale;
+
+    fn best_and_lengthscale() -> (Vec<f64>, f64) {
+        (
+            (0..11).map(|i| 0.3 * (i as f64).sin()).collect(),
+            default_lengthscale(11),
+        )
+    }
+
+    /// A push raises the best lap's pedal by one size everywhere, within its jitter around U₀
+    /// (the second around U₀/2), and its fitted weights drive that pedal.
+    #[test]
+    fn a_push_raises_the_best_pedal_by_its_size_everywhere() {
+        let (best, l) = best_and_lengthscale();
+        let policy = RkhsPolicy::new(best.clone(), l).unwrap();
+        for (number, nominal) in [(1, SIZE), (2, SIZE / 2.0)] {
+            let push = Push::begin(number, &best, l, SIZE, 7).unwrap();
+            let g = push.targets.len();
+            assert_eq!(g, MIN_TARGETS);
+            let size = push.targets[0] - policy.action(0.0);
+            assert!(
+                (size - nominal).abs() <= JITTER * nominal && size != nominal,
+                "{size}"
+            );
+            for (k, a) in push.targets.iter().enumerate() {
+                assert!((a - policy.action(x_of(k, g)) - size).abs() < 1e-12);
+            }
+            let w = push
+                .weights(l, &SearchBox::around(&best, 10.0).unwrap())
+                .unwrap();
+            let fitted = RkhsPolicy::new(w, l).unwrap();
+            for x in [0.1, 0.33, 0.5, 0.77, 0.9] {
+                let target = policy.action(x) + size;
+                assert!(
+                    (fitted.raw(x) - target).abs() < 0.02,
+                    "x {x}: {} against {target}",
+                    fitted.raw(x)
+                );
+            }
+        }
+        // Other seeds, other sizes.
+        let other = Push::begin(1, &best, l, SIZE, 8).unwrap();
+        assert_ne!(
+            other.targets[0],
+            Push::begin(1, &best, l, SIZE, 7).unwrap().targets[0]
+        );
+    }
+
+    /// A repair lowers the targets over two spacings before a failure of a too-fast car and
+    /// nowhere else; the push gives up once its step has halved below GIVE_UP·δ₀ (a stall and a
+    /// spin in turn at one place) or after LAPS laps.
+    #[test]
+    fn a_push_repairs_before_the_failure_and_gives_up_when_it_oscillates() {
+        let (best, l) = best_and_lengthscale();
+        let mut push = Push::begin(1, &best, l, SIZE, 7).unwrap();
+        let before = push.targets.clone();
+        let g = before.len();
+        assert!(push.repair(FailedLap::too_fast(0.5)));
+        for (k, (a, b)) in push.targets.iter().zip(&before).enumerate() {
+            let moved = (0.3 - 1e-9..=0.5).contains(&x_of(k, g));
+            assert!(
+                (a - b - if moved { -REPAIR_STEP } else { 0.0 }).abs() < 1e-12,
+                "k {k}"
+            );
+        }
+        let stall = FailedLap {
+            at: 0.51,
+            too_slow: true,
+        };
+        assert!(push.repair(stall)); // δ halves to 0.05
+        assert!(push.repair(FailedLap::too_fast(0.5))); // and to 0.025
+        assert!(push.repair.step < GIVE_UP * REPAIR_STEP);
+        assert!(!push.repair(stall));
+        let mut fresh = Push::begin(1, &best, l, SIZE, 7).unwrap();
+        fresh.laps = LAPS;
+        assert!(!fresh.repair(FailedLap::too_fast(0.5)));
+    }
+}
