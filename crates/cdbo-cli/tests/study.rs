@@ -108,7 +108,8 @@ fn ask_tell_workflow_and_bad_input() {
     ok(
         &dir,
         &[
-            "study", "tell", "car", "--trial", "2", "--failed", "--at", "0.25",
+            "study", "tell", "car", "--trial", "2", "--failed", "--at", "0.25", "--reason",
+            "stalled",
         ],
     );
     let status: serde_json::Value =
@@ -121,7 +122,7 @@ fn ask_tell_workflow_and_bad_input() {
     assert_eq!(best["trial"], 1);
     let hist = ok(&dir, &["study", "history", "car"]);
     assert_eq!(hist.lines().count(), 3);
-    assert!(hist.contains("2,0,15,,failed,0.25"), "{hist}");
+    assert!(hist.contains("2,0,15,,stalled,0.25"), "{hist}");
     ok(&dir, &["study", "export", "car", "--out", "exp"]);
     for f in [
         "history.csv",

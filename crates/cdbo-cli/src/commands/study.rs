@@ -193,6 +193,11 @@ pub enum StudyCommand {
         /// Where it failed, as a fraction of the lap.
         #[arg(long, requires = "failed", allow_negative_numbers = true, value_parser = super::value::fraction)]
         at: Option<f64>,
+        /// Why it failed: `stalled` or `time_limit` when the car was too slow there (the
+        /// pattern search then adds pedal before the place), else how it left the road
+        /// (`off_track`, `spun`, `backwards`) or any note; kept with the trial.
+        #[arg(long, requires = "failed")]
+        reason: Option<String>,
     },
     /// Progress: trials told, failures, the best reward.
     Status {
@@ -277,6 +282,7 @@ pub fn run(cmd: &StudyCommand) -> CliResult {
             length,
             failed,
             at,
+            reason,
         } => {
             let outcome = match (reward, lap_time, length, failed) {
                 (Some(r), _, _, _) => Outcome::Reward(*r),
@@ -286,7 +292,7 @@ pub fn run(cmd: &StudyCommand) -> CliResult {
                 },
                 (None, None, None, true) => Outcome::Failed {
                     at: *at,
-                    reason: None,
+                    reason: reason.clone(),
                 },
                 _ => return Err("give --reward R, --lap-time T --length L, or --failed".into()),
             };

@@ -44,8 +44,8 @@
 //! search begins, after the start lap, by raising the whole pedal by U₀ ≈ 0.35 and repairing
 //! the pushed lap corner by corner where it fails, as the ceiling repairs its fit, then once
 //! more by U₀/2; after a kept push the sweeps begin at single weights (the pushed lap is near
-//! the limit everywhere, where blocks of 8 mostly fail). Measured on the training panels: 34.37
-//! against 32.80 m/s, with σ₀ re-swept to 0.08 (docs/results/beyond).
+//! the limit everywhere, where blocks of 8 mostly fail). Measured on the training panels: 34.54
+//! against 32.80 m/s, with σ₀ re-swept to 0.12 (docs/results/beyond).
 
 pub mod push;
 
