@@ -579,3 +579,32 @@ fn a_search_saved_before_pushes_resumes_without_them() {
     };
     resumes_as_saved_without(config, &["push", "pushed"], "push", 80);
 }
+
+/// A saved push that this code could not have made — a push number of 0 or past the last, a
+/// non-finite target, a step of 0, too few targets, no length-scale — is refused with the
+/// state's shape, not driven.
+#[test]
+fn a_saved_push_that_cannot_be_is_refused() {
+    let (mut opt, l) = pushing(9);
+    drive_pedal(opt.as_mut(), l, 3);
+    let Saved::PatternSearch(state) = opt.save() else {
+        panic!("not a pattern search's state");
+    };
+    assert!(PatternSearch::resume((*state).clone()).is_ok());
+    let corrupt: [fn(&mut cdbo::optimizers::pattern_search::PatternSearchState); 6] = [
+        |s| s.push.as_mut().unwrap().number = 0,
+        |s| s.push.as_mut().unwrap().number = u32::MAX,
+        |s| s.push.as_mut().unwrap().targets[7] = f64::NAN,
+        |s| s.push.as_mut().unwrap().repair.step = 0.0,
+        |s| {
+            s.push.as_mut().unwrap().targets.pop();
+        },
+        |s| s.config.lengthscale = None,
+    ];
+    for (k, spoil) in corrupt.iter().enumerate() {
+        let mut bad = (*state).clone();
+        spoil(&mut bad);
+        let e = PatternSearch::resume(bad).unwrap_err().to_string();
+        assert!(e.contains("push targets"), "case {k}: {e}");
+    }
+}

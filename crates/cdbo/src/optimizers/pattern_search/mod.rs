@@ -289,9 +289,10 @@ impl PatternSearch {
             || state.sharp_rests.len() != n
             || state.order.iter().any(|&i| i >= n)
             || (state.next == Trial::Push) != state.push.is_some()
-            || state.push.as_ref().is_some_and(|p| {
-                state.config.lengthscale.is_none() || p.targets.len() != push::targets_for(n)
-            })
+            || state
+                .push
+                .as_ref()
+                .is_some_and(|p| state.config.lengthscale.is_none() || !p.is_sound(n))
         {
             return Err(Error::CorruptState {
                 method: "pattern search",

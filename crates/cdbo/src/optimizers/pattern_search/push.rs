@@ -77,17 +77,32 @@ impl Push {
         })
     }
 
+    /// Whether a saved push is one this code could have made for an M-kernel policy: a push
+    /// number in 1..=[`PUSHES`], [`targets_for`]`(M)` finite targets, a positive finite repair
+    /// step at the policy's kernel spacing, at most [`LAPS`] laps.
+    pub fn is_sound(&self, kernels: usize) -> bool {
+        (1..=PUSHES).contains(&self.number)
+            && self.targets.len() == targets_for(kernels)
+            && self.targets.iter().all(|a| a.is_finite())
+            && self.repair.step.is_finite()
+            && self.repair.step > 0.0
+            && self.repair.spacing == PedalRepair::new(kernels).spacing
+            && self
+                .repair
+                .last
+                .is_none_or(|(x, d)| x.is_finite() && d.is_finite())
+            && self.laps <= LAPS
+    }
+
     /// The weights of the push's next lap: its targets fitted by ridge regression, in the box.
     pub fn weights(&self, lengthscale: f64, bounds: &SearchBox) -> Result<Vec<f64>> {
-        let g = self.targets.len();
-        let pairs: Vec<(f64, f64)> = self
-            .targets
-            .iter()
-            .enumerate()
-            .map(|(k, &a)| (x_of(k, g), a))
-            .collect();
-        let mut w =
-            RkhsPolicy::fit(&pairs, bounds.lower.len(), lengthscale, DEFAULT_RIDGE)?.weights;
+        let mut w = RkhsPolicy::fit(
+            &self.pairs(),
+            bounds.lower.len(),
+            lengthscale,
+            DEFAULT_RIDGE,
+        )?
+        .weights;
         bounds.clamp(&mut w);
         Ok(w)
     }
@@ -98,16 +113,20 @@ impl Push {
         if self.laps >= LAPS || self.repair.step < GIVE_UP * REPAIR_STEP {
             return false;
         }
-        let g = self.targets.len();
-        let mut pairs: Vec<(f64, f64)> = self
-            .targets
-            .iter()
-            .enumerate()
-            .map(|(k, &a)| (x_of(k, g), a))
-            .collect();
+        let mut pairs = self.pairs();
         self.repair.repair(&mut pairs, failure.at, failure.too_slow);
         self.targets = pairs.into_iter().map(|(_, a)| a).collect();
         true
+    }
+
+    /// The targets as (xₖ, a(xₖ)) pairs.
+    fn pairs(&self) -> Vec<(f64, f64)> {
+        let g = self.targets.len();
+        self.targets
+            .iter()
+            .enumerate()
+            .map(|(k, &a)| (x_of(k, g), a))
+            .collect()
     }
 }
 
