@@ -141,7 +141,7 @@ impl Method {
             }
             Method::Random => "Gaussian random search around the best point",
             Method::PatternSearch => {
-                "adaptive coordinate search around the best lap, repairing failed laps"
+                "the whole pedal pushed and repaired where laps fail, then coordinate search around the best lap"
             }
         }
     }
