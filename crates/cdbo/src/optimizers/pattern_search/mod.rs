@@ -20,8 +20,8 @@
 //!   search moves to the next block.
 //!
 //! The blocks are visited in a fresh random order each sweep; a step that has shrunk below
-//! σ₀/16 starts the next sweep at ±σ₀ again. Only the lap's reward and where it failed are
-//! used: what a car's lap timer gives.
+//! σ₀/16 starts the next sweep at ±σ₀ again. Only the lap's reward, where it failed and
+//! whether the car stalled there are used: what a car's lap timer and driver give.
 //!
 //! **Sharpening sweeps.** One weight's pedal, wᵢφᵢ(x), is a bump two kernel spacings wide: a
 //! braking point sharper than that needs neighbours of opposite signs (the ceiling's fitted
@@ -43,9 +43,10 @@
 //! **The push** ([`push`]). When the weights are a lap policy's (its length-scale is told), the
 //! search begins, after the start lap, by raising the whole pedal by U₀ ≈ 0.35 and repairing
 //! the pushed lap corner by corner where it fails, as the ceiling repairs its fit, then by
-//! U₀/2, U₀/4, U₀/8 while the pushes are kept; after a kept push the sweeps begin at single weights (the pushed lap is near
-//! the limit everywhere, where blocks of 8 mostly fail). Measured on the training panels: 34.86
-//! against 32.80 m/s, with σ₀ re-swept to 0.12 (docs/results/beyond).
+//! U₀/2, U₀/4, U₀/8 while the pushes are kept; after a kept push the sweeps begin at single
+//! weights (the pushed lap is near the limit everywhere, where blocks of 8 mostly fail).
+//! Measured on the training panels: 34.86 against 32.80 m/s, with σ₀ re-swept to 0.12
+//! (docs/results/beyond).
 
 pub mod push;
 
