@@ -62,6 +62,7 @@ fn study_config() -> StudyConfig {
         beta: 1.0,
         w0: vec![0.2, 0.3, -0.1, 0.4, 0.1],
         track: None,
+        track_length: None,
     }
 }
 

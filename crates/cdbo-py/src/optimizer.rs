@@ -15,15 +15,17 @@ use crate::convert::{IntoPy, array, lock, vector};
 /// An ask/tell optimiser of rewards over weights, started from w0.
 ///
 /// `Optimizer(method, w0, seed=0, beta=1.0, bounds=1.5, sigma0=None, knob=None,
-/// lengthscale=None)`: `method` is
+/// lengthscale=None, track_length=None)`: `method` is
 /// one of `cdbo.METHODS`; the weights are searched in the box [w0 - bounds, w0 + bounds];
 /// `sigma0` is the exploration scale around w0 (CDBO's initial samples, the evolution
 /// strategies' step); `knob` is the method's main knob (`cdbo race --knob`: σ₀ for CMA-ES,
 /// random and pattern search, TuRBO's initial trust-region side, LineBO's step, REMBO's box),
 /// checked against its range; `lengthscale`, when w0 are a lap policy's weights, is its
 /// kernels' length-scale (`RaceEnv.lengthscale`; pattern search then pushes the policy's
-/// pedal). With the defaults and the policy's length-scale, it is `cdbo race`'s optimiser
-/// (each knob at its tuned value), so the same seed asks the same weights.
+/// pedal) and `track_length` the lap's length in metres (`RaceEnv.track_length`; the push then
+/// repairs over road). With the defaults, the policy's length-scale and the lap's length, it
+/// is `cdbo race`'s optimiser (each knob at its tuned value), so the same seed asks the same
+/// weights.
 #[pyclass(name = "Optimizer", module = "cdbo")]
 pub struct PyOptimizer {
     inner: Mutex<Box<dyn Optimizer + Send>>,
@@ -43,7 +45,7 @@ impl PyOptimizer {
 #[pymethods]
 impl PyOptimizer {
     #[new]
-    #[pyo3(signature = (method, w0, *, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, bounds = DEFAULT_BOX_RADIUS, sigma0 = None, knob = None, lengthscale = None))]
+    #[pyo3(signature = (method, w0, *, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, bounds = DEFAULT_BOX_RADIUS, sigma0 = None, knob = None, lengthscale = None, track_length = None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -55,6 +57,7 @@ impl PyOptimizer {
         sigma0: Option<f64>,
         knob: Option<f64>,
         lengthscale: Option<f64>,
+        track_length: Option<f64>,
     ) -> PyResult<Self> {
         let w0 = vector(w0, "w0")?;
         let method: Method = method.parse().py()?;
@@ -63,6 +66,7 @@ impl PyOptimizer {
             box_radius: bounds,
             sigma0: sigma0.unwrap_or(race.sigma0),
             policy_lengthscale: lengthscale,
+            track_length,
             ..race
         };
         if let Some(value) = knob {

@@ -63,8 +63,10 @@ impl PyTrial {
 /// A persistent ask/tell study: one SQLite file, the same as `cdbo study` reads and writes,
 /// so a study created here can be driven by the command line and back.
 ///
-/// `Study.create(path, w0, method="cdbo", lengthscale=None, seed=0, beta=1.0)` (M = len(w0)
-/// kernels, length-scale 1/(M − 1) by default), `Study.open(path)`; then `ask()` → `Trial`,
+/// `Study.create(path, w0, method="cdbo", lengthscale=None, seed=0, beta=1.0,
+/// track_length=None)` (M = len(w0) kernels, length-scale 1/(M − 1) by default; the lap's
+/// length in metres, if known, lets pattern search repair over road), `Study.open(path)`;
+/// then `ask()` → `Trial`,
 /// `tell(trial, reward)`, `tell(trial, lap_time=T, length=L)` or `tell(trial, failed=True,
 /// at=x, reason=...)`; every told result is on disk when `tell` returns.
 #[pyclass(name = "Study", module = "cdbo")]
@@ -75,7 +77,7 @@ pub struct PyStudy {
 #[pymethods]
 impl PyStudy {
     #[classmethod]
-    #[pyo3(signature = (path, w0, *, method = "cdbo", lengthscale = None, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA))]
+    #[pyo3(signature = (path, w0, *, method = "cdbo", lengthscale = None, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, track_length = None))]
     #[allow(clippy::too_many_arguments)]
     fn create(
         _cls: &Bound<'_, PyType>,
@@ -86,6 +88,7 @@ impl PyStudy {
         lengthscale: Option<f64>,
         seed: u64,
         beta: f64,
+        track_length: Option<f64>,
     ) -> PyResult<Self> {
         let w0 = vector(w0, "w0")?;
         let config = StudyConfig {
@@ -96,6 +99,7 @@ impl PyStudy {
             beta,
             w0,
             track: None,
+            track_length,
         };
         let study = py.detach(|| Study::create(&path, config)).py()?;
         Ok(PyStudy {

@@ -39,7 +39,14 @@ def test_a_python_loop_over_optimizer_and_env_is_the_librarys_race(method, knob)
     result = cdbo.race("ridgeway", method=method, kernels=20, laps=laps, seed=5, knob=knob)
     env = cdbo.RaceEnv("ridgeway", kernels=20)
     assert np.array_equal(env.w0, result.initial.weights)
-    opt = cdbo.Optimizer(method, env.w0, seed=5, knob=knob, lengthscale=env.lengthscale)
+    opt = cdbo.Optimizer(
+        method,
+        env.w0,
+        seed=5,
+        knob=knob,
+        lengthscale=env.lengthscale,
+        track_length=env.track_length,
+    )
     rewards = []
     for _ in range(laps):
         env.reset()

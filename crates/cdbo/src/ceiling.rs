@@ -131,23 +131,41 @@ pub struct PedalRepair {
     pub step: f64,
     /// The last repair's failure place and direction (±1).
     pub last: Option<(f64, f64)>,
+    /// The stretch before a failure that a repair moves (lap fraction); `None`:
+    /// [`REPAIR_SPACINGS`] kernel spacings (the ceiling's, and repairs saved before it was set).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub window: Option<f64>,
 }
 
 impl PedalRepair {
-    /// Repairs of an M-kernel fit, at δ₀ = [`REPAIR_STEP`].
+    /// Repairs of an M-kernel fit, at δ₀ = [`REPAIR_STEP`], over [`REPAIR_SPACINGS`] spacings.
     pub fn new(kernels: usize) -> PedalRepair {
         PedalRepair {
             spacing: default_lengthscale(kernels),
             step: REPAIR_STEP,
             last: None,
+            window: None,
         }
     }
 
-    /// Moves the targets (x, a) with x ∈ [x_f − [`REPAIR_SPACINGS`]·spacing, x_f] by ±δ for a
-    /// lap that failed at x_f: down where the car was too fast (off the road, spun,
-    /// backwards), up where it was `too_slow` (stalled, time limit); halving δ first if the
-    /// last failure lay within one spacing and asked for the other direction, or restoring δ₀
-    /// if it lay more than one spacing before x_f.
+    /// These repairs over a stretch of `window` (lap fraction) before each failure.
+    pub fn over(self, window: f64) -> PedalRepair {
+        PedalRepair {
+            window: Some(window),
+            ..self
+        }
+    }
+
+    /// The stretch before a failure that a repair moves (lap fraction).
+    pub fn window(&self) -> f64 {
+        self.window.unwrap_or(REPAIR_SPACINGS * self.spacing)
+    }
+
+    /// Moves the targets (x, a) with x ∈ [x_f − [`window`](Self::window), x_f] by ±δ for a lap
+    /// that failed at x_f: down where the car was too fast (off the road, spun, backwards), up
+    /// where it was `too_slow` (stalled, time limit); halving δ first if the last failure lay
+    /// within one spacing and asked for the other direction, or restoring δ₀ if it lay more
+    /// than one spacing before x_f.
     pub fn repair(&mut self, targets: &mut [(f64, f64)], x_fail: f64, too_slow: bool) {
         let direction = if too_slow { 1.0 } else { -1.0 };
         match self.last {
@@ -158,7 +176,7 @@ impl PedalRepair {
             _ => self.step = REPAIR_STEP,
         }
         self.last = Some((x_fail, direction));
-        let from = x_fail - REPAIR_SPACINGS * self.spacing;
+        let from = x_fail - self.window();
         for (x, a) in targets.iter_mut() {
             if (from..=x_fail).contains(x) {
                 *a += direction * self.step;
@@ -296,5 +314,13 @@ mod tests {
         repair.repair(&mut targets, 0.8, FailureReason::OffTrack.too_slow());
         assert_eq!(repair.step, REPAIR_STEP);
         assert!(close(targets[80].1, 0.4) && close(targets[57].1, 0.5));
+        // Over a window of its own: 0.055 of the lap before the failure, not two spacings.
+        let mut narrow = PedalRepair::new(11).over(0.055);
+        let mut targets: Vec<(f64, f64)> = (0..=100).map(|i| (i as f64 / 100.0, 0.5)).collect();
+        narrow.repair(&mut targets, 0.5, FailureReason::Spun.too_slow());
+        for (i, &(x, a)) in targets.iter().enumerate() {
+            let moved = (45..=50).contains(&i);
+            assert!(close(a, if moved { 0.4 } else { 0.5 }), "x {x}: {a}");
+        }
     }
 }

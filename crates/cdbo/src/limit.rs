@@ -37,6 +37,13 @@ pub struct Limit {
     pub speed: Vec<f64>,
 }
 
+impl Limit {
+    /// The lap's length L = R·T (m).
+    pub fn track_length(&self) -> f64 {
+        self.reward_mps * self.lap_time_s
+    }
+}
+
 /// Computes the QSS limit lap of `car` on `track`.
 pub fn limit_lap(track: &Track, car: &Car) -> Limit {
     let n = track.len();
@@ -186,6 +193,7 @@ mod tests {
             lateral <= grip && lateral > 0.97 * grip,
             "v {v}: {lateral} vs {grip}"
         );
+        assert!((lim.track_length() - std::f64::consts::TAU * r).abs() < 1e-9);
     }
 
     #[test]

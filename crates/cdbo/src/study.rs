@@ -72,6 +72,10 @@ pub struct StudyConfig {
     /// in studies made before it was recorded, and left out of the stored settings then).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub track: Option<String>,
+    /// The lap's length (m), where the user told it (the pattern search's push repairs over
+    /// road then; absent in studies made before it was recorded).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub track_length: Option<f64>,
 }
 
 /// One trial of a study.
@@ -117,11 +121,13 @@ impl Study {
                 config.w0.len(),
             ));
         }
-        // Fails on a bad method or w₀ before anything is written.
-        let optimizer = config.method.optimizer(
-            config.w0.clone(),
-            &Settings::race(config.method, config.seed, config.beta).for_policy(config.lengthscale),
-        )?;
+        // Fails on a bad method, w₀ or lap length before anything is written.
+        let mut settings =
+            Settings::race(config.method, config.seed, config.beta).for_policy(config.lengthscale);
+        if let Some(length) = config.track_length {
+            settings = settings.on_track(length);
+        }
+        let optimizer = config.method.optimizer(config.w0.clone(), &settings)?;
         let dump = Dump {
             config: serde_json::to_string(&config).map_err(|e| Error::json("study settings", e))?,
             optimizer: serde_json::to_string(&optimizer.save())
@@ -526,6 +532,7 @@ mod tests {
             beta: 1.0,
             w0: vec![0.1, 0.2, 0.3],
             track: None,
+            track_length: None,
         }
     }
 

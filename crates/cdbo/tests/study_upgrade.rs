@@ -25,6 +25,7 @@ fn config() -> StudyConfig {
         beta: 1.0,
         w0: vec![0.1, -0.2, 0.3, 0.05],
         track: None,
+        track_length: None,
     }
 }
 

@@ -57,6 +57,10 @@ pub struct InitialPolicy {
     /// Policy length-scale (default 1/(M − 1)).
     #[arg(long, allow_negative_numbers = true, value_parser = super::value::positive)]
     lengthscale: Option<f64>,
+    /// The lap's length in metres, if known: pattern search's push then repairs a failed lap
+    /// over the 275 m of road before the failure (otherwise over two kernel spacings).
+    #[arg(long, value_name = "METRES", allow_negative_numbers = true, value_parser = super::value::positive)]
+    track_length: Option<f64>,
     /// Optimiser (default cdbo).
     #[arg(long)]
     method: Option<Method>,
@@ -105,6 +109,7 @@ impl InitialPolicy {
             beta: self.beta.unwrap_or(cdbo::acquisition::ucb::DEFAULT_BETA),
             w0: policy.weights,
             track: None,
+            track_length: self.track_length,
         })
     }
 
@@ -139,6 +144,15 @@ impl InitialPolicy {
                 l.to_string(),
                 stored.lengthscale.to_string(),
             );
+        }
+        if let Some(l) = self
+            .track_length
+            .filter(|l| Some(*l) != stored.track_length)
+        {
+            let kept = stored
+                .track_length
+                .map_or("no --track-length".into(), |k| k.to_string());
+            return differs("--track-length", l.to_string(), kept);
         }
         Ok(())
     }

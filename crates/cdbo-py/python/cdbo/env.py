@@ -54,6 +54,8 @@ class RaceEnv(_Base):
     truncated, info)`` with ``terminated=True``: each episode is one lap. The observation is
     a constant (there is nothing to observe before a lap). ``action_space`` is the box
     [w0 - bounds, w0 + bounds] the library's optimisers search; the weights are not clipped.
+    ``w0``, ``lengthscale`` and ``track_length`` (m) are what ``cdbo.Optimizer`` is told to
+    race as ``cdbo race`` does.
     """
 
     metadata = {"render_modes": []}
@@ -78,6 +80,7 @@ class RaceEnv(_Base):
         self.initial = Policy.fit(x, a, kernels)
         self.w0 = self.initial.weights
         self.lengthscale = self.initial.lengthscale
+        self.track_length = self.simulator.track.length
         self.action_space = _box(self.w0 - bounds, self.w0 + bounds)
         self.observation_space = _box(np.zeros(1), np.ones(1))
         self.last = None

@@ -135,6 +135,9 @@ pub struct Settings {
     /// and studies; the pattern search pushes that policy's pedal); `None` for any other
     /// problem.
     pub policy_lengthscale: Option<f64>,
+    /// The lap's length (m) when the weights are a lap policy's and it is known (races, and
+    /// studies that record it): the pattern search's push repairs over road rather than kernels.
+    pub track_length: Option<f64>,
 }
 
 impl Settings {
@@ -151,6 +154,7 @@ impl Settings {
             sigma0: registry::PAPER_SIGMA0,
             knob: None,
             policy_lengthscale: None,
+            track_length: None,
         }
         .with_knob_unchecked(method, knob.value)
     }
@@ -184,6 +188,14 @@ impl Settings {
         }
     }
 
+    /// These settings for a lap of `length` metres.
+    pub fn on_track(self, length: f64) -> Settings {
+        Settings {
+            track_length: Some(length),
+            ..self
+        }
+    }
+
     /// For a test problem on a box of half-width r: σ₀ = r/15.
     pub fn problem(seed: u64, box_radius: f64) -> Settings {
         Settings {
@@ -193,6 +205,7 @@ impl Settings {
             sigma0: box_radius / 15.0,
             knob: None,
             policy_lengthscale: None,
+            track_length: None,
         }
     }
 }
@@ -212,6 +225,7 @@ impl Method {
             sigma0,
             knob,
             policy_lengthscale,
+            track_length,
         } = *settings;
         let bo = |maximiser| bo::BoConfig {
             seed,
@@ -283,6 +297,7 @@ impl Method {
                     box_radius,
                     repair: true,
                     lengthscale: policy_lengthscale,
+                    track_length,
                     ..pattern_search::PatternSearchConfig::default()
                 },
             )?),

@@ -45,8 +45,9 @@
 //! the pushed lap corner by corner where it fails, as the ceiling repairs its fit, then by
 //! U₀/2, U₀/4, U₀/8 while the pushes are kept; after a kept push the sweeps begin at single
 //! weights (the pushed lap is near the limit everywhere, where blocks of 8 mostly fail).
-//! Measured on the training panels: 34.86 against 32.80 m/s, with σ₀ re-swept to 0.12
-//! (docs/results/beyond).
+//! Measured on the training panels: 34.86 against 32.80 m/s, with σ₀ re-swept to 0.12; with
+//! the lap's length told, repairs over 275 m of road and later pushes holding what a kept one
+//! lowered, 35.62 (docs/results/beyond).
 
 pub mod push;
 
@@ -91,6 +92,10 @@ pub struct PatternSearchConfig {
     /// it (without it, no push).
     #[serde(default)]
     pub lengthscale: Option<f64>,
+    /// The lap's length (m), when told: the push repairs over [`push::REPAIR_DISTANCE`] m of
+    /// road before a failure (without it, over two kernel spacings).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub track_length: Option<f64>,
 }
 
 /// Blocks of one weight and one repair: the settings of a search saved before they existed.
@@ -117,6 +122,7 @@ impl Default for PatternSearchConfig {
             rest: true,
             push: push::SIZE,
             lengthscale: None,
+            track_length: None,
         }
     }
 }
@@ -255,16 +261,13 @@ impl PatternSearch {
                 "0 or more",
             ));
         }
-        if let Some(l) = state
-            .config
-            .lengthscale
-            .filter(|l| !(l.is_finite() && *l > 0.0))
-        {
-            return Err(Error::invalid_value(
-                "the policy's length-scale",
-                l,
-                "positive",
-            ));
+        for (what, value) in [
+            ("the policy's length-scale", state.config.lengthscale),
+            ("the lap's length (m)", state.config.track_length),
+        ] {
+            if let Some(v) = value.filter(|v| !(v.is_finite() && *v > 0.0)) {
+                return Err(Error::invalid_value(what, v, "positive"));
+            }
         }
         if !(state.config.give_back.is_finite() && state.config.give_back > 0.0) {
             return Err(Error::invalid_value(
@@ -283,6 +286,10 @@ impl PatternSearch {
                 // Saved before rests existed.
                 *rests = vec![Rest::default(); n];
             }
+        }
+        if let Some(push) = state.push.as_mut().filter(|p| p.repaired.is_empty()) {
+            // Saved before pushes held their lowered targets.
+            push.repaired = vec![0.0; push.targets.len()];
         }
         if state.steps.len() != n
             || state.sharp_steps.len() != n
@@ -327,8 +334,9 @@ impl PatternSearch {
         self.state.best.get().map_or(&self.state.start[..], |b| b.0)
     }
 
-    /// Push `number` from the best lap, if this search pushes and has not pushed that often.
-    fn begin_push(&mut self, number: u32) -> Result<Option<Push>> {
+    /// Push `number` from the best lap after the kept push `previous`, if this search pushes
+    /// and has not pushed that often.
+    fn begin_push(&self, number: u32, previous: Option<&Push>) -> Result<Option<Push>> {
         let c = &self.state.config;
         let n = self.state.start.len();
         match (c.lengthscale, self.state.best.get()) {
@@ -337,16 +345,17 @@ impl PatternSearch {
                     && number <= push::PUSHES
                     && (2..=push::MAX_KERNELS).contains(&n) =>
             {
-                Push::begin(number, best, l, c.push, c.seed).map(Some)
+                Push::begin(number, best, l, c, previous).map(Some)
             }
             _ => Ok(None),
         }
     }
 
-    /// The next push, or the sweeps once the pushes are done: from single weights after a kept
-    /// push, from the widest blocks otherwise.
-    fn push_or_sweep(&mut self, number: u32) -> Result<()> {
-        self.state.push = self.begin_push(number)?;
+    /// The next push (number `number`, after the kept push `previous`), or the sweeps once the
+    /// pushes are done: from single weights after a kept push, from the widest blocks
+    /// otherwise.
+    fn push_or_sweep(&mut self, number: u32, previous: Option<&Push>) -> Result<()> {
+        self.state.push = self.begin_push(number, previous)?;
         if self.state.push.is_some() {
             self.state.next = Trial::Push;
         } else {
@@ -551,7 +560,7 @@ impl Optimizer for PatternSearch {
         let failed_at = failure.map(|f| f.at);
         let repair = self.state.config.repair;
         match self.state.next.clone() {
-            Trial::Start => self.push_or_sweep(1)?,
+            Trial::Start => self.push_or_sweep(1, None)?,
             Trial::Push => {
                 let Some(mut push) = self.state.push.take() else {
                     return Err(Error::CorruptState {
@@ -562,11 +571,11 @@ impl Optimizer for PatternSearch {
                 push.laps += 1;
                 if better {
                     self.state.pushed = true;
-                    self.push_or_sweep(push.number + 1)?;
+                    self.push_or_sweep(push.number + 1, Some(&push))?;
                 } else if failure.is_some_and(|f| push.repair(f)) {
                     self.state.push = Some(push);
                 } else {
-                    self.push_or_sweep(push::PUSHES + 1)?;
+                    self.push_or_sweep(push::PUSHES + 1, None)?;
                 }
             }
             Trial::Step { weight } | Trial::Repair { weight, .. } if better => {
