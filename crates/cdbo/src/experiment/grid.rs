@@ -339,7 +339,7 @@ mod tests {
         assert_eq!(plus.runs().len(), 6 * 9 * 4);
         assert_eq!(plus.knob.get(&Method::Random), Some(&0.01));
         assert_eq!(plus.knob.get(&Method::Cmaes), Some(&0.03));
-        assert_eq!(plus.knob.get(&Method::PatternSearch), Some(&0.12));
+        assert_eq!(plus.knob.get(&Method::PatternSearch), Some(&0.05));
         assert_eq!(plus.knob.get(&Method::Turbo), Some(&0.03));
         assert_eq!(plus.knob.get(&Method::Linebo), Some(&0.3));
         assert_eq!(plus.knob.get(&Method::Rembo5d), Some(&0.1));

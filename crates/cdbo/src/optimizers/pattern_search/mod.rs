@@ -45,9 +45,9 @@
 //! the pushed lap corner by corner where it fails, as the ceiling repairs its fit, then by
 //! U₀/2, U₀/4, U₀/8 while the pushes are kept; after a kept push the sweeps begin at single
 //! weights (the pushed lap is near the limit everywhere, where blocks of 8 mostly fail).
-//! Measured on the training panels: 34.86 against 32.80 m/s, with σ₀ re-swept to 0.12; with
-//! the lap's length told, repairs over 275 m of road and later pushes holding what a kept one
-//! lowered, 35.62 (docs/results/beyond).
+//! Measured on the training panels: 34.86 against 32.80 m/s (σ₀ 0.12); with the lap's length
+//! told, repairs over 275 m of road and later pushes holding what a kept one lowered, 35.62,
+//! and 35.68 with σ₀ re-swept to 0.05 (docs/results/beyond).
 
 pub mod push;
 
