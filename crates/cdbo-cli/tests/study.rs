@@ -159,6 +159,28 @@ fn ask_tell_workflow_and_bad_input() {
         !dir.join("w.cdbo.db").exists(),
         "a failed create left a file"
     );
+    let with_length = |metres: &'static str| {
+        [
+            "study",
+            "create",
+            "fast",
+            "--kernels",
+            "5",
+            "--demo",
+            "demo.csv",
+            "--method",
+            "pattern-search",
+            "--track-length",
+            metres,
+        ]
+    };
+    fails(&dir, &with_length("0"), "--track-length");
+    fails(&dir, &with_length("NaN"), "--track-length");
+    ok(&dir, &with_length("3596"));
+    let stored: serde_json::Value =
+        serde_json::from_str(&ok(&dir, &["study", "status", "fast", "--json"])).unwrap();
+    assert_eq!(stored["track_length_m"], 3596.0);
+    assert_eq!(status["track_length_m"], serde_json::Value::Null);
 }
 
 #[test]

@@ -632,3 +632,62 @@ fn with_the_push_it_beats_random_search_on_the_pedal_cliff() {
         );
     }
 }
+
+/// A study told the lap's length drives the laps `cdbo race` drives, lap for lap (its push
+/// repairs over the same road); one created without it repairs over two kernel spacings and
+/// parts ways with the race once a pushed lap fails.
+#[test]
+fn a_study_told_the_laps_length_drives_the_races_laps() {
+    use cdbo::evaluator::Outcome;
+    use cdbo::experiment::race::{RaceConfig, race};
+    use cdbo::study::{Study, StudyConfig};
+
+    let track = || cdbo::track::builtin::load("ridgeway").unwrap().unwrap();
+    let car = cdbo::car::Car::spirit_300();
+    let config = RaceConfig {
+        method: Method::PatternSearch,
+        kernels: 12,
+        laps: 25,
+        seed: 3,
+        ..RaceConfig::default()
+    };
+    let raced = race(track(), &car, &config, |_| {}).unwrap();
+    let race_rewards: Vec<f64> = raced.laps.iter().map(|l| l.reward_mps).collect();
+    assert!(race_rewards[1..].contains(&0.0), "no pushed lap failed");
+    let sim = cdbo::sim::Simulator::new(track(), &car);
+    let length = sim.track.length;
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("study_like_race");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    for (name, track_length) in [("told", Some(length)), ("untold", None)] {
+        let mut study = Study::create(
+            &dir.join(format!("{name}.cdbo.db")),
+            StudyConfig {
+                method: config.method,
+                kernels: config.kernels,
+                lengthscale: raced.initial.lengthscale,
+                seed: config.seed,
+                beta: config.beta,
+                w0: raced.initial.weights.clone(),
+                track: None,
+                track_length,
+            },
+        )
+        .unwrap();
+        let rewards: Vec<f64> = (0..config.laps)
+            .map(|_| {
+                let trial = study.ask().unwrap();
+                let policy = RkhsPolicy::new(trial.weights, raced.initial.lengthscale).unwrap();
+                let lap = sim.lap(&mut policy.pedal());
+                study
+                    .tell(trial.id, &Outcome::of_lap(&lap, length))
+                    .unwrap()
+            })
+            .collect();
+        assert_eq!(
+            rewards == race_rewards,
+            track_length.is_some(),
+            "{name}: {rewards:?} against the race's {race_rewards:?}"
+        );
+    }
+}

@@ -399,6 +399,7 @@ fn status(s: &Study, json: bool) -> CliResult {
         "study": s.path().display().to_string(),
         "method": c.method,
         "kernels": c.kernels,
+        "track_length_m": c.track_length,
         "told": told,
         "failed": failed,
         "pending_trial": pending,
@@ -410,10 +411,12 @@ fn status(s: &Study, json: bool) -> CliResult {
         return print_json(&v);
     }
     println!(
-        "{}: {} with {} kernels; {told} trials told ({failed} failed){}; best {}",
+        "{}: {} with {} kernels{}; {told} trials told ({failed} failed){}; best {}",
         s.path().display(),
         c.method,
         c.kernels,
+        c.track_length
+            .map_or(String::new(), |l| format!(" on a {l} m lap")),
         pending.map_or(String::new(), |p| format!(", trial {p} pending")),
         best.map_or("none yet".into(), |t| format!(
             "{:.4} (trial {})",
