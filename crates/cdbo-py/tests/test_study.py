@@ -54,6 +54,30 @@ def test_a_study_asks_what_the_optimizer_asks():
         opt.tell(w, float(-i))
 
 
+def test_a_study_told_the_laps_length_asks_what_the_optimizer_asks(tmp_path):
+    env = cdbo.RaceEnv("ridgeway", kernels=12)
+    told = dict(lengthscale=env.lengthscale, track_length=env.track_length, seed=3)
+    study = cdbo.Study.create(tmp_path / "s.db", env.w0, method="pattern-search", **told)
+    opt = cdbo.Optimizer("pattern-search", env.w0, **told)
+    failed = 0
+    for _ in range(12):
+        t = study.ask()
+        w = opt.ask()
+        assert np.array_equal(t.weights, w)
+        _, reward, _, _, info = env.step(w)
+        if info["completed"]:
+            study.tell(t, reward)
+        else:
+            failed += 1
+            study.tell(t, failed=True, at=info["x_fail"], reason=info["failure"])
+        opt.tell(w, reward, failed_at=info["x_fail"], too_slow=info["too_slow"])
+    assert failed > 0
+    for bad in (0.0, -5.0, math.nan):
+        with pytest.raises(ValueError, match="lap's length"):
+            cdbo.Study.create(tmp_path / "bad.db", env.w0, track_length=bad)
+        assert not (tmp_path / "bad.db").exists()
+
+
 def test_history_is_a_list_of_dicts_or_a_dataframe(tmp_path):
     study = cdbo.Study.create(tmp_path / "h.db", np.zeros(3))
     t = study.ask()

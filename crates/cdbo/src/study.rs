@@ -121,7 +121,14 @@ impl Study {
                 config.w0.len(),
             ));
         }
-        // Fails on a bad method, w₀ or lap length before anything is written.
+        if let Some(length) = config.track_length.filter(|l| !(l.is_finite() && *l > 0.0)) {
+            return Err(Error::invalid_value(
+                "the lap's length (m)",
+                length,
+                "a positive number of metres",
+            ));
+        }
+        // Fails on a bad method or w₀ before anything is written.
         let mut settings =
             Settings::race(config.method, config.seed, config.beta).for_policy(config.lengthscale);
         if let Some(length) = config.track_length {
@@ -581,6 +588,25 @@ mod tests {
         assert_eq!(s.history().unwrap().len(), 2);
         assert_eq!(s.best().unwrap().unwrap().reward, Some(25.0));
         assert!(Study::create(&path, config()).is_err());
+    }
+
+    /// A lap length that is not a positive number of metres is refused, whatever the method,
+    /// and nothing is written.
+    #[test]
+    fn a_bad_lap_length_is_refused_before_anything_is_written() {
+        for (k, length) in [0.0, -3.0, f64::NAN, f64::INFINITY].into_iter().enumerate() {
+            let path = temp(&format!("length-{k}"));
+            let bad = StudyConfig {
+                track_length: Some(length),
+                ..config()
+            };
+            let Err(e) = Study::create(&path, bad).map(|_| ()) else {
+                panic!("{length}: created");
+            };
+            let e = e.to_string();
+            assert!(e.contains("lap's length"), "{length}: {e}");
+            assert!(!path.exists(), "{length}: a file was written");
+        }
     }
 
     #[test]
