@@ -35,8 +35,9 @@ use crate::error::Result;
 use crate::policy::RkhsPolicy;
 use crate::policy::rkhs::DEFAULT_RIDGE;
 
-/// The first push's size U₀ (pedal units), chosen by a sweep on the training panels
-/// (docs/results/beyond).
+/// The first push's size U₀ (pedal units), chosen by a sweep on the training panels and
+/// checked again with repairs over road (0.25 / 0.3 / 0.35 / 0.4 / 0.45: 34.22 / 35.01 /
+/// 35.68 / 34.96 / 35.13 m/s; docs/results/beyond).
 pub const SIZE: f64 = 0.35;
 /// Pushes at most: U₀, then U₀/2, U₀/4, U₀/8, each after a kept one (chosen on the training
 /// panels: 2, 3, 4, 6 pushes gave 34.54, 34.81, 34.86, 34.86 m/s; with repairs over road, 1,
