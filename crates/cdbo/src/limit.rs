@@ -35,13 +35,9 @@ pub struct Limit {
     /// Limit speed at each track sample (m/s), plus the finish.
     #[serde(skip)]
     pub speed: Vec<f64>,
-}
-
-impl Limit {
-    /// The lap's length L = R·T (m).
-    pub fn track_length(&self) -> f64 {
-        self.reward_mps * self.lap_time_s
-    }
+    /// The lap's length L (m), R = L/T.
+    #[serde(skip)]
+    pub track_length: f64,
 }
 
 /// Computes the QSS limit lap of `car` on `track`.
@@ -153,6 +149,7 @@ pub fn limit_lap(track: &Track, car: &Car) -> Limit {
     Limit {
         lap_time_s: lap_time,
         reward_mps: track.length / lap_time,
+        track_length: track.length,
         speed: v,
     }
 }
@@ -193,7 +190,8 @@ mod tests {
             lateral <= grip && lateral > 0.97 * grip,
             "v {v}: {lateral} vs {grip}"
         );
-        assert!((lim.track_length() - std::f64::consts::TAU * r).abs() < 1e-9);
+        assert_eq!(lim.track_length, t.length);
+        assert!((lim.reward_mps * lim.lap_time_s - std::f64::consts::TAU * r).abs() < 1e-9);
     }
 
     #[test]

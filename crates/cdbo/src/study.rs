@@ -121,14 +121,7 @@ impl Study {
                 config.w0.len(),
             ));
         }
-        if let Some(length) = config.track_length.filter(|l| !(l.is_finite() && *l > 0.0)) {
-            return Err(Error::invalid_value(
-                "the lap's length (m)",
-                length,
-                "a positive number of metres",
-            ));
-        }
-        // Fails on a bad method or w₀ before anything is written.
+        // Fails on a bad method, w₀ or lap length before anything is written.
         let mut settings =
             Settings::race(config.method, config.seed, config.beta).for_policy(config.lengthscale);
         if let Some(length) = config.track_length {

@@ -154,7 +154,7 @@ pub fn race_with(
     let initial = RkhsPolicy::fit(&demo_pairs, config.kernels, lengthscale, DEFAULT_RIDGE)?;
     let mut settings = crate::optimizers::Settings::race(config.method, config.seed, config.beta)
         .for_policy(lengthscale)
-        .on_track(limit.track_length());
+        .on_track(limit.track_length);
     if let Some(value) = config.knob {
         settings = settings.with_knob(config.method, value)?;
     }

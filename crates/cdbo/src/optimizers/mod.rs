@@ -227,6 +227,13 @@ impl Method {
             policy_lengthscale,
             track_length,
         } = *settings;
+        if let Some(length) = track_length.filter(|l| !(l.is_finite() && *l > 0.0)) {
+            return Err(Error::invalid_value(
+                "the lap's length (m)",
+                length,
+                "a positive number of metres",
+            ));
+        }
         let bo = |maximiser| bo::BoConfig {
             seed,
             acquisition: crate::acquisition::Acquisition::Ucb { beta },
