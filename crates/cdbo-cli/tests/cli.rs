@@ -438,7 +438,7 @@ fn bench_optimizers_compares_every_method() {
         .iter()
         .map(|r| r["method"].as_str().unwrap())
         .collect();
-    assert_eq!(methods, cdbo::optimizers::Method::ALL.map(|m| m.name()));
+    assert_eq!(methods, cdbo::method::Method::ALL.map(|m| m.name()));
     for r in results {
         assert!(
             r["mean_best"].as_f64().unwrap() <= 0.0 && r["stderr_best"].as_f64().unwrap() >= 0.0

@@ -55,7 +55,7 @@ const LENGTHSCALE: f64 = 0.25;
 
 fn study_config() -> StudyConfig {
     StudyConfig {
-        method: cdbo::optimizers::Method::Random,
+        method: cdbo::method::Method::Random,
         kernels: KERNELS,
         lengthscale: LENGTHSCALE,
         seed: 3,

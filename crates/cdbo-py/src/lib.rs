@@ -22,7 +22,7 @@ fn _cdbo(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add(
         "METHODS",
-        cdbo::optimizers::Method::ALL.map(|m| m.name()).to_vec(),
+        cdbo::method::Method::ALL.map(|m| m.name()).to_vec(),
     )?;
     m.add("DEFAULT_BETA", cdbo::acquisition::ucb::DEFAULT_BETA)?;
     m.add("DEFAULT_BOX_RADIUS", cdbo::optimizers::DEFAULT_BOX_RADIUS)?;

@@ -8,7 +8,8 @@ use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyType};
 
-use cdbo::optimizers::{DEFAULT_BOX_RADIUS, FailedLap, Method, Optimizer, Saved, Settings};
+use cdbo::method::{Method, Settings};
+use cdbo::optimizers::{DEFAULT_BOX_RADIUS, FailedLap, Optimizer, Saved};
 
 use crate::convert::{IntoPy, array, lock, vector};
 
@@ -154,7 +155,7 @@ impl PyOptimizer {
         let saved: Saved = serde_json::from_slice(state).map_err(|e| {
             pyo3::exceptions::PyValueError::new_err(format!("not a saved cdbo optimiser: {e}"))
         })?;
-        let inner = py.detach(|| saved.resume()).py()?;
+        let inner = py.detach(|| cdbo::method::resume(saved)).py()?;
         Ok(PyOptimizer::wrap(inner))
     }
 

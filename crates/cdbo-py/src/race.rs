@@ -107,7 +107,7 @@ pub fn race(
     let track = track_from(py, track, data_dir)?;
     let car = car_from(car, data_dir)?;
     let config = RaceConfig {
-        method: method.parse::<cdbo::optimizers::Method>().py()?,
+        method: method.parse::<cdbo::method::Method>().py()?,
         kernels,
         laps,
         seed,

@@ -92,7 +92,7 @@ impl PyStudy {
     ) -> PyResult<Self> {
         let w0 = vector(w0, "w0")?;
         let config = StudyConfig {
-            method: method.parse::<cdbo::optimizers::Method>().py()?,
+            method: method.parse::<cdbo::method::Method>().py()?,
             kernels: w0.len(),
             lengthscale: lengthscale.unwrap_or_else(|| default_lengthscale(w0.len())),
             seed,

@@ -9,15 +9,15 @@
 //!    monotone in k; the bisection keeps a completed k as its lower end, so the result is a
 //!    completed lap).
 //! 2. **The policy class**: the pedal of that lap, a(x), fitted by ridge regression with M
-//!    kernels (paper eq. 9), then **repaired where it fails**: while the fitted policy's lap
-//!    fails at x_f, the fit's targets over the [`REPAIR_SPACINGS`] kernel spacings before it,
-//!    x ∈ [x_f − 2/(M − 1), x_f], move by δ, down where the car was too fast (off the road,
-//!    spun, backwards) and up where it was too slow (stalled, past the time limit), and the
-//!    policy is fitted again. δ starts at δ₀ = [`REPAIR_STEP`], halves when the next failure
-//!    lies within one spacing of the last and asks for the other direction (a bisection of the
-//!    pedal there), and returns to δ₀ once a failure lies further on. The first completed lap
-//!    (within [`REPAIR_LAPS`] laps) gives the fitted policy, a lower bound of the M-kernel
-//!    policies' best.
+//!    kernels (paper eq. 9), then **repaired where it fails** ([`PedalRepair`]): while the
+//!    fitted policy's lap fails at x_f, the fit's targets over the [`REPAIR_SPACINGS`] kernel
+//!    spacings before it, x ∈ [x_f − 2/(M − 1), x_f], move by δ, down where the car was too
+//!    fast (off the road, spun, backwards) and up where it was too slow (stalled, past the
+//!    time limit), and the policy is fitted again. δ starts at δ₀ = [`REPAIR_STEP`], halves
+//!    when the next failure lies within one spacing of the last and asks for the other
+//!    direction (a bisection of the pedal there), and returns to δ₀ once a failure lies
+//!    further on. The first completed lap (within [`REPAIR_LAPS`] laps) gives the fitted
+//!    policy, a lower bound of the M-kernel policies' best.
 //!
 //!    Why a plain fit is not enough: the fitted pedal drives open loop. The tracker brakes
 //!    for about a second at −0.5…−1 and then holds its speed with a small pedal; M kernels
@@ -31,15 +31,19 @@
 //! Their rewards beside the limit's show how much of the gap to the limit is the steering's
 //! (limit → tracked profile) and the policy class's (tracked profile → fitted policy), and
 //! what is left to an optimiser.
+//!
+//! [`REPAIR_SPACINGS`]: crate::learner::repair::REPAIR_SPACINGS
+//! [`REPAIR_STEP`]: crate::learner::repair::REPAIR_STEP
 
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 use crate::car::Car;
 use crate::drive::{Observation, Pedal};
 use crate::error::{Error, Result};
+use crate::learner::repair::PedalRepair;
 use crate::limit::{Limit, limit_lap};
 use crate::policy::RkhsPolicy;
-use crate::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
+use crate::policy::rkhs::DEFAULT_RIDGE;
 use crate::sim::Simulator;
 use crate::track::Track;
 
@@ -52,10 +56,6 @@ pub const PREVIEW_S: f64 = 0.3;
 pub const TRACKER_FLOOR_MPS: f64 = 10.0;
 /// Bisection steps on k.
 pub const BISECTION_STEPS: usize = 14;
-/// The first step δ₀ of a repair of the fitted pedal.
-pub const REPAIR_STEP: f64 = 0.1;
-/// Kernel spacings 1/(M − 1) before a failure over which a repair moves the fit's targets.
-pub const REPAIR_SPACINGS: f64 = 2.0;
 /// Laps of fitted policies driven at most (the first fit and its repairs).
 pub const REPAIR_LAPS: usize = 150;
 
@@ -119,70 +119,6 @@ pub struct Ceiling {
     pub policy: Option<RkhsPolicy>,
     /// Repairs before it completed ([`REPAIR_LAPS`] if none did).
     pub repairs: usize,
-}
-
-/// The repairs of a fitted pedal's targets at the places its laps fail (step 2 of the
-/// ceiling): the step δ and the last failure's place and direction.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct PedalRepair {
-    /// The kernel spacing 1/(M − 1).
-    pub spacing: f64,
-    /// The current step δ.
-    pub step: f64,
-    /// The last repair's failure place and direction (±1).
-    pub last: Option<(f64, f64)>,
-    /// The stretch before a failure that a repair moves (lap fraction); `None`:
-    /// [`REPAIR_SPACINGS`] kernel spacings (the ceiling's, and repairs saved before it was set).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub window: Option<f64>,
-}
-
-impl PedalRepair {
-    /// Repairs of an M-kernel fit, at δ₀ = [`REPAIR_STEP`], over [`REPAIR_SPACINGS`] spacings.
-    pub fn new(kernels: usize) -> PedalRepair {
-        PedalRepair {
-            spacing: default_lengthscale(kernels),
-            step: REPAIR_STEP,
-            last: None,
-            window: None,
-        }
-    }
-
-    /// These repairs over a stretch of `window` (lap fraction) before each failure.
-    pub fn over(self, window: f64) -> PedalRepair {
-        PedalRepair {
-            window: Some(window),
-            ..self
-        }
-    }
-
-    /// The stretch before a failure that a repair moves (lap fraction).
-    pub fn window(&self) -> f64 {
-        self.window.unwrap_or(REPAIR_SPACINGS * self.spacing)
-    }
-
-    /// Moves the targets (x, a) with x ∈ [x_f − [`window`](Self::window), x_f] by ±δ for a lap
-    /// that failed at x_f: down where the car was too fast (off the road, spun, backwards), up
-    /// where it was `too_slow` (stalled, time limit); halving δ first if the last failure lay
-    /// within one spacing and asked for the other direction, or restoring δ₀ if it lay more
-    /// than one spacing before x_f.
-    pub fn repair(&mut self, targets: &mut [(f64, f64)], x_fail: f64, too_slow: bool) {
-        let direction = if too_slow { 1.0 } else { -1.0 };
-        match self.last {
-            Some((x, d)) if (x_fail - x).abs() < self.spacing && d != direction => {
-                self.step *= 0.5;
-            }
-            Some((x, _)) if x_fail <= x + self.spacing => {}
-            _ => self.step = REPAIR_STEP,
-        }
-        self.last = Some((x_fail, direction));
-        let from = x_fail - self.window();
-        for (x, a) in targets.iter_mut() {
-            if (from..=x_fail).contains(x) {
-                *a += direction * self.step;
-            }
-        }
-    }
 }
 
 /// The ceiling of `kernels`-kernel policies for `car` on `track`.
@@ -251,7 +187,6 @@ pub fn ceiling_with(sim: &Simulator, limit: &Limit, kernels: usize) -> Result<Ce
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sim::lap::FailureReason;
 
     /// The simulator on the built-in Ridgeway with the Spirit 300, and its limit lap.
     fn ridgeway() -> (Simulator, Limit) {
@@ -290,37 +225,5 @@ mod tests {
         assert!(lap.completed);
         assert_eq!(lap.reward_mps, c.policy_mps);
         assert!(c.policy_mps > 15.0 && c.policy_mps < c.limit_mps, "{c:?}");
-    }
-
-    /// A repair moves the targets over two spacings before the failure only, down for a spin
-    /// and up for a stall; a reversal within one spacing halves δ, a failure further on
-    /// restores δ₀.
-    #[test]
-    fn a_repair_moves_the_targets_before_the_failure() {
-        let mut repair = PedalRepair::new(11);
-        let mut targets: Vec<(f64, f64)> = (0..=100).map(|i| (i as f64 / 100.0, 0.5)).collect();
-        repair.repair(&mut targets, 0.5, FailureReason::Spun.too_slow());
-        let close = |a: f64, b: f64| (a - b).abs() < 1e-12;
-        for (i, &(x, a)) in targets.iter().enumerate() {
-            let moved = (30..=50).contains(&i);
-            assert!(close(a, if moved { 0.4 } else { 0.5 }), "x {x}: {a}");
-        }
-        repair.repair(&mut targets, 0.52, FailureReason::Stalled.too_slow());
-        assert_eq!(repair.step, REPAIR_STEP / 2.0);
-        assert!(close(targets[51].1, 0.55) && close(targets[50].1, 0.45));
-        assert!(close(targets[31].1, 0.4) && close(targets[32].1, 0.45));
-        repair.repair(&mut targets, 0.53, FailureReason::Stalled.too_slow());
-        assert_eq!(repair.step, REPAIR_STEP / 2.0);
-        repair.repair(&mut targets, 0.8, FailureReason::OffTrack.too_slow());
-        assert_eq!(repair.step, REPAIR_STEP);
-        assert!(close(targets[80].1, 0.4) && close(targets[57].1, 0.5));
-        // Over a window of its own: 0.055 of the lap before the failure, not two spacings.
-        let mut narrow = PedalRepair::new(11).over(0.055);
-        let mut targets: Vec<(f64, f64)> = (0..=100).map(|i| (i as f64 / 100.0, 0.5)).collect();
-        narrow.repair(&mut targets, 0.5, FailureReason::Spun.too_slow());
-        for (i, &(x, a)) in targets.iter().enumerate() {
-            let moved = (45..=50).contains(&i);
-            assert!(close(a, if moved { 0.4 } else { 0.5 }), "x {x}: {a}");
-        }
     }
 }

@@ -10,14 +10,16 @@
 //! - [`drive`]: the environment's controllers (steering, demonstrator).
 //! - [`limit`]: the quasi-steady-state minimum lap time.
 //! - [`policy`]: policies π(x), the paper's RKHS policy and (x, a) tables.
-//! - [`gp`], [`acquisition`], [`optimizers`]: the Gaussian process, UCB / EI and the ask/tell
-//!   optimisers, CDBO first.
+//! - [`gp`], [`acquisition`], [`optimizers`]: the Gaussian process, UCB / EI and the generic
+//!   ask/tell optimisers of weights in Rᵈ, CDBO first.
+//! - [`learner`]: learners that know they learn laps (the pattern search and its repairs).
+//! - [`method`]: the one registry of methods, their knobs and settings, and what they cost.
 //! - [`experiment`]: learning to race a track end to end, and the paper's experiment grid.
 //! - [`study`]: persistent ask/tell studies for a real car; [`evaluator`]: sources of laps;
 //!   [`serve`]: laps as a JSON-lines service.
 //! - [`torcs`]: the racing game TORCS as a source of laps (its robot, setup and lap runner).
 //! - [`benchmarks`]: standard test functions.
-//! - [`sizes`]: the bounds on every size a user gives, and the slow-size estimate.
+//! - [`sizes`]: the bounds on every size a user gives.
 
 pub mod acquisition;
 pub mod benchmarks;
@@ -30,7 +32,9 @@ pub mod evaluator;
 pub mod experiment;
 pub mod gp;
 pub mod interp;
+pub mod learner;
 pub mod limit;
+pub mod method;
 pub mod optimizers;
 pub mod params;
 pub mod policy;

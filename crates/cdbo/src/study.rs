@@ -31,7 +31,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 pub use crate::evaluator::Outcome;
-use crate::optimizers::{Method, Optimizer, Saved, Settings};
+use crate::method::{Method, Settings, resume};
+use crate::optimizers::{Optimizer, Saved};
 use claim::{Handout, Worker};
 pub use sqlite::BUSY_TIMEOUT;
 pub use storage::Location;
@@ -476,7 +477,7 @@ fn beside(
     if !optimizer.tells_any_weights() {
         return Ok(None);
     }
-    let mut fantasy = optimizer.save().resume()?;
+    let mut fantasy = resume(optimizer.save())?;
     for t in in_flight {
         fantasy.ask()?;
         fantasy.tell(&t.weights, lie)?;
@@ -513,7 +514,7 @@ fn load_optimizer<'a>(
                 what: format!("{}: the optimiser state", label.display()),
                 source: e,
             })?;
-            (saved.resume()?, told)
+            (resume(saved)?, told)
         }
     };
     Ok(&mut cache.insert(current).0)

@@ -2,7 +2,8 @@
 //! results of the papers that introduced the peers (TuRBO, LineBO, REMBO).
 
 use cdbo::benchmarks::Problem;
-use cdbo::optimizers::{FailedLap, Method, Optimizer, Saved, Settings, by_name};
+use cdbo::method::{Method, Settings, by_name, resume};
+use cdbo::optimizers::{FailedLap, Optimizer, Saved};
 
 fn optimiser(method: &str, problem: &Problem, seed: u64) -> Box<dyn Optimizer + Send> {
     by_name(
@@ -53,7 +54,7 @@ fn every_method_is_deterministic_and_resumes_exactly() {
         let pending = a.ask().unwrap();
         let json = serde_json::to_string(&a.save()).unwrap();
         let saved: Saved = serde_json::from_str(&json).unwrap();
-        let mut resumed = saved.resume().unwrap();
+        let mut resumed = resume(saved).unwrap();
         assert_eq!(resumed.name(), method);
         assert_eq!(resumed.evaluations(), 23, "{method}");
         assert_eq!(resumed.best(), a.best(), "{method}");
@@ -82,7 +83,7 @@ fn cdbo_with_fits_in_flight_is_deterministic_and_resumes_exactly() {
     assert_eq!(drive(&mut a, &problem, n), drive(&mut b, &problem, n));
     let mut clone = a.clone();
     let saved: Saved = serde_json::from_str(&serde_json::to_string(&a.save()).unwrap()).unwrap();
-    let mut resumed = saved.resume().unwrap();
+    let mut resumed = resume(saved).unwrap();
     let rest = drive(&mut a, &problem, 12);
     assert_eq!(
         rest,

@@ -1,8 +1,9 @@
 //! The pattern search with failure repair: its repair move, its save/resume with failure
 //! places, and a lap with a cliff on which it must beat random search.
 
-use cdbo::optimizers::pattern_search::{PatternSearch, PatternSearchConfig, push};
-use cdbo::optimizers::{FailedLap, Method, Optimizer, Saved, Settings, by_name};
+use cdbo::learner::pattern_search::{PatternSearch, PatternSearchConfig, push};
+use cdbo::method::{Method, Settings, by_name, resume};
+use cdbo::optimizers::{FailedLap, Optimizer, Saved};
 use cdbo::policy::RkhsPolicy;
 use cdbo::policy::rkhs::default_lengthscale;
 
@@ -197,7 +198,7 @@ fn pattern_search_is_deterministic_and_resumes_exactly() {
     assert_eq!(drive(a.as_mut(), 40), drive(b.as_mut(), 40));
     let pending = a.ask().unwrap();
     let saved: Saved = serde_json::from_str(&serde_json::to_string(&a.save()).unwrap()).unwrap();
-    let mut resumed = saved.resume().unwrap();
+    let mut resumed = resume(saved).unwrap();
     assert_eq!(resumed.ask().unwrap(), pending);
     assert_eq!(drive(a.as_mut(), 30), drive(resumed.as_mut(), 30));
     assert_eq!(a.best(), resumed.best());
@@ -272,17 +273,18 @@ fn a_failure_after_less_pedal_is_not_repaired() {
 #[test]
 fn a_saved_search_with_a_bad_setting_is_refused() {
     let ps = started(4, PatternSearchConfig::default());
-    let Saved::PatternSearch(state) = ps.save() else {
-        panic!("not a pattern search's state");
-    };
-    assert!(PatternSearch::resume((*state).clone()).is_ok());
+    let saved = ps.save();
+    assert_eq!(saved.kind(), "pattern-search");
+    let state: cdbo::learner::pattern_search::PatternSearchState =
+        saved.state("pattern search").unwrap();
+    assert!(PatternSearch::resume(state.clone()).is_ok());
     for (sigma0, give_back) in [
         (f64::NAN, 0.5),
         (-0.1, 0.5),
         (0.1, f64::INFINITY),
         (0.1, 0.0),
     ] {
-        let mut bad = (*state).clone();
+        let mut bad = state.clone();
         bad.config.sigma0 = sigma0;
         bad.config.give_back = give_back;
         let e = PatternSearch::resume(bad).unwrap_err().to_string();
@@ -369,7 +371,7 @@ fn resumes_as_saved_without(
     let config_json = state["config"].as_object_mut().unwrap();
     assert!(config_json.remove(config_key).is_some(), "no {config_key}");
     let saved: Saved = serde_json::from_value(json).unwrap();
-    let mut resumed = saved.resume().unwrap();
+    let mut resumed = resume(saved).unwrap();
     assert_eq!(drive(&mut old, laps), drive(resumed.as_mut(), laps));
 }
 
@@ -556,10 +558,7 @@ fn a_search_saved_mid_push_resumes_exactly() {
         json.contains("\"next\":\"Push\""),
         "not in a push after 5 laps"
     );
-    let mut resumed = serde_json::from_str::<Saved>(&json)
-        .unwrap()
-        .resume()
-        .unwrap();
+    let mut resumed = resume(serde_json::from_str::<Saved>(&json).unwrap()).unwrap();
     assert_eq!(
         drive_pedal(a.as_mut(), l, 80),
         drive_pedal(resumed.as_mut(), l, 80)
@@ -587,11 +586,12 @@ fn a_search_saved_before_pushes_resumes_without_them() {
 fn a_saved_push_that_cannot_be_is_refused() {
     let (mut opt, l) = pushing(9);
     drive_pedal(opt.as_mut(), l, 3);
-    let Saved::PatternSearch(state) = opt.save() else {
-        panic!("not a pattern search's state");
-    };
-    assert!(PatternSearch::resume((*state).clone()).is_ok());
-    let corrupt: [fn(&mut cdbo::optimizers::pattern_search::PatternSearchState); 6] = [
+    let saved = opt.save();
+    assert_eq!(saved.kind(), "pattern-search");
+    let state: cdbo::learner::pattern_search::PatternSearchState =
+        saved.state("pattern search").unwrap();
+    assert!(PatternSearch::resume(state.clone()).is_ok());
+    let corrupt: [fn(&mut cdbo::learner::pattern_search::PatternSearchState); 6] = [
         |s| s.push.as_mut().unwrap().number = 0,
         |s| s.push.as_mut().unwrap().number = u32::MAX,
         |s| s.push.as_mut().unwrap().targets[7] = f64::NAN,
@@ -602,7 +602,7 @@ fn a_saved_push_that_cannot_be_is_refused() {
         |s| s.config.lengthscale = None,
     ];
     for (k, spoil) in corrupt.iter().enumerate() {
-        let mut bad = (*state).clone();
+        let mut bad = state.clone();
         spoil(&mut bad);
         let e = PatternSearch::resume(bad).unwrap_err().to_string();
         assert!(e.contains("push targets"), "case {k}: {e}");

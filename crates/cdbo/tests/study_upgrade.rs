@@ -18,7 +18,7 @@ fn scratch(name: &str) -> PathBuf {
 
 fn config() -> StudyConfig {
     StudyConfig {
-        method: cdbo::optimizers::Method::Cdbo,
+        method: cdbo::method::Method::Cdbo,
         kernels: 4,
         lengthscale: 1.0 / 3.0,
         seed: 7,

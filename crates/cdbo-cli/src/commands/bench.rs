@@ -6,7 +6,7 @@ use serde::Serialize;
 use super::{CliResult, Setup, print_json};
 use cdbo::data_path::DataPath;
 use cdbo::drive::demo::{DEFAULT_TARGET_SPEED, SpeedHold};
-use cdbo::optimizers::Method;
+use cdbo::method::Method;
 use cdbo::sim::Simulator;
 
 #[derive(Debug, Subcommand)]
@@ -35,7 +35,7 @@ pub struct OptimizersArgs {
     #[arg(long, default_value_t = 10, value_parser = super::value::seeds)]
     seeds: u64,
     /// Methods, comma-separated.
-    #[arg(long, value_delimiter = ',', default_values_t = Method::ALL)]
+    #[arg(long, value_parser = super::method_parser(), value_delimiter = ',', default_values_t = Method::ALL)]
     methods: Vec<Method>,
     /// Print JSON.
     #[arg(long)]
@@ -139,7 +139,7 @@ fn optimizers(args: &OptimizersArgs) -> CliResult {
     for method in &args.methods {
         let (mut bests, mut seconds) = (Vec::new(), 0.0);
         for seed in 0..args.seeds {
-            let settings = cdbo::optimizers::Settings::problem(seed, problem.radius);
+            let settings = cdbo::method::Settings::problem(seed, problem.radius);
             let mut opt = method.optimizer(problem.start.clone(), &settings)?;
             let start = std::time::Instant::now();
             for _ in 0..args.evals {
@@ -233,7 +233,7 @@ fn suggest(args: &SuggestArgs) -> CliResult {
     }
     times.sort_by(f64::total_cmp);
     let pick = |q: f64| times[((times.len() - 1) as f64 * q).round() as usize];
-    let settings = cdbo::optimizers::Settings::race(Method::PatternSearch, 7, 1.0);
+    let settings = cdbo::method::Settings::race(Method::PatternSearch, 7, 1.0);
     let mut ps = Method::PatternSearch.optimizer(vec![0.0; args.dims], &settings)?;
     for _ in 0..args.observations {
         let w = ps.ask()?;

@@ -54,11 +54,12 @@ pub struct ExperimentArgs {
     /// into the folder that holds the others' runs: the grid stays whole.
     #[arg(
         long,
+        value_parser = super::method_parser(),
         value_delimiter = ',',
         value_name = "METHOD,...",
         conflicts_with = "storage"
     )]
-    methods: Vec<cdbo::optimizers::Method>,
+    methods: Vec<cdbo::method::Method>,
     /// Car: built-in spirit-300, a car .xml, or a car name in the data folders.
     #[arg(long, default_value = cars::DEFAULT)]
     car: String,
@@ -174,13 +175,13 @@ pub fn run_grid(args: &ExperimentArgs, data: &DataPath, simulator: Simulator) ->
     // The grid's costliest run: its largest policy, raced by its costliest method.
     let largest = config.tracks.iter().flat_map(|t| t.kernels.iter()).max();
     let slow = largest.and_then(|&k| {
-        let cost = |m| cdbo::sizes::race_seconds(m, k, config.laps);
+        let cost = |m| cdbo::method::cost::race_seconds(m, k, config.laps);
         let costliest = config
             .methods
             .iter()
             .copied()
             .max_by(|a, b| cost(*a).total_cmp(&cost(*b)))?;
-        cdbo::sizes::slow_race_warning(costliest, k, config.laps)
+        cdbo::method::cost::slow_race_warning(costliest, k, config.laps)
     });
     if let Some(w) = slow {
         eprintln!("warning: {name}: each of its largest runs: {w}");

@@ -18,10 +18,18 @@ pub mod torcs_compare;
 pub mod track;
 
 use clap::Args;
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 
 use cdbo::car::{Car, catalog as cars};
 use cdbo::data_path::DataPath;
+use cdbo::method::Method;
 use cdbo::track::{Ends, Track, builtin, catalog as tracks};
+
+/// `--method`'s parser: the registry's names, each with its one-line description in `--help`.
+pub fn method_parser() -> impl clap::builder::TypedValueParser<Value = Method> {
+    let names = Method::ALL.map(|m| PossibleValue::new(m.name()).help(m.description()));
+    PossibleValuesParser::new(names).try_map(|name| name.parse::<Method>())
+}
 
 /// The boxed error every command returns; printed as one line by `main`.
 pub type CliResult = Result<(), Box<dyn std::error::Error>>;

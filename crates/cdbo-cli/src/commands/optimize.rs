@@ -54,9 +54,11 @@ pub struct OptimizeArgs {
 }
 
 pub fn run(args: &OptimizeArgs, simulator: Simulator) -> CliResult {
-    if let Some(w) =
-        cdbo::sizes::slow_study_warning(args.initial.method(), args.initial.kernels, args.laps)
-    {
+    if let Some(w) = cdbo::method::cost::slow_study_warning(
+        args.initial.method(),
+        args.initial.kernels,
+        args.laps,
+    ) {
         eprintln!("warning: {w}");
     }
     // The game is set up (or refused) before the study is touched: nothing half-made.

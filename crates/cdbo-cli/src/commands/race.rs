@@ -10,7 +10,7 @@ use serde::Serialize;
 use super::{CliResult, Setup, Simulator, from_flag, print_json};
 use cdbo::data_path::DataPath;
 use cdbo::experiment::race::{RaceConfig, RaceOutcome, race};
-use cdbo::optimizers::{KnobKind, Method};
+use cdbo::method::{KnobKind, Method};
 use cdbo::policy::RkhsPolicy;
 
 #[derive(Debug, Args)]
@@ -21,7 +21,7 @@ pub struct RaceArgs {
     #[arg(long, default_value_t = 30, value_parser = super::value::kernels)]
     kernels: usize,
     /// Optimiser.
-    #[arg(long, default_value_t = Method::Cdbo)]
+    #[arg(long, value_parser = super::method_parser(), default_value_t = Method::Cdbo)]
     method: Method,
     /// Laps (the paper: 300).
     #[arg(long, default_value_t = 300, value_parser = super::value::laps)]
@@ -89,7 +89,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         Some(v) => Some(knob.check(args.method, v)?),
         None => None,
     };
-    if let Some(w) = cdbo::sizes::slow_race_warning(args.method, args.kernels, args.laps) {
+    if let Some(w) = cdbo::method::cost::slow_race_warning(args.method, args.kernels, args.laps) {
         eprintln!("warning: {w}");
     }
     // In the game, the track and car are the game's, read by cdbo for the limit and plots.

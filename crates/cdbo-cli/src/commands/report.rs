@@ -18,7 +18,7 @@ use cdbo::experiment::race::demonstrate;
 use cdbo::experiment::record::RunRecord;
 use cdbo::experiment::shared::SharedGrid;
 use cdbo::experiment::summary::{Curve, cell_means, claims, curves, times};
-use cdbo::optimizers::Method;
+use cdbo::method::Method;
 use cdbo::policy::RkhsPolicy;
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 use cdbo::study::Location;

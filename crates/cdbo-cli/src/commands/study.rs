@@ -6,7 +6,7 @@ use clap::{Args, Subcommand, ValueEnum};
 
 use super::policy::{read_demo, read_policy};
 use super::{CliResult, from_flag, print_json};
-use cdbo::optimizers::Method;
+use cdbo::method::Method;
 use cdbo::policy::RkhsPolicy;
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 use cdbo::study::{Location, Outcome, Study, StudyConfig, Trial};
@@ -62,7 +62,7 @@ pub struct InitialPolicy {
     #[arg(long, value_name = "METRES", allow_negative_numbers = true, value_parser = super::value::positive)]
     track_length: Option<f64>,
     /// Optimiser (default cdbo).
-    #[arg(long)]
+    #[arg(long, value_parser = super::method_parser())]
     method: Option<Method>,
     /// Seed of every random choice (default 0).
     #[arg(long)]
@@ -265,9 +265,9 @@ pub fn run(cmd: &StudyCommand) -> CliResult {
             initial,
             track,
         } => {
-            let laps = cdbo::sizes::STUDY_LAPS_ASSUMED;
+            let laps = cdbo::method::cost::STUDY_LAPS_ASSUMED;
             if let Some(w) =
-                cdbo::sizes::slow_study_warning(initial.method(), initial.kernels, laps)
+                cdbo::method::cost::slow_study_warning(initial.method(), initial.kernels, laps)
             {
                 eprintln!("warning: {w}; {laps} laps assumed, the paper's budget");
             }

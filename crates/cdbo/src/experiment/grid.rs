@@ -19,7 +19,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::optimizers::Method;
+use crate::method::Method;
 
 use crate::error::{Error, Result};
 
@@ -75,7 +75,7 @@ pub const PRESETS: &[&str] = &["paper", "paper-plus", "quick"];
 
 impl ExperimentConfig {
     /// The main knob `method` runs at in this grid: its entry in the `[knob]` table, else its
-    /// published setting ([`Knob::published`](crate::optimizers::Knob::published): σ₀ 0.03,
+    /// published setting ([`Knob::published`](crate::method::Knob::published): σ₀ 0.03,
     /// TuRBO's 0.8, LineBO's whole line, REMBO's √d), so that a grid names every tuned value
     /// it uses and reads the same whatever the race defaults become.
     pub fn knob_of(&self, method: Method) -> f64 {

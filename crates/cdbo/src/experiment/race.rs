@@ -9,7 +9,7 @@ use crate::error::{Error, Result};
 use crate::evaluator::simulator::SimEvaluator;
 use crate::evaluator::{Evaluator, Outcome};
 use crate::limit::{Limit, limit_lap};
-use crate::optimizers::Method;
+use crate::method::Method;
 use crate::policy::RkhsPolicy;
 use crate::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 use crate::sim::{FailureReason, LapResult, Simulator};
@@ -152,7 +152,7 @@ pub fn race_with(
     }
     let lengthscale = default_lengthscale(config.kernels);
     let initial = RkhsPolicy::fit(&demo_pairs, config.kernels, lengthscale, DEFAULT_RIDGE)?;
-    let mut settings = crate::optimizers::Settings::race(config.method, config.seed, config.beta)
+    let mut settings = crate::method::Settings::race(config.method, config.seed, config.beta)
         .for_policy(lengthscale)
         .on_track(limit.track_length);
     if let Some(value) = config.knob {

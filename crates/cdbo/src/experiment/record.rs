@@ -165,7 +165,7 @@ pub fn run_at(
     progress: impl FnMut(&LapRecord),
 ) -> Result<RunRecord> {
     let start = std::time::Instant::now();
-    let method: crate::optimizers::Method = spec.method.parse()?;
+    let method: crate::method::Method = spec.method.parse()?;
     let config = RaceConfig {
         method,
         kernels: spec.kernels,

@@ -2,7 +2,7 @@
 //! the best reward after each lap, paper Fig. 4–5), run times (Table 1) and the paper's claims
 //! checked against the numbers.
 
-use crate::optimizers::Method;
+use crate::method::Method;
 use std::collections::BTreeMap;
 
 use super::record::RunRecord;

@@ -30,13 +30,20 @@ use serde::{Deserialize, Serialize};
 
 use super::cmaes_ascent::CmaesSearch;
 use super::coordinate_ascent::{Ascent, AxisSearch, GpAcquisition};
-use super::{Best, Optimizer, SearchBox, check_tell, rng_for};
+use super::{Best, Optimizer, Saved, SearchBox, check_tell, rng_for};
 use crate::acquisition::Acquisition;
 use crate::acquisition::ucb::DEFAULT_BETA;
 use crate::error::{Error, Result};
 use crate::gp::fit_in_flight::FitInFlight;
 use crate::gp::likelihood::{Bounds, fit};
 use crate::gp::{GaussianProcess, Hyper, Kernel, Mean};
+
+/// The paper's CDBO: the acquisition maximised by randomised coordinate ascent.
+pub const CDBO: &str = "cdbo";
+/// BO-CMA-ES: the acquisition maximised by CMA-ES.
+pub const BO_CMAES: &str = "bo-cmaes";
+/// The kind of the saved state of either.
+const SAVED_KIND: &str = "bo";
 
 /// Hyperparameter fits are fitted at once below this many observations, where they are
 /// cheap, and on their own thread from it on.
@@ -435,8 +442,8 @@ impl Bo {
 impl Optimizer for Bo {
     fn name(&self) -> &'static str {
         match self.state.config.maximiser {
-            Maximiser::CoordinateAscent(_) => crate::optimizers::Method::Cdbo.name(),
-            Maximiser::Cmaes(_) => crate::optimizers::Method::BoCmaes.name(),
+            Maximiser::CoordinateAscent(_) => CDBO,
+            Maximiser::Cmaes(_) => BO_CMAES,
         }
     }
 
@@ -475,7 +482,7 @@ impl Optimizer for Bo {
         self.state.observations.len()
     }
 
-    fn save(&self) -> super::Saved {
-        super::Saved::Bo(Box::new(self.state.clone()))
+    fn save(&self) -> Saved {
+        Saved::new(SAVED_KIND, &self.state)
     }
 }

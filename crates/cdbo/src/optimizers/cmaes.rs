@@ -21,8 +21,12 @@ use faer::{Mat, Side};
 use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
 
-use super::{Best, FailedLap, Optimizer, SearchBox, check_tell, check_tell_lap, rng_for};
+use super::{Best, FailedLap, Optimizer, Saved, SearchBox, check_tell, check_tell_lap, rng_for};
 use crate::error::{Error, Result};
+
+/// The method's name, and the kind of its saved state.
+pub const NAME: &str = "cmaes";
+const SAVED_KIND: &str = NAME;
 
 /// Settings of a CMA-ES run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -465,7 +469,7 @@ impl Cmaes {
 
 impl Optimizer for Cmaes {
     fn name(&self) -> &'static str {
-        crate::optimizers::Method::Cmaes.name()
+        NAME
     }
 
     fn dim(&self) -> usize {
@@ -500,7 +504,7 @@ impl Optimizer for Cmaes {
         self.state.evaluations
     }
 
-    fn save(&self) -> super::Saved {
-        super::Saved::Cmaes(Box::new(self.state.clone()))
+    fn save(&self) -> Saved {
+        Saved::new(SAVED_KIND, &self.state)
     }
 }

@@ -17,11 +17,15 @@ use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
 
-use super::{Best, Optimizer, SearchBox, check_tell, rng_for};
+use super::{Best, Optimizer, Saved, SearchBox, check_tell, rng_for};
 use crate::acquisition::ucb::{DEFAULT_BETA, ucb};
 use crate::error::{Error, Result};
 use crate::gp::likelihood::{Bounds, fit};
 use crate::gp::{GaussianProcess, Hyper, Kernel, Mean};
+
+/// The method's name, and the kind of its saved state.
+pub const NAME: &str = "linebo";
+const SAVED_KIND: &str = NAME;
 
 /// Settings of a LineBO run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -240,7 +244,7 @@ impl LineBo {
 
 impl Optimizer for LineBo {
     fn name(&self) -> &'static str {
-        crate::optimizers::Method::Linebo.name()
+        NAME
     }
 
     fn dim(&self) -> usize {
@@ -295,7 +299,7 @@ impl Optimizer for LineBo {
         self.state.observations.len()
     }
 
-    fn save(&self) -> super::Saved {
-        super::Saved::Linebo(Box::new(self.state.clone()))
+    fn save(&self) -> Saved {
+        Saved::new(SAVED_KIND, &self.state)
     }
 }

@@ -9,15 +9,13 @@ pub mod cmaes;
 pub mod cmaes_ascent;
 pub mod coordinate_ascent;
 pub mod linebo;
-pub mod pattern_search;
 pub mod random;
-pub mod registry;
 pub mod rembo;
 pub mod turbo;
 
-pub use registry::{Knob, KnobKind, Method};
-
+use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
+use serde_json::value::RawValue;
 
 use crate::error::{Error, Result};
 
@@ -81,234 +79,43 @@ impl FailedLap {
     }
 }
 
-/// The saved state of an optimiser of any method, tagged with its kind.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case", tag = "kind", content = "state")]
-pub enum Saved {
-    /// CDBO or BO-CMA-ES.
-    Bo(Box<bo::BoState>),
-    /// Active CMA-ES.
-    Cmaes(Box<cmaes::CmaesState>),
-    /// Random search.
-    Random(Box<random::RandomState>),
-    /// REMBO.
-    Rembo(Box<rembo::RemboState>),
-    /// TuRBO-1.
-    Turbo(Box<turbo::TurboState>),
-    /// LineBO.
-    Linebo(Box<linebo::LineBoState>),
-    /// Pattern search with failure repair.
-    PatternSearch(Box<pattern_search::PatternSearchState>),
+/// The saved state of an optimiser of any method: its kind and its state as JSON, exactly as
+/// written (`{"kind": "bo", "state": {…}}`). [`crate::method::resume`] continues it.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Saved {
+    kind: String,
+    state: Box<RawValue>,
 }
 
 impl Saved {
-    /// The optimiser, continuing exactly as the saved one would have.
-    pub fn resume(self) -> Result<Box<dyn Optimizer + Send>> {
-        Ok(match self {
-            Saved::Bo(s) => Box::new(bo::Bo::resume(*s)?),
-            Saved::Cmaes(s) => Box::new(cmaes::Cmaes::resume(*s)?),
-            Saved::Random(s) => Box::new(random::RandomSearch::resume(*s)?),
-            Saved::Rembo(s) => Box::new(rembo::Rembo::resume(*s)?),
-            Saved::Turbo(s) => Box::new(turbo::Turbo::resume(*s)?),
-            Saved::Linebo(s) => Box::new(linebo::LineBo::resume(*s)?),
-            Saved::PatternSearch(s) => Box::new(pattern_search::PatternSearch::resume(*s)?),
+    /// The state of an optimiser of `kind`.
+    pub fn new(kind: &str, state: &impl Serialize) -> Saved {
+        Saved {
+            kind: kind.to_owned(),
+            state: serde_json::value::to_raw_value(state)
+                .expect("an optimiser's state is plain data that serialises to JSON"),
+        }
+    }
+
+    /// The kind of optimiser it is the state of (`bo`, `cmaes`, `pattern-search`, …).
+    pub fn kind(&self) -> &str {
+        &self.kind
+    }
+
+    /// The state, read as `T` (the state of the optimiser of [`kind`](Saved::kind)); a state
+    /// that does not read is refused naming `method`.
+    pub fn state<T: DeserializeOwned>(&self, method: &'static str) -> Result<T> {
+        serde_json::from_str(self.state.get()).map_err(|e| Error::CorruptState {
+            method,
+            reason: e.to_string(),
         })
     }
 }
 
-/// What every method is told besides w₀.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Settings {
-    /// Seed of every random choice.
-    pub seed: u64,
-    /// UCB β of the UCB methods (CDBO, BO-CMA-ES, LineBO).
-    pub beta: f64,
-    /// Half-width r of the search box around w₀.
-    pub box_radius: f64,
-    /// The exploration scale around w₀: CDBO's and REMBO's initial σ₀, and the main knob of the
-    /// methods whose knob is σ₀ ([`KnobKind::Sigma0`]: CMA-ES, random and pattern search).
-    pub sigma0: f64,
-    /// The main knob of the other methods ([`Method::knob`]: TuRBO's L_init, LineBO's line
-    /// half-length, REMBO's box half-width); `None`: the method's published setting.
-    pub knob: Option<f64>,
-    /// The length-scale ℓ of the policy's kernels when the weights are a lap policy's (races
-    /// and studies; the pattern search pushes that policy's pedal); `None` for any other
-    /// problem.
-    pub policy_lengthscale: Option<f64>,
-    /// The lap's length (m) when the weights are a lap policy's and it is known (races, and
-    /// studies that record it): the pattern search's push repairs over road rather than kernels.
-    pub track_length: Option<f64>,
-}
-
-impl Settings {
-    /// For a race of `method`: the policy box (r = 1.5), σ₀ = 0.03 (CDBO's initial samples;
-    /// with σ = 0.1, most perturbations of a cruising demonstration brake the car to a stop on
-    /// Forza, and a search whose every lap fails learns nothing) and the method's main knob at
-    /// its race value ([`Knob::value`]: tuned on the training panels where swept).
-    pub fn race(method: Method, seed: u64, beta: f64) -> Settings {
-        let knob = method.knob();
-        Settings {
-            seed,
-            beta,
-            box_radius: DEFAULT_BOX_RADIUS,
-            sigma0: registry::PAPER_SIGMA0,
-            knob: None,
-            policy_lengthscale: None,
-            track_length: None,
-        }
-        .with_knob_unchecked(method, knob.value)
-    }
-
-    /// These settings with `method`'s main knob at `value`, refused with the knob's name and
-    /// range if the method cannot take it ([`Knob::check`]).
-    pub fn with_knob(self, method: Method, value: f64) -> Result<Settings> {
-        let value = method.knob().check(method, value)?;
-        Ok(self.with_knob_unchecked(method, value))
-    }
-
-    fn with_knob_unchecked(self, method: Method, value: f64) -> Settings {
-        let knob = method.knob();
-        match knob.kind {
-            KnobKind::Sigma0 => Settings {
-                sigma0: value,
-                ..self
-            },
-            _ => Settings {
-                knob: (value != knob.published).then_some(value),
-                ..self
-            },
-        }
-    }
-
-    /// These settings for the weights of a lap policy whose kernels have length-scale ℓ.
-    pub fn for_policy(self, lengthscale: f64) -> Settings {
-        Settings {
-            policy_lengthscale: Some(lengthscale),
-            ..self
-        }
-    }
-
-    /// These settings for a lap of `length` metres.
-    pub fn on_track(self, length: f64) -> Settings {
-        Settings {
-            track_length: Some(length),
-            ..self
-        }
-    }
-
-    /// For a test problem on a box of half-width r: σ₀ = r/15.
-    pub fn problem(seed: u64, box_radius: f64) -> Settings {
-        Settings {
-            seed,
-            beta: crate::acquisition::ucb::DEFAULT_BETA,
-            box_radius,
-            sigma0: box_radius / 15.0,
-            knob: None,
-            policy_lengthscale: None,
-            track_length: None,
-        }
-    }
-}
-
-/// An optimiser by its name ([`Method`]), from w₀ and the settings shared by every method.
-pub fn by_name(name: &str, w0: Vec<f64>, settings: &Settings) -> Result<Box<dyn Optimizer + Send>> {
-    name.parse::<Method>()?.optimizer(w0, settings)
-}
-
-impl Method {
-    /// The method's optimiser, from w₀ and the settings shared by every method.
-    pub fn optimizer(self, w0: Vec<f64>, settings: &Settings) -> Result<Box<dyn Optimizer + Send>> {
-        let Settings {
-            seed,
-            beta,
-            box_radius,
-            sigma0,
-            knob,
-            policy_lengthscale,
-            track_length,
-        } = *settings;
-        if let Some(length) = track_length.filter(|l| !(l.is_finite() && *l > 0.0)) {
-            return Err(Error::invalid_value(
-                "the lap's length (m)",
-                length,
-                "a positive number of metres",
-            ));
-        }
-        let bo = |maximiser| bo::BoConfig {
-            seed,
-            acquisition: crate::acquisition::Acquisition::Ucb { beta },
-            box_radius,
-            maximiser,
-            initial_sigma: sigma0,
-            ..bo::BoConfig::default()
-        };
-        let rembo = |embedding_dim| rembo::RemboConfig {
-            seed,
-            embedding_dim,
-            box_radius,
-            sigma0,
-            embedding_box: knob,
-        };
-        Ok(match self {
-            Method::Cdbo => Box::new(bo::Bo::new(
-                w0,
-                bo(bo::Maximiser::CoordinateAscent(Default::default())),
-            )?),
-            Method::BoCmaes => Box::new(bo::Bo::new(
-                w0,
-                bo(bo::Maximiser::Cmaes(Default::default())),
-            )?),
-            Method::Cmaes => {
-                let config = cmaes::CmaesConfig {
-                    seed,
-                    sigma0,
-                    bounds: Some(SearchBox::around(&w0, box_radius)?),
-                    ..cmaes::CmaesConfig::default()
-                };
-                Box::new(cmaes::Cmaes::new(w0, config)?)
-            }
-            Method::Rembo5d => Box::new(rembo::Rembo::new(w0, rembo(5))?),
-            Method::Rembo10d => Box::new(rembo::Rembo::new(w0, rembo(10))?),
-            Method::Turbo => Box::new(turbo::Turbo::new(
-                w0,
-                turbo::TurboConfig {
-                    seed,
-                    box_radius,
-                    length_init: knob.unwrap_or(turbo::LENGTH_INIT),
-                    ..turbo::TurboConfig::default()
-                },
-            )?),
-            Method::Linebo => Box::new(linebo::LineBo::new(
-                w0,
-                linebo::LineBoConfig {
-                    seed,
-                    box_radius,
-                    beta,
-                    step: knob,
-                    ..linebo::LineBoConfig::default()
-                },
-            )?),
-            Method::Random => Box::new(random::RandomSearch::new(
-                w0,
-                random::RandomConfig {
-                    seed,
-                    sigma: sigma0,
-                    box_radius,
-                },
-            )?),
-            Method::PatternSearch => Box::new(pattern_search::PatternSearch::new(
-                w0,
-                pattern_search::PatternSearchConfig {
-                    seed,
-                    sigma0,
-                    box_radius,
-                    repair: true,
-                    lengthscale: policy_lengthscale,
-                    track_length,
-                    ..pattern_search::PatternSearchConfig::default()
-                },
-            )?),
-        })
+/// Two saved states are equal when they are of the same kind and their JSON is the same.
+impl PartialEq for Saved {
+    fn eq(&self, other: &Saved) -> bool {
+        self.kind == other.kind && self.state.get() == other.state.get()
     }
 }
 

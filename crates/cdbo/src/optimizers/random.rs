@@ -4,8 +4,12 @@
 use rand_distr::{Distribution, Normal};
 use serde::{Deserialize, Serialize};
 
-use super::{Best, Optimizer, SearchBox, check_tell, rng_for};
+use super::{Best, Optimizer, Saved, SearchBox, check_tell, rng_for};
 use crate::error::{Error, Result};
+
+/// The method's name, and the kind of its saved state.
+pub const NAME: &str = "random";
+const SAVED_KIND: &str = NAME;
 
 /// Settings of a random search.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -87,7 +91,7 @@ impl RandomSearch {
 
 impl Optimizer for RandomSearch {
     fn name(&self) -> &'static str {
-        crate::optimizers::Method::Random.name()
+        NAME
     }
 
     fn dim(&self) -> usize {
@@ -130,7 +134,7 @@ impl Optimizer for RandomSearch {
         self.state.evaluations
     }
 
-    fn save(&self) -> super::Saved {
-        super::Saved::Random(Box::new(self.state.clone()))
+    fn save(&self) -> Saved {
+        Saved::new(SAVED_KIND, &self.state)
     }
 }

@@ -15,10 +15,17 @@ use serde::{Deserialize, Serialize};
 
 use super::bo::{Bo, BoConfig, BoState, Maximiser};
 use super::coordinate_ascent::AxisSearch;
-use super::{Optimizer, check_tell, rng_for};
+use super::{Best, Optimizer, Saved, check_tell, rng_for};
 use crate::acquisition::Acquisition;
 use crate::error::{Error, Result};
 use crate::gp::Kernel;
+
+/// REMBO in a 5-dimensional embedding.
+pub const NAME_5D: &str = "rembo-5d";
+/// REMBO in a 10-dimensional embedding.
+pub const NAME_10D: &str = "rembo-10d";
+/// The kind of the saved state of any REMBO.
+const SAVED_KIND: &str = "rembo";
 
 /// Settings of a REMBO run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -59,7 +66,7 @@ pub struct Rembo {
     inner: Bo,
     /// The embedded point of the pending suggestion and its weights.
     pending: Option<(Vec<f64>, Vec<f64>)>,
-    best: super::Best,
+    best: Best,
 }
 
 /// Uniform points of Y scored before each ascent of the expected improvement: REMBO
@@ -138,7 +145,7 @@ impl Rembo {
             embedding,
             inner,
             pending: None,
-            best: super::Best::default(),
+            best: Best::default(),
         };
         let told: Vec<(Vec<f64>, f64)> = run.inner.state().observations.clone();
         for (y, r) in told {
@@ -178,9 +185,9 @@ impl Rembo {
 impl Optimizer for Rembo {
     fn name(&self) -> &'static str {
         match self.config.embedding_dim {
-            5 => crate::optimizers::Method::Rembo5d.name(),
-            10 => crate::optimizers::Method::Rembo10d.name(),
-            _ => "rembo",
+            5 => NAME_5D,
+            10 => NAME_10D,
+            _ => SAVED_KIND,
         }
     }
 
@@ -227,7 +234,7 @@ impl Optimizer for Rembo {
         self.inner.evaluations()
     }
 
-    fn save(&self) -> super::Saved {
-        super::Saved::Rembo(Box::new(self.state()))
+    fn save(&self) -> Saved {
+        Saved::new(SAVED_KIND, &self.state())
     }
 }

@@ -23,11 +23,15 @@ use rand::Rng;
 use rand::seq::SliceRandom;
 use serde::{Deserialize, Serialize};
 
-use super::{Best, Optimizer, SearchBox, check_tell, rng_for};
+use super::{Best, Optimizer, Saved, SearchBox, check_tell, rng_for};
 use crate::acquisition::thompson;
 use crate::error::{Error, Result};
 use crate::gp::likelihood::{Bounds, fit};
 use crate::gp::{GaussianProcess, Hyper, Kernel, Mean};
+
+/// The method's name, and the kind of its saved state.
+pub const NAME: &str = "turbo";
+const SAVED_KIND: &str = NAME;
 
 /// TuRBO's initial base side of the trust region (the default L_init).
 pub const LENGTH_INIT: f64 = 0.8;
@@ -338,7 +342,7 @@ impl Turbo {
 
 impl Optimizer for Turbo {
     fn name(&self) -> &'static str {
-        crate::optimizers::Method::Turbo.name()
+        NAME
     }
 
     fn dim(&self) -> usize {
@@ -379,7 +383,7 @@ impl Optimizer for Turbo {
         self.state.observations.len()
     }
 
-    fn save(&self) -> super::Saved {
-        super::Saved::Turbo(Box::new(self.state.clone()))
+    fn save(&self) -> Saved {
+        Saved::new(SAVED_KIND, &self.state)
     }
 }

@@ -280,7 +280,7 @@ fn with_heartbeat(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::optimizers::{Method, Settings, by_name};
+    use crate::method::{Method, Settings, by_name};
 
     /// Rewards from a closed form: −‖w − w*‖², a failed lap where w₀ > 1.
     struct Bowl;

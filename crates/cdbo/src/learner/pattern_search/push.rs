@@ -28,10 +28,10 @@
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 
-use super::super::{FailedLap, SearchBox, rng_for};
 use super::PatternSearchConfig;
-use crate::ceiling::{PedalRepair, REPAIR_STEP};
 use crate::error::Result;
+use crate::learner::repair::{PedalRepair, REPAIR_STEP};
+use crate::optimizers::{FailedLap, SearchBox, rng_for};
 use crate::policy::RkhsPolicy;
 use crate::policy::rkhs::DEFAULT_RIDGE;
 

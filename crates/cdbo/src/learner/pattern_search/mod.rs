@@ -54,9 +54,15 @@ pub mod push;
 use rand::seq::SliceRandom;
 use serde::{Deserialize, Serialize};
 
-use super::{Best, FailedLap, Optimizer, SearchBox, check_tell_lap, rng_for};
 use crate::error::{Error, Result};
+use crate::optimizers::{
+    Best, DEFAULT_BOX_RADIUS, FailedLap, Optimizer, Saved, SearchBox, check_tell_lap, rng_for,
+};
 use push::Push;
+
+/// The method's name, and the kind of its saved state.
+pub const NAME: &str = "pattern-search";
+const SAVED_KIND: &str = NAME;
 
 /// Settings of a pattern search.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -113,7 +119,7 @@ impl Default for PatternSearchConfig {
         PatternSearchConfig {
             seed: 0,
             sigma0: 0.03,
-            box_radius: super::DEFAULT_BOX_RADIUS,
+            box_radius: DEFAULT_BOX_RADIUS,
             repair: true,
             block: 8,
             repairs: 3,
@@ -508,7 +514,7 @@ impl PatternSearch {
 
 impl Optimizer for PatternSearch {
     fn name(&self) -> &'static str {
-        crate::optimizers::Method::PatternSearch.name()
+        NAME
     }
 
     fn dim(&self) -> usize {
@@ -624,7 +630,7 @@ impl Optimizer for PatternSearch {
         self.state.evaluations
     }
 
-    fn save(&self) -> super::Saved {
-        super::Saved::PatternSearch(Box::new(self.state.clone()))
+    fn save(&self) -> Saved {
+        Saved::new(SAVED_KIND, &self.state)
     }
 }

@@ -1,0 +1,116 @@
+//! The repair of a pedal where its lap fails: the targets (x, a) the policy is fitted to move
+//! down over the stretch of road before a failure where the car was too fast (off the road,
+//! spun, backwards) and up where it was too slow (stalled, past the time limit). The ceiling
+//! ([`crate::ceiling`]) repairs its fitted pedal this way, and the pattern search's push
+//! ([`crate::learner::pattern_search`]) repairs a pushed pedal.
+
+use serde::{Deserialize, Serialize};
+
+use crate::policy::rkhs::default_lengthscale;
+
+/// The first step δ₀ of a repair of the fitted pedal.
+pub const REPAIR_STEP: f64 = 0.1;
+/// Kernel spacings 1/(M − 1) before a failure over which a repair moves the fit's targets.
+pub const REPAIR_SPACINGS: f64 = 2.0;
+
+/// The repairs of a fitted pedal's targets at the places its laps fail (step 2 of the
+/// ceiling): the step δ and the last failure's place and direction.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PedalRepair {
+    /// The kernel spacing 1/(M − 1).
+    pub spacing: f64,
+    /// The current step δ.
+    pub step: f64,
+    /// The last repair's failure place and direction (±1).
+    pub last: Option<(f64, f64)>,
+    /// The stretch before a failure that a repair moves (lap fraction); `None`:
+    /// [`REPAIR_SPACINGS`] kernel spacings (the ceiling's, and repairs saved before it was set).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub window: Option<f64>,
+}
+
+impl PedalRepair {
+    /// Repairs of an M-kernel fit, at δ₀ = [`REPAIR_STEP`], over [`REPAIR_SPACINGS`] spacings.
+    pub fn new(kernels: usize) -> PedalRepair {
+        PedalRepair {
+            spacing: default_lengthscale(kernels),
+            step: REPAIR_STEP,
+            last: None,
+            window: None,
+        }
+    }
+
+    /// These repairs over a stretch of `window` (lap fraction) before each failure.
+    pub fn over(self, window: f64) -> PedalRepair {
+        PedalRepair {
+            window: Some(window),
+            ..self
+        }
+    }
+
+    /// The stretch before a failure that a repair moves (lap fraction).
+    pub fn window(&self) -> f64 {
+        self.window.unwrap_or(REPAIR_SPACINGS * self.spacing)
+    }
+
+    /// Moves the targets (x, a) with x ∈ [x_f − [`window`](Self::window), x_f] by ±δ for a lap
+    /// that failed at x_f: down where the car was too fast (off the road, spun, backwards), up
+    /// where it was `too_slow` (stalled, time limit); halving δ first if the last failure lay
+    /// within one spacing and asked for the other direction, or restoring δ₀ if it lay more
+    /// than one spacing before x_f.
+    pub fn repair(&mut self, targets: &mut [(f64, f64)], x_fail: f64, too_slow: bool) {
+        let direction = if too_slow { 1.0 } else { -1.0 };
+        match self.last {
+            Some((x, d)) if (x_fail - x).abs() < self.spacing && d != direction => {
+                self.step *= 0.5;
+            }
+            Some((x, _)) if x_fail <= x + self.spacing => {}
+            _ => self.step = REPAIR_STEP,
+        }
+        self.last = Some((x_fail, direction));
+        let from = x_fail - self.window();
+        for (x, a) in targets.iter_mut() {
+            if (from..=x_fail).contains(x) {
+                *a += direction * self.step;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sim::lap::FailureReason;
+
+    /// A repair moves the targets over two spacings before the failure only, down for a spin
+    /// and up for a stall; a reversal within one spacing halves δ, a failure further on
+    /// restores δ₀.
+    #[test]
+    fn a_repair_moves_the_targets_before_the_failure() {
+        let mut repair = PedalRepair::new(11);
+        let mut targets: Vec<(f64, f64)> = (0..=100).map(|i| (i as f64 / 100.0, 0.5)).collect();
+        repair.repair(&mut targets, 0.5, FailureReason::Spun.too_slow());
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-12;
+        for (i, &(x, a)) in targets.iter().enumerate() {
+            let moved = (30..=50).contains(&i);
+            assert!(close(a, if moved { 0.4 } else { 0.5 }), "x {x}: {a}");
+        }
+        repair.repair(&mut targets, 0.52, FailureReason::Stalled.too_slow());
+        assert_eq!(repair.step, REPAIR_STEP / 2.0);
+        assert!(close(targets[51].1, 0.55) && close(targets[50].1, 0.45));
+        assert!(close(targets[31].1, 0.4) && close(targets[32].1, 0.45));
+        repair.repair(&mut targets, 0.53, FailureReason::Stalled.too_slow());
+        assert_eq!(repair.step, REPAIR_STEP / 2.0);
+        repair.repair(&mut targets, 0.8, FailureReason::OffTrack.too_slow());
+        assert_eq!(repair.step, REPAIR_STEP);
+        assert!(close(targets[80].1, 0.4) && close(targets[57].1, 0.5));
+        // Over a window of its own: 0.055 of the lap before the failure, not two spacings.
+        let mut narrow = PedalRepair::new(11).over(0.055);
+        let mut targets: Vec<(f64, f64)> = (0..=100).map(|i| (i as f64 / 100.0, 0.5)).collect();
+        narrow.repair(&mut targets, 0.5, FailureReason::Spun.too_slow());
+        for (i, &(x, a)) in targets.iter().enumerate() {
+            let moved = (45..=50).contains(&i);
+            assert!(close(a, if moved { 0.4 } else { 0.5 }), "x {x}: {a}");
+        }
+    }
+}
