@@ -63,6 +63,7 @@ fn study_config() -> StudyConfig {
         w0: vec![0.2, 0.3, -0.1, 0.4, 0.1],
         track: None,
         track_length: None,
+        knob: None,
     }
 }
 

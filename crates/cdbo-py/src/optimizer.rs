@@ -8,7 +8,7 @@ use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyType};
 
-use cdbo::method::{Method, Settings};
+use cdbo::method::{Method, Spec};
 use cdbo::optimizers::{DEFAULT_BOX_RADIUS, FailedLap, Optimizer, Saved};
 
 use crate::convert::{IntoPy, array, lock, vector};
@@ -62,18 +62,24 @@ impl PyOptimizer {
     ) -> PyResult<Self> {
         let w0 = vector(w0, "w0")?;
         let method: Method = method.parse().py()?;
-        let race = Settings::race(method, seed, beta);
-        let mut settings = Settings {
-            box_radius: bounds,
-            sigma0: sigma0.unwrap_or(race.sigma0),
-            policy_lengthscale: lengthscale,
-            track_length,
-            ..race
+        let spec = || -> cdbo::Result<Spec> {
+            let mut spec = Spec::race(method)
+                .seed(seed)
+                .beta(beta)?
+                .box_radius(bounds)?;
+            if let Some(sigma0) = sigma0 {
+                spec = spec.sigma0(sigma0)?;
+            }
+            if let Some(value) = knob {
+                spec = spec.knob(value)?;
+            }
+            if let Some(lengthscale) = lengthscale {
+                spec = spec.policy(lengthscale)?;
+            }
+            track_length.map_or(Ok(spec), |length| spec.track_length(length))
         };
-        if let Some(value) = knob {
-            settings = settings.with_knob(method, value).py()?;
-        }
-        let inner = py.detach(|| method.optimizer(w0, &settings)).py()?;
+        let spec = spec().py()?;
+        let inner = py.detach(|| spec.optimizer(w0)).py()?;
         Ok(PyOptimizer::wrap(inner))
     }
 

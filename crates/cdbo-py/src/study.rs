@@ -77,7 +77,7 @@ pub struct PyStudy {
 #[pymethods]
 impl PyStudy {
     #[classmethod]
-    #[pyo3(signature = (path, w0, *, method = "cdbo", lengthscale = None, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, track_length = None))]
+    #[pyo3(signature = (path, w0, *, method = "cdbo", lengthscale = None, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, track_length = None, knob = None))]
     #[allow(clippy::too_many_arguments)]
     fn create(
         _cls: &Bound<'_, PyType>,
@@ -89,6 +89,7 @@ impl PyStudy {
         seed: u64,
         beta: f64,
         track_length: Option<f64>,
+        knob: Option<f64>,
     ) -> PyResult<Self> {
         let w0 = vector(w0, "w0")?;
         let config = StudyConfig {
@@ -100,6 +101,7 @@ impl PyStudy {
             w0,
             track: None,
             track_length,
+            knob,
         };
         let study = py.detach(|| Study::create(&path, config)).py()?;
         Ok(PyStudy {

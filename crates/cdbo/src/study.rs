@@ -31,7 +31,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 pub use crate::evaluator::Outcome;
-use crate::method::{Method, Settings, resume};
+use crate::method::{Method, Spec, resume};
 use crate::optimizers::{Optimizer, Saved};
 use claim::{Handout, Worker};
 pub use sqlite::BUSY_TIMEOUT;
@@ -77,6 +77,20 @@ pub struct StudyConfig {
     /// road then; absent in studies made before it was recorded).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub track_length: Option<f64>,
+    /// The method's main knob ([`Method::knob`]), where the user set it; absent: its race
+    /// value (and in studies made before it could be set).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub knob: Option<f64>,
+}
+
+impl StudyConfig {
+    /// The study's specification of its method, for the weights of its lap policy.
+    pub fn spec(&self) -> Result<Spec> {
+        let spec =
+            Spec::told(self.method, self.seed, self.beta, self.knob)?.policy(self.lengthscale)?;
+        self.track_length
+            .map_or(Ok(spec), |length| spec.track_length(length))
+    }
 }
 
 /// One trial of a study.
@@ -123,12 +137,7 @@ impl Study {
             ));
         }
         // Fails on a bad method, w₀ or lap length before anything is written.
-        let mut settings =
-            Settings::race(config.method, config.seed, config.beta).for_policy(config.lengthscale);
-        if let Some(length) = config.track_length {
-            settings = settings.on_track(length);
-        }
-        let optimizer = config.method.optimizer(config.w0.clone(), &settings)?;
+        let optimizer = config.spec()?.optimizer(config.w0.clone())?;
         let dump = Dump {
             config: serde_json::to_string(&config).map_err(|e| Error::json("study settings", e))?,
             optimizer: serde_json::to_string(&optimizer.save())
@@ -534,6 +543,7 @@ mod tests {
             w0: vec![0.1, 0.2, 0.3],
             track: None,
             track_length: None,
+            knob: None,
         }
     }
 

@@ -2,16 +2,15 @@
 //! results of the papers that introduced the peers (TuRBO, LineBO, REMBO).
 
 use cdbo::benchmarks::Problem;
-use cdbo::method::{Method, Settings, by_name, resume};
+use cdbo::method::{Method, Spec, resume};
 use cdbo::optimizers::{FailedLap, Optimizer, Saved};
 
 fn optimiser(method: &str, problem: &Problem, seed: u64) -> Box<dyn Optimizer + Send> {
-    by_name(
-        method,
-        problem.start.clone(),
-        &Settings::problem(seed, problem.radius),
-    )
-    .unwrap()
+    Spec::problem(method.parse().unwrap(), problem.radius)
+        .unwrap()
+        .seed(seed)
+        .optimizer(problem.start.clone())
+        .unwrap()
 }
 
 /// The best reward of `evals` laps.
@@ -152,7 +151,7 @@ fn every_method_refuses_bad_tells_and_keeps_its_state() {
             "{method}: the pending suggestion changed"
         );
     }
-    assert!(by_name("simplex", vec![0.0], &Settings::problem(0, 1.0)).is_err());
+    assert!("simplex".parse::<Method>().is_err());
 }
 
 /// TuRBO (Eriksson et al. 2019, Fig. 3) and LineBO (Kirschner et al. 2019, Fig. 2) beat
@@ -237,7 +236,11 @@ fn rembo_finds_branin_in_100d_far_faster_than_random_search() {
 #[test]
 fn cmaes_follows_the_failure_places_while_every_lap_fails() {
     let run = |with_places: bool| -> f64 {
-        let mut es = by_name("cmaes", vec![0.0; 5], &Settings::problem(1, 5.0)).unwrap();
+        let mut es = Spec::problem(Method::Cmaes, 5.0)
+            .unwrap()
+            .seed(1)
+            .optimizer(vec![0.0; 5])
+            .unwrap();
         let mut last = Vec::new();
         for lap in 0..200 {
             let w = es.ask().unwrap();
@@ -264,14 +267,8 @@ fn cmaes_follows_the_failure_places_while_every_lap_fails() {
 
 /// The largest |wᵢ − w₀ᵢ| (max norm) and Euclidean distance from w₀ over `laps` laps scored
 /// by `reward`.
-fn reach(
-    method: Method,
-    settings: &Settings,
-    w0: &[f64],
-    laps: usize,
-    reward: impl Fn(&[f64]) -> f64,
-) -> (f64, f64) {
-    let mut opt = method.optimizer(w0.to_vec(), settings).unwrap();
+fn reach(spec: Spec, w0: &[f64], laps: usize, reward: impl Fn(&[f64]) -> f64) -> (f64, f64) {
+    let mut opt = spec.optimizer(w0.to_vec()).unwrap();
     let (mut max_norm, mut euclid) = (0.0f64, 0.0f64);
     for _ in 0..laps {
         let w = opt.ask().unwrap();
@@ -291,43 +288,22 @@ fn reach(
 #[test]
 fn each_methods_knob_reaches_its_optimiser() {
     let w0: Vec<f64> = (0..12).map(|i| 0.1 * i as f64 - 0.4).collect();
-    let race = |m| Settings::race(m, 3, 1.0);
-    let with = |m, v| race(m).with_knob(m, v).unwrap();
-    let as_published = |m| Settings {
-        knob: None,
-        ..race(m)
-    };
+    let race = |m| Spec::race(m).seed(3);
+    let with = |m, v| race(m).knob(v).unwrap();
+    let as_published = |m: Method| race(m).knob(m.knob().published).unwrap();
     let failing = |_: &[f64]| 0.0;
     let rising = |w: &[f64]| 10.0 + w.iter().sum::<f64>();
     // TuRBO: 10 design points (w₀ and 9 in the region) at L_init 0.1: within 0.15 of w₀.
-    let (tuned, _) = reach(Method::Turbo, &with(Method::Turbo, 0.1), &w0, 10, failing);
-    let (published, _) = reach(
-        Method::Turbo,
-        &as_published(Method::Turbo),
-        &w0,
-        10,
-        failing,
-    );
+    let (tuned, _) = reach(with(Method::Turbo, 0.1), &w0, 10, failing);
+    let (published, _) = reach(as_published(Method::Turbo), &w0, 10, failing);
     assert!(
         tuned <= 0.1 * 1.5 + 1e-12 && tuned > 0.05,
         "TuRBO at L_init 0.1: {tuned}"
     );
     assert!(published > 0.5, "TuRBO at 0.8: {published}");
     // LineBO at step 0.05: every lap within 0.05 of w₀.
-    let (_, tuned) = reach(
-        Method::Linebo,
-        &with(Method::Linebo, 0.05),
-        &w0,
-        12,
-        failing,
-    );
-    let (_, published) = reach(
-        Method::Linebo,
-        &as_published(Method::Linebo),
-        &w0,
-        12,
-        failing,
-    );
+    let (_, tuned) = reach(with(Method::Linebo, 0.05), &w0, 12, failing);
+    let (_, published) = reach(as_published(Method::Linebo), &w0, 12, failing);
     assert!(
         tuned <= 0.05 + 1e-12 && tuned > 0.01,
         "LineBO at step 0.05: {tuned}"
@@ -335,21 +311,26 @@ fn each_methods_knob_reaches_its_optimiser() {
     assert!(published > 0.5, "LineBO on the whole line: {published}");
     // REMBO-5d at b = 0.002: |Δwᵢ| ≤ 1.5·0.002·Σⱼ|Aᵢⱼ| (5 standard normals: well under 0.1).
     for m in [Method::Rembo5d, Method::Rembo10d] {
-        let (tuned, _) = reach(m, &with(m, 0.002), &w0, 15, rising);
-        let (published, _) = reach(m, &as_published(m), &w0, 15, rising);
+        let (tuned, _) = reach(with(m, 0.002), &w0, 15, rising);
+        let (published, _) = reach(as_published(m), &w0, 15, rising);
         assert!(tuned < 0.1 && tuned > 0.0, "{m} at b 0.002: {tuned}");
         assert!(published > 0.5, "{m} at √d: {published}");
     }
     // The σ₀ methods: the knob is σ₀.
-    assert_eq!(with(Method::Random, 0.2).sigma0, 0.2);
-    assert_eq!(race(Method::Random).sigma0, Method::Random.knob().value);
-    assert_eq!(race(Method::Turbo).knob, Some(Method::Turbo.knob().value));
+    assert_eq!(with(Method::Random, 0.2).sigma0_value(), 0.2);
+    assert_eq!(
+        race(Method::Random).sigma0_value(),
+        Method::Random.knob().value
+    );
+    assert_eq!(
+        race(Method::Turbo).knob_value(),
+        Some(Method::Turbo.knob().value)
+    );
 }
 
 /// A value a method cannot take is refused naming the method, its knob and the range.
 #[test]
 fn bad_knob_values_are_refused_naming_the_knob() {
-    let s = Settings::race(Method::Turbo, 0, 1.0);
     for (m, v) in [
         (Method::Turbo, 2.0),
         (Method::Turbo, 0.0),
@@ -357,12 +338,12 @@ fn bad_knob_values_are_refused_naming_the_knob() {
         (Method::Rembo5d, f64::NAN),
         (Method::Random, f64::INFINITY),
     ] {
-        let e = s.with_knob(m, v).unwrap_err().to_string();
+        let e = Spec::race(m).knob(v).unwrap_err().to_string();
         assert!(
             e.contains(m.name()) && e.contains(m.knob().kind.name()),
             "{m} {v}: {e}"
         );
     }
-    let e = s.with_knob(Method::Turbo, 1.7).unwrap_err().to_string();
+    let e = Spec::race(Method::Turbo).knob(1.7).unwrap_err().to_string();
     assert!(e.contains("(0, 1.6]"), "{e}");
 }

@@ -2,10 +2,15 @@
 //! places, and a lap with a cliff on which it must beat random search.
 
 use cdbo::learner::pattern_search::{PatternSearch, PatternSearchConfig, push};
-use cdbo::method::{Method, Settings, by_name, resume};
+use cdbo::method::{Method, Spec, resume};
 use cdbo::optimizers::{FailedLap, Optimizer, Saved};
 use cdbo::policy::RkhsPolicy;
 use cdbo::policy::rkhs::default_lengthscale;
+
+/// `method` as it races, with this seed and β = 2.
+fn race_spec(method: Method, seed: u64) -> Spec {
+    Spec::told(method, seed, 2.0, None).unwrap()
+}
 
 /// A toy lap with a cliff: D segments driven in order at speeds wᵢ; segment i takes at most
 /// cᵢ = 0.5 + 0.4·sin²(i). Too fast (wᵢ > cᵢ) or stopped (wᵢ ≤ 0.05), the car fails there, at
@@ -50,12 +55,9 @@ fn started(n: usize, config: PatternSearchConfig) -> PatternSearch {
 
 /// The best reward of a method on the 20-segment cliff from wᵢ = 0.2, 200 laps.
 fn best_on_cliff(method: &str, seed: u64) -> f64 {
-    let mut opt = by_name(
-        method,
-        vec![0.2; 20],
-        &Settings::race(method.parse().unwrap(), seed, 2.0),
-    )
-    .unwrap();
+    let mut opt = race_spec(method.parse().unwrap(), seed)
+        .optimizer(vec![0.2; 20])
+        .unwrap();
     drive(opt.as_mut(), 200);
     opt.best().unwrap().1
 }
@@ -187,12 +189,9 @@ fn sweeps_narrow_their_blocks() {
 #[test]
 fn pattern_search_is_deterministic_and_resumes_exactly() {
     let new = || {
-        by_name(
-            "pattern-search",
-            vec![0.2; 12],
-            &Settings::race(Method::PatternSearch, 3, 2.0),
-        )
-        .unwrap()
+        race_spec(Method::PatternSearch, 3)
+            .optimizer(vec![0.2; 12])
+            .unwrap()
     };
     let (mut a, mut b) = (new(), new());
     assert_eq!(drive(a.as_mut(), 40), drive(b.as_mut(), 40));
@@ -207,12 +206,9 @@ fn pattern_search_is_deterministic_and_resumes_exactly() {
 /// A failure place outside [0, 1] is refused and changes nothing.
 #[test]
 fn a_bad_failure_place_is_refused() {
-    let mut ps = by_name(
-        "pattern-search",
-        vec![0.2; 4],
-        &Settings::race(Method::PatternSearch, 0, 2.0),
-    )
-    .unwrap();
+    let mut ps = race_spec(Method::PatternSearch, 0)
+        .optimizer(vec![0.2; 4])
+        .unwrap();
     let w = ps.ask().unwrap();
     let before = ps.save();
     for at in [-0.1, 1.5, f64::NAN] {
@@ -456,10 +452,11 @@ fn pedal_lap(w: &[f64], lengthscale: f64) -> (f64, Option<FailedLap>) {
 /// A race's pattern search on a 12-kernel policy (told its length-scale) from π = 0.
 fn pushing(seed: u64) -> (Box<dyn Optimizer + Send>, f64) {
     let l = default_lengthscale(12);
-    let settings = Settings::race(Method::PatternSearch, seed, 2.0).for_policy(l);
     (
-        Method::PatternSearch
-            .optimizer(vec![0.0; 12], &settings)
+        race_spec(Method::PatternSearch, seed)
+            .policy(l)
+            .unwrap()
+            .optimizer(vec![0.0; 12])
             .unwrap(),
         l,
     )
@@ -502,12 +499,9 @@ fn the_push_raises_the_pedal_and_repairs_it_until_the_lap_completes() {
         laps[0].1
     );
 
-    let mut plain = by_name(
-        "pattern-search",
-        vec![0.0; 12],
-        &Settings::race(Method::PatternSearch, 4, 2.0),
-    )
-    .unwrap();
+    let mut plain = race_spec(Method::PatternSearch, 4)
+        .optimizer(vec![0.0; 12])
+        .unwrap();
     let laps = drive_pedal(plain.as_mut(), l, 2);
     assert_eq!(
         laps[1].0.iter().filter(|&&v| v != 0.0).count(),
@@ -616,8 +610,8 @@ fn a_saved_push_that_cannot_be_is_refused() {
 fn with_the_push_it_beats_random_search_on_the_pedal_cliff() {
     let l = default_lengthscale(12);
     let best = |method: Method, seed: u64| {
-        let settings = Settings::race(method, seed, 2.0).for_policy(l);
-        let mut opt = method.optimizer(vec![0.0; 12], &settings).unwrap();
+        let spec = race_spec(method, seed).policy(l).unwrap();
+        let mut opt = spec.optimizer(vec![0.0; 12]).unwrap();
         drive_pedal(opt.as_mut(), l, 150);
         opt.best().unwrap().1
     };
@@ -671,6 +665,7 @@ fn a_study_told_the_laps_length_drives_the_races_laps() {
                 w0: raced.initial.weights.clone(),
                 track: None,
                 track_length,
+                knob: None,
             },
         )
         .unwrap();

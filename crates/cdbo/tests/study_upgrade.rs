@@ -26,6 +26,7 @@ fn config() -> StudyConfig {
         w0: vec![0.1, -0.2, 0.3, 0.05],
         track: None,
         track_length: None,
+        knob: None,
     }
 }
 

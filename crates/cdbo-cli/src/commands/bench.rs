@@ -139,8 +139,8 @@ fn optimizers(args: &OptimizersArgs) -> CliResult {
     for method in &args.methods {
         let (mut bests, mut seconds) = (Vec::new(), 0.0);
         for seed in 0..args.seeds {
-            let settings = cdbo::method::Settings::problem(seed, problem.radius);
-            let mut opt = method.optimizer(problem.start.clone(), &settings)?;
+            let spec = cdbo::method::Spec::problem(*method, problem.radius)?.seed(seed);
+            let mut opt = spec.optimizer(problem.start.clone())?;
             let start = std::time::Instant::now();
             for _ in 0..args.evals {
                 let w = opt.ask()?;
@@ -233,8 +233,8 @@ fn suggest(args: &SuggestArgs) -> CliResult {
     }
     times.sort_by(f64::total_cmp);
     let pick = |q: f64| times[((times.len() - 1) as f64 * q).round() as usize];
-    let settings = cdbo::method::Settings::race(Method::PatternSearch, 7, 1.0);
-    let mut ps = Method::PatternSearch.optimizer(vec![0.0; args.dims], &settings)?;
+    let spec = cdbo::method::Spec::told(Method::PatternSearch, 7, 1.0, None)?;
+    let mut ps = spec.optimizer(vec![0.0; args.dims])?;
     for _ in 0..args.observations {
         let w = ps.ask()?;
         ps.tell(&w, reward(&w))?;

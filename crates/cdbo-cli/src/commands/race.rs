@@ -85,10 +85,17 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         )
         .into());
     }
-    let knob_value = match args.knob.or(args.sigma0) {
-        Some(v) => Some(knob.check(args.method, v)?),
-        None => None,
+    let config = RaceConfig {
+        method: args.method,
+        kernels: args.kernels,
+        laps: args.laps,
+        seed: args.seed,
+        beta: args.beta,
+        demo_speed: args.demo_speed,
+        knob: args.knob.or(args.sigma0),
     };
+    // A knob the method cannot take is refused before any lap is driven.
+    config.spec()?;
     if let Some(w) = cdbo::method::cost::slow_race_warning(args.method, args.kernels, args.laps) {
         eprintln!("warning: {w}");
     }
@@ -123,15 +130,6 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         ))
     });
     std::fs::create_dir_all(&out).map_err(|e| format!("{}: {e}", out.display()))?;
-    let config = RaceConfig {
-        method: args.method,
-        kernels: args.kernels,
-        laps: args.laps,
-        seed: args.seed,
-        beta: args.beta,
-        demo_speed: args.demo_speed,
-        knob: knob_value,
-    };
     let bar = if args.json {
         ProgressBar::hidden()
     } else {

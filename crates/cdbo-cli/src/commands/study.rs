@@ -70,6 +70,9 @@ pub struct InitialPolicy {
     /// UCB exploration weight β (default 1).
     #[arg(long, allow_negative_numbers = true, value_parser = super::value::non_negative)]
     beta: Option<f64>,
+    /// The method's main knob, as `cdbo race --knob` (default: its race value).
+    #[arg(long, allow_negative_numbers = true)]
+    knob: Option<f64>,
 }
 
 impl InitialPolicy {
@@ -110,6 +113,7 @@ impl InitialPolicy {
             w0: policy.weights,
             track: None,
             track_length: self.track_length,
+            knob: self.knob,
         })
     }
 
@@ -153,6 +157,10 @@ impl InitialPolicy {
                 .track_length
                 .map_or("no --track-length".into(), |k| k.to_string());
             return differs("--track-length", l.to_string(), kept);
+        }
+        if let Some(k) = self.knob.filter(|k| Some(*k) != stored.knob) {
+            let kept = stored.knob.map_or("no --knob".into(), |k| k.to_string());
+            return differs("--knob", k.to_string(), kept);
         }
         Ok(())
     }

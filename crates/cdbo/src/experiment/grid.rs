@@ -19,7 +19,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::method::Method;
+use crate::method::{Method, Spec};
 
 use crate::error::{Error, Result};
 
@@ -221,7 +221,7 @@ impl ExperimentConfig {
                     "a method of the grid",
                 ));
             }
-            m.knob().check(m, v)?;
+            Spec::race(m).knob(v)?;
         }
         if !(self.demo_speed.is_finite() && self.demo_speed > 0.0) {
             return Err(Error::invalid_value(

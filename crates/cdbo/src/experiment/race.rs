@@ -9,7 +9,7 @@ use crate::error::{Error, Result};
 use crate::evaluator::simulator::SimEvaluator;
 use crate::evaluator::{Evaluator, Outcome};
 use crate::limit::{Limit, limit_lap};
-use crate::method::Method;
+use crate::method::{Method, Spec};
 use crate::policy::RkhsPolicy;
 use crate::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 use crate::sim::{FailureReason, LapResult, Simulator};
@@ -35,6 +35,13 @@ pub struct RaceConfig {
     /// box); `None`: its race value. Older configs name it `sigma0`.
     #[serde(default, alias = "sigma0", skip_serializing_if = "Option::is_none")]
     pub knob: Option<f64>,
+}
+
+impl RaceConfig {
+    /// The race's specification of its method.
+    pub fn spec(&self) -> Result<Spec> {
+        Spec::told(self.method, self.seed, self.beta, self.knob)
+    }
 }
 
 impl Default for RaceConfig {
@@ -152,15 +159,11 @@ pub fn race_with(
     }
     let lengthscale = default_lengthscale(config.kernels);
     let initial = RkhsPolicy::fit(&demo_pairs, config.kernels, lengthscale, DEFAULT_RIDGE)?;
-    let mut settings = crate::method::Settings::race(config.method, config.seed, config.beta)
-        .for_policy(lengthscale)
-        .on_track(limit.track_length);
-    if let Some(value) = config.knob {
-        settings = settings.with_knob(config.method, value)?;
-    }
     let optimizer = config
-        .method
-        .optimizer(initial.weights.clone(), &settings)?;
+        .spec()?
+        .policy(lengthscale)?
+        .track_length(limit.track_length)?
+        .optimizer(initial.weights.clone())?;
     let mut laps = Vec::with_capacity(config.laps);
     let mut best = (initial.weights.clone(), 0.0);
     let mut source = InMemory::new(optimizer, config.laps);

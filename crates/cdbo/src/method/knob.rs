@@ -12,7 +12,7 @@ pub const PAPER_SIGMA0: f64 = 0.03;
 /// What a method's main knob sets.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum KnobKind {
-    /// The exploration scale σ₀ around w₀ ([`Settings::sigma0`](crate::method::Settings::sigma0)).
+    /// The exploration scale σ₀ around w₀ ([`Spec::sigma0`](crate::method::Spec::sigma0)).
     Sigma0,
     /// TuRBO's initial trust-region side L_init.
     TrustRegionLength,
@@ -61,7 +61,7 @@ impl Knob {
 
     /// `value` if the method can take it: positive, at most [`max`](Knob::max), and finite
     /// unless the published value is infinite (LineBO's whole line: `--knob inf`).
-    pub fn check(&self, method: Method, value: f64) -> Result<f64> {
+    pub(super) fn check(&self, method: Method, value: f64) -> Result<f64> {
         let finite = value.is_finite() || value == self.published;
         if finite && value > 0.0 && value <= self.max {
             Ok(value)
@@ -154,10 +154,10 @@ mod tests {
             linebo.check(Method::Linebo, f64::INFINITY).unwrap(),
             f64::INFINITY
         );
-        let settings = crate::method::Settings::race(Method::Linebo, 0, 1.0);
-        assert_eq!(settings.knob, Some(0.3));
-        let whole = settings.with_knob(Method::Linebo, f64::INFINITY).unwrap();
-        assert_eq!(whole.knob, None);
+        let spec = crate::method::Spec::race(Method::Linebo);
+        assert_eq!(spec.knob_value(), Some(0.3));
+        let whole = spec.knob(f64::INFINITY).unwrap();
+        assert_eq!(whole.knob_value(), None);
         for m in [Method::Turbo, Method::Rembo5d, Method::Random] {
             let e = m.knob().check(m, f64::INFINITY).unwrap_err().to_string();
             assert!(e.contains(m.name()), "{e}");

@@ -1,15 +1,15 @@
 //! The one registry of methods: each method's name (on the command line, in grids, records,
 //! studies and the Python package), its description (the command line's help), its colour in
-//! figures, its main knob ([`knob`]), the settings every method is built from ([`settings`])
+//! figures, its main knob ([`knob`]), the specification every run is built from ([`spec`])
 //! and what it costs ([`cost`]). Everything that names a method reads [`Method`]; the generic
 //! optimisers ([`crate::optimizers`]) and the learners ([`crate::learner`]) know nothing of it.
 
 pub mod cost;
 pub mod knob;
-pub mod settings;
+pub mod spec;
 
 pub use knob::{Knob, KnobKind, PAPER_SIGMA0};
-pub use settings::{Settings, by_name, resume};
+pub use spec::{Spec, resume};
 
 use std::fmt;
 use std::str::FromStr;

@@ -280,7 +280,7 @@ fn with_heartbeat(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::method::{Method, Settings, by_name};
+    use crate::method::{Method, Spec};
 
     /// Rewards from a closed form: −‖w − w*‖², a failed lap where w₀ > 1.
     struct Bowl;
@@ -302,8 +302,11 @@ mod tests {
     /// The in-memory loop asks, drives and tells exactly as a hand-written ask/tell loop does.
     #[test]
     fn in_memory_runs_are_the_hand_written_loop() {
-        let optimizer =
-            || by_name("cdbo", vec![0.0; 3], &Settings::race(Method::Cdbo, 4, 2.0)).unwrap();
+        let optimizer = || {
+            Spec::told(Method::Cdbo, 4, 2.0, None)
+                .and_then(|spec| spec.optimizer(vec![0.0; 3]))
+                .unwrap()
+        };
         let mut told = Vec::new();
         let mut source = InMemory::new(optimizer(), 12);
         run(&mut source, &mut Bowl, &mut |e| {
