@@ -20,6 +20,38 @@
 //! - [`torcs`]: the racing game TORCS as a source of laps (its robot, setup and lap runner).
 //! - [`benchmarks`]: standard test functions.
 //! - [`sizes`]: the bounds on every size a user gives.
+//! - [`prelude`]: the names most programs need, in one import.
+//!
+//! # Learning a lap in twenty lines
+//!
+//! Load a track, fit the paper's w₀ to a 15 m/s demonstration, then let a method ask for a
+//! policy and tell it each lap's reward and, for a failed lap, where and why it failed:
+//!
+//! ```
+//! use cdbo::prelude::*;
+//!
+//! # fn main() -> cdbo::Result<()> {
+//! let track = Track::builtin("ridgeway")?;
+//! let sim = Simulator::new(track, &Car::spirit_300());
+//! let (demo, pairs) = demonstrate(&sim, 15.0);
+//! let kernels = 30;
+//! let w0 = RkhsPolicy::fit(&pairs, kernels, default_lengthscale(kernels), DEFAULT_RIDGE)?;
+//! let mut optimizer = Spec::race(Method::PatternSearch)
+//!     .seed(7)
+//!     .policy(w0.lengthscale)?
+//!     .track_length(sim.track.length)?
+//!     .optimizer(w0.weights.clone())?;
+//! let mut laps = SimEvaluator { sim, lengthscale: w0.lengthscale };
+//! for trial in 1..=20 {
+//!     let weights = optimizer.ask()?;
+//!     let outcome = laps.evaluate(trial, &weights)?;
+//!     optimizer.tell_lap(&weights, outcome.reward()?, outcome.failed_lap())?;
+//! }
+//! let (_, best) = optimizer.best().expect("twenty laps were told");
+//! assert!(best > demo.reward_mps, "{best} m/s against the demonstration's {}", demo.reward_mps);
+//! # Ok(())
+//! # }
+//! ```
 
 pub mod acquisition;
 pub mod benchmarks;
@@ -38,6 +70,7 @@ pub mod method;
 pub mod optimizers;
 pub mod params;
 pub mod policy;
+pub mod prelude;
 #[cfg(test)]
 mod scratch;
 pub mod serve;

@@ -3,7 +3,7 @@
 //! They are written in the TORCS track format and read by [`super::torcs`], like real tracks.
 
 use super::Track;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::params::Params;
 
 /// The default track of every command.
@@ -27,9 +27,28 @@ pub fn load(name: &str) -> Option<Result<Track>> {
     )
 }
 
+impl Track {
+    /// The built-in track `name` ([`names`]), or an error naming the built-in tracks.
+    pub fn builtin(name: &str) -> Result<Track> {
+        load(name).unwrap_or_else(|| {
+            Err(Error::NotFound {
+                what: "built-in track",
+                name: format!("{name:?}"),
+                detail: format!("built in: {}", names().collect::<Vec<_>>().join(", ")),
+            })
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_unknown_builtin_names_the_builtins() {
+        let e = Track::builtin("monaco").unwrap_err().to_string();
+        assert!(e.contains("\"monaco\"") && e.contains("ridgeway"), "{e}");
+    }
 
     #[test]
     fn every_builtin_track_is_a_closed_circuit_of_3_to_6_km() {
