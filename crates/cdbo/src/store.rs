@@ -7,7 +7,7 @@
 //! its upgrade, the write transaction under the study's or grid's lock, the claim and its
 //! renewal (the heartbeat), counting the rows done and not done, and every error naming the
 //! database ([`sqlite`], [`postgres`]). A study or a grid says only what its rows are: a
-//! [`Kind`], and the statements of what it stores beside the claims ([`crate::study`],
+//! `Kind`, and the statements of what it stores beside the claims ([`crate::study`],
 //! [`crate::experiment::shared`]). Which row a worker gets is decided by the rules of
 //! [`claim`], apart from any database; [`Location`] is where a user names one.
 
@@ -43,22 +43,57 @@ pub(crate) struct Table {
     pub sqlite_upgrade: &'static str,
     /// The table in a PostgreSQL database (any number of studies or grids).
     pub postgres: &'static str,
-    /// In PostgreSQL, the column naming the study or grid a row belongs to.
-    pub parent: &'static str,
     /// The column that is NULL until the row is done.
     pub done: &'static str,
     /// In PostgreSQL, the statement that takes the study's or grid's write lock (its name is
     /// `$1`); it returns no row where there is nothing to lock.
     pub lock: &'static str,
-    /// Whether opening to write makes what is missing (a grid, which any worker may store
-    /// first: the SQLite file, the PostgreSQL tables), rather than refusing it (a study, made
-    /// by its own `create`).
-    pub made_on_open: bool,
+    /// What the rows belong to.
+    pub parent: Parent,
+}
+
+/// What claimed rows belong to: it names them in messages, and decides who makes them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Parent {
+    /// A study's trials.
+    Study,
+    /// A grid's cells.
+    Grid,
+}
+
+impl Parent {
+    /// In PostgreSQL, the column naming the study or grid a row belongs to.
+    #[cfg_attr(not(feature = "postgres"), allow(dead_code))]
+    pub(crate) fn column(self) -> &'static str {
+        match self {
+            Parent::Study => "study",
+            Parent::Grid => "grid",
+        }
+    }
+
+    /// Whether opening to write makes what is missing (the SQLite file, the PostgreSQL
+    /// tables): for a grid, which any worker may store first; a study is made by its own
+    /// `create` only.
+    pub(crate) fn made_on_open(self) -> bool {
+        self == Parent::Grid
+    }
+
     /// The error for a study or grid that does not exist.
-    pub missing: fn(PathBuf) -> Error,
+    pub(crate) fn missing(self, path: PathBuf) -> Error {
+        match self {
+            Parent::Study => Error::NoStudy { path },
+            Parent::Grid => Error::NoGrid { path },
+        }
+    }
+
     /// The error for a file or database that holds no study or grid this version reads, and
     /// why.
-    pub foreign: fn(PathBuf, String) -> Error,
+    pub(crate) fn foreign(self, path: PathBuf, reason: String) -> Error {
+        match self {
+            Parent::Study => Error::NotAStudy { path, reason },
+            Parent::Grid => Error::NotAGrid { path, reason },
+        }
+    }
 }
 
 /// A kind of claimed rows (a study's trials, a grid's cells): the type that ties a back end's
@@ -91,15 +126,11 @@ pub(crate) trait RowsTransaction {
     fn commit(self: Box<Self>) -> Result<()>;
 }
 
-/// Refuses a file or database written with a newer schema than this version reads, with the
-/// error `foreign` makes ([`Table::foreign`]).
-pub(crate) fn check_version(
-    label: &Path,
-    version: i64,
-    foreign: fn(PathBuf, String) -> Error,
-) -> Result<()> {
+/// Refuses a file or database written with a newer schema than this version reads, as not
+/// holding a study or grid of `parent`'s kind.
+pub(crate) fn check_version(label: &Path, version: i64, parent: Parent) -> Result<()> {
     if version > SCHEMA_VERSION {
-        return Err(foreign(
+        return Err(parent.foreign(
             label.to_owned(),
             format!(
                 "written by a newer cdbo (study schema {version}, this version reads {SCHEMA_VERSION}); upgrade cdbo"

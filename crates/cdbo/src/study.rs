@@ -90,6 +90,20 @@ pub struct Trial {
     pub x_fail: Option<f64>,
 }
 
+impl Trial {
+    /// A trial just asked: `weights` to drive, nothing told yet.
+    fn asked(id: i64, weights: Vec<f64>) -> Trial {
+        Trial {
+            id,
+            weights,
+            reward: None,
+            lap_time_s: None,
+            failure: None,
+            x_fail: None,
+        }
+    }
+}
+
 /// An open study.
 pub struct Study {
     location: Location,
@@ -240,16 +254,9 @@ impl Study {
         let told = tx.told()?;
         let optimizer = load_optimizer(tx.as_mut(), &self.label, &mut self.optimizer, told)?;
         let weights = optimizer.ask()?;
-        let id = tx.add_trial(&weights_json(&weights)?, unix_now(), None)?;
+        let id = tx.add_trial(&weights_json(&weights)?, unix_now())?;
         tx.commit()?;
-        Ok(Trial {
-            id,
-            weights,
-            reward: None,
-            lap_time_s: None,
-            failure: None,
-            x_fail: None,
-        })
+        Ok(Trial::asked(id, weights))
     }
 
     /// The trial `worker` is to drive next, claimed for it until its lease runs out (renew it
@@ -298,19 +305,9 @@ impl Study {
                         None => return Ok(Next::Wait),
                     }
                 };
-                let id = tx.add_trial(
-                    &weights_json(&weights)?,
-                    now,
-                    Some((&worker.id, lease_until)),
-                )?;
-                Trial {
-                    id,
-                    weights,
-                    reward: None,
-                    lap_time_s: None,
-                    failure: None,
-                    x_fail: None,
-                }
+                let id = tx.add_trial(&weights_json(&weights)?, now)?;
+                tx.set_claim(id, &worker.id, lease_until)?;
+                Trial::asked(id, weights)
             }
         };
         tx.commit()?;

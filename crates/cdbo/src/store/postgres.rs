@@ -5,9 +5,9 @@
 //! grids `cdbo_grids`, `cdbo_grid_runs` and `cdbo_grid_sessions`, all created together.
 //! Numbers are `DOUBLE PRECISION`, read and written in binary: bit for bit.
 //!
-//! Every write transaction first takes its study's or grid's lock ([`Table::lock`]), so that
-//! the claims of one study or grid are serialised as SQLite's write lock serialises a file's,
-//! while those of others run side by side.
+//! Every write transaction first takes its study's or grid's lock (the `lock` statement of its
+//! kind's table), so that the claims of one study or grid are serialised as SQLite's write
+//! lock serialises a file's, while those of others run side by side.
 
 use std::marker::PhantomData;
 use std::path::{Path, PathBuf};
@@ -16,7 +16,7 @@ use std::time::Duration;
 use postgres::{Client, GenericClient, NoTls};
 
 use super::claim::Claim;
-use super::{BUSY_TIMEOUT, Kind, Rows, RowsTransaction, SCHEMA_VERSION, Table, check_version};
+use super::{BUSY_TIMEOUT, Kind, Parent, Rows, RowsTransaction, SCHEMA_VERSION, check_version};
 use crate::error::{Error, Result};
 
 /// How long connecting may take before the database counts as unreachable.
@@ -89,12 +89,12 @@ impl<K: Kind> PgRows<K> {
                 .map_err(err)?;
         }
         let mut tx = client.transaction().map_err(err)?;
-        if writable && table.made_on_open {
-            ensure_schema(&mut tx, label, table.foreign)?;
+        if writable && table.parent.made_on_open() {
+            ensure_schema(&mut tx, label, table.parent)?;
         } else {
-            let version =
-                schema_version(&mut tx, label)?.ok_or_else(|| (table.missing)(label.to_owned()))?;
-            check_version(label, version, table.foreign)?;
+            let version = schema_version(&mut tx, label)?
+                .ok_or_else(|| table.parent.missing(label.to_owned()))?;
+            check_version(label, version, table.parent)?;
         }
         tx.commit().map_err(err)?;
         Ok(PgRows {
@@ -117,7 +117,7 @@ impl<K: Kind> PgRows<K> {
         let err = |e| pg_error(label, e);
         let mut client = connect(url, label)?;
         let mut tx = client.transaction().map_err(err)?;
-        ensure_schema(&mut tx, label, K::TABLE.foreign)?;
+        ensure_schema(&mut tx, label, K::TABLE.parent)?;
         let mut tx = PgTransaction {
             label,
             parent: name,
@@ -142,7 +142,7 @@ impl<K: Kind> PgRows<K> {
         let mut tx = self.client.transaction().map_err(err)?;
         let locked = tx.query_opt(K::TABLE.lock, &[&self.parent]).map_err(err)?;
         if locked.is_none() {
-            return Err((K::TABLE.missing)(label.clone()));
+            return Err(K::TABLE.parent.missing(label.clone()));
         }
         Ok(PgTransaction {
             label,
@@ -159,16 +159,12 @@ impl<K: Kind> Rows for PgRows<K> {
     }
 
     fn heartbeat(&mut self, id: i64, owner: &str, until: f64) -> Result<bool> {
-        let Table {
-            postgres,
-            parent,
-            done,
-            ..
-        } = K::TABLE;
         let sql = format!(
-            "UPDATE {postgres} SET lease_until_unix_s = $1 WHERE {parent} = $2 AND id = $3 AND owner = $4 AND {done} IS NULL"
+            "UPDATE {} SET lease_until_unix_s = $2 WHERE {} AND id = $3 AND owner = $4",
+            K::TABLE.postgres,
+            rows_of::<K>(false),
         );
-        let n = self.with(|c, name| c.execute(&sql, &[&until, &name, &id, &owner]))?;
+        let n = self.with(|c, name| c.execute(&sql, &[&name, &until, &id, &owner]))?;
         Ok(n == 1)
     }
 
@@ -207,14 +203,10 @@ impl<K: Kind> RowsTransaction for PgTransaction<'_, K> {
     }
 
     fn claims(&mut self) -> Result<Vec<Claim>> {
-        let Table {
-            postgres,
-            parent,
-            done,
-            ..
-        } = K::TABLE;
         let sql = format!(
-            "SELECT id, owner, lease_until_unix_s FROM {postgres} WHERE {parent} = $1 AND {done} IS NULL ORDER BY id"
+            "SELECT id, owner, lease_until_unix_s FROM {} WHERE {} ORDER BY id",
+            K::TABLE.postgres,
+            rows_of::<K>(false),
         );
         self.with(|tx, name| {
             tx.query(&sql, &[&name])?
@@ -231,13 +223,12 @@ impl<K: Kind> RowsTransaction for PgTransaction<'_, K> {
     }
 
     fn set_claim(&mut self, id: i64, owner: &str, until: f64) -> Result<()> {
-        let Table {
-            postgres, parent, ..
-        } = K::TABLE;
         let sql = format!(
-            "UPDATE {postgres} SET owner = $1, lease_until_unix_s = $2 WHERE {parent} = $3 AND id = $4"
+            "UPDATE {} SET owner = $2, lease_until_unix_s = $3 WHERE {} = $1 AND id = $4",
+            K::TABLE.postgres,
+            K::TABLE.parent.column(),
         );
-        self.with(|tx, name| tx.execute(&sql, &[&owner, &until, &name, &id]))?;
+        self.with(|tx, name| tx.execute(&sql, &[&name, &owner, &until, &id]))?;
         Ok(())
     }
 
@@ -249,16 +240,24 @@ impl<K: Kind> RowsTransaction for PgTransaction<'_, K> {
 
 /// Number of `name`'s rows done (or, `done` false, not done yet).
 fn count<K: Kind>(client: &mut impl GenericClient, name: &str, done: bool) -> Sql<usize> {
-    let Table {
-        postgres,
-        parent,
-        done: column,
-        ..
-    } = K::TABLE;
-    let is = if done { "IS NOT NULL" } else { "IS NULL" };
-    let sql = format!("SELECT COUNT(*) FROM {postgres} WHERE {parent} = $1 AND {column} {is}");
+    let sql = format!(
+        "SELECT COUNT(*) FROM {} WHERE {}",
+        K::TABLE.postgres,
+        rows_of::<K>(done)
+    );
     let n: i64 = client.query_one(&sql, &[&name])?.try_get(0)?;
     Ok(n as usize)
+}
+
+/// The condition that picks the rows of the study or grid named `$1` that are done (or,
+/// `done` false, not done yet).
+fn rows_of<K: Kind>(done: bool) -> String {
+    let is = if done { "IS NOT NULL" } else { "IS NULL" };
+    format!(
+        "{} = $1 AND {} {is}",
+        K::TABLE.parent.column(),
+        K::TABLE.done
+    )
 }
 
 /// The studies and the grids the database at `url` holds, by name, in a read-only session
@@ -273,7 +272,7 @@ pub fn names(url: &str, label: &Path) -> Result<(Vec<String>, Vec<String>)> {
     let Some(version) = schema_version(&mut tx, label)? else {
         return Ok((Vec::new(), Vec::new()));
     };
-    check_version(label, version, not_a_study)?;
+    check_version(label, version, Parent::Study)?;
     let mut listed = Vec::new();
     for table in ["cdbo_studies", "cdbo_grids"] {
         let exists: bool = tx
@@ -298,17 +297,13 @@ pub fn names(url: &str, label: &Path) -> Result<(Vec<String>, Vec<String>)> {
 
 /// Creates the tables where the database has none yet, under the schema lock (workers that
 /// start at once create them once); first refuses a database of a newer schema with
-/// `foreign`'s error, having written nothing.
-fn ensure_schema(
-    tx: &mut postgres::Transaction<'_>,
-    label: &Path,
-    foreign: fn(PathBuf, String) -> Error,
-) -> Result<()> {
+/// `parent`'s error, having written nothing.
+fn ensure_schema(tx: &mut postgres::Transaction<'_>, label: &Path, parent: Parent) -> Result<()> {
     let err = |e| pg_error(label, e);
     tx.execute("SELECT pg_advisory_xact_lock($1)", &[&SCHEMA_LOCK])
         .map_err(err)?;
     if let Some(version) = schema_version(tx, label)? {
-        check_version(label, version, foreign)?;
+        check_version(label, version, parent)?;
     }
     tx.batch_execute(SCHEMA).map_err(err)?;
     tx.execute(
@@ -364,11 +359,6 @@ fn schema_version(tx: &mut postgres::Transaction<'_>, label: &Path) -> Result<Op
         path: label.to_owned(),
         reason: format!("schema version {value:?} is not a number"),
     })
-}
-
-/// A database's "not a cdbo study", for what is not one study's or grid's.
-fn not_a_study(path: PathBuf, reason: String) -> Error {
-    Error::NotAStudy { path, reason }
 }
 
 /// Sorts a PostgreSQL error: a lock not had within the lock timeout is "busy", as in SQLite.

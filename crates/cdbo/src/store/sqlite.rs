@@ -26,7 +26,7 @@ impl<K: Kind> SqliteRows<K> {
     /// Opens the file at `path`, refusing one that is not SQLite or of a newer schema, then
     /// lets `read` check what it holds (given the schema version) before anything is written.
     /// Writable, the file is brought to [`SCHEMA_VERSION`] ([`Table::sqlite_upgrade`]), and a
-    /// missing or empty file is made where the kind is [`Table::made_on_open`]. Read-only,
+    /// missing or empty file is made where the kind is made on open ([`super::Parent::made_on_open`]). Read-only,
     /// nothing is written, and a file or folder that is read-only works (then as an immutable
     /// file, if SQLite cannot share it).
     pub(crate) fn open<T>(
@@ -35,8 +35,9 @@ impl<K: Kind> SqliteRows<K> {
         read: impl FnOnce(&Connection, i64) -> Result<T>,
     ) -> Result<(SqliteRows<K>, T)> {
         let table = &K::TABLE;
-        let make = writable && table.made_on_open;
-        let absent = if table.made_on_open {
+        let parent = table.parent;
+        let make = writable && parent.made_on_open();
+        let absent = if parent.made_on_open() {
             std::fs::metadata(path).map_or(true, |m| m.len() == 0)
         } else {
             !path.is_file()
@@ -44,7 +45,7 @@ impl<K: Kind> SqliteRows<K> {
         if !absent {
             check_header(path, table)?;
         } else if !make {
-            return Err((table.missing)(path.to_owned()));
+            return Err(parent.missing(path.to_owned()));
         }
         let err = |e| sql_error::<K>(path, e);
         let conn = if writable {
@@ -60,7 +61,7 @@ impl<K: Kind> SqliteRows<K> {
         };
         conn.busy_timeout(BUSY_TIMEOUT).map_err(err)?;
         let version = user_version(&conn).map_err(err)?;
-        check_version(path, version, table.foreign)?;
+        check_version(path, version, parent)?;
         // Read before anything is written: a foreign database is left as it was.
         let read = read(&conn, version)?;
         if writable {
@@ -156,15 +157,14 @@ impl<K: Kind> Rows for SqliteRows<K> {
     }
 
     fn heartbeat(&mut self, id: i64, owner: &str, until: f64) -> Result<bool> {
-        let Table { sqlite, done, .. } = K::TABLE;
+        let sql = format!(
+            "UPDATE {} SET lease_until_unix_s = ?1 WHERE id = ?2 AND owner = ?3 AND {}",
+            K::TABLE.sqlite,
+            rows_of::<K>(false),
+        );
         let n = self
             .conn
-            .execute(
-                &format!(
-                    "UPDATE {sqlite} SET lease_until_unix_s = ?1 WHERE id = ?2 AND owner = ?3 AND {done} IS NULL"
-                ),
-                params![until, id, owner],
-            )
+            .execute(&sql, params![until, id, owner])
             .map_err(self.err())?;
         Ok(n == 1)
     }
@@ -200,14 +200,13 @@ impl<K: Kind> RowsTransaction for SqliteTransaction<'_, K> {
     }
 
     fn claims(&mut self) -> Result<Vec<Claim>> {
-        let Table { sqlite, done, .. } = K::TABLE;
+        let sql = format!(
+            "SELECT id, owner, lease_until_unix_s FROM {} WHERE {} ORDER BY id",
+            K::TABLE.sqlite,
+            rows_of::<K>(false),
+        );
         let err = self.err();
-        let mut stmt = self
-            .tx
-            .prepare(&format!(
-                "SELECT id, owner, lease_until_unix_s FROM {sqlite} WHERE {done} IS NULL ORDER BY id"
-            ))
-            .map_err(&err)?;
+        let mut stmt = self.tx.prepare(&sql).map_err(&err)?;
         let rows = stmt
             .query_map([], |r| {
                 Ok(Claim {
@@ -245,27 +244,28 @@ pub(crate) fn sql_error<K: Kind>(path: &Path, source: rusqlite::Error) -> Error 
     let path = path.to_owned();
     match source.sqlite_error_code() {
         Some(ErrorCode::DatabaseBusy | ErrorCode::DatabaseLocked) => Error::Busy { path },
-        Some(ErrorCode::NotADatabase) => {
-            (K::TABLE.foreign)(path, "the file is not an SQLite database".into())
-        }
+        Some(ErrorCode::NotADatabase) => K::TABLE
+            .parent
+            .foreign(path, "the file is not an SQLite database".into()),
         _ => Error::Sql { path, source },
     }
 }
 
 /// Number of rows done (or, `done` false, not done yet).
 fn count<K: Kind>(conn: &Connection, done: bool) -> rusqlite::Result<usize> {
-    let Table {
-        sqlite,
-        done: column,
-        ..
-    } = K::TABLE;
+    let sql = format!(
+        "SELECT COUNT(*) FROM {} WHERE {}",
+        K::TABLE.sqlite,
+        rows_of::<K>(done)
+    );
+    conn.query_row(&sql, [], |r| r.get::<_, i64>(0))
+        .map(|n| n as usize)
+}
+
+/// The condition that picks the rows done (or, `done` false, not done yet).
+fn rows_of<K: Kind>(done: bool) -> String {
     let is = if done { "IS NOT NULL" } else { "IS NULL" };
-    conn.query_row(
-        &format!("SELECT COUNT(*) FROM {sqlite} WHERE {column} {is}"),
-        [],
-        |r| r.get::<_, i64>(0),
-    )
-    .map(|n| n as usize)
+    format!("{} {is}", K::TABLE.done)
 }
 
 /// WAL journal, full synchronous commits, a busy timeout.
@@ -288,13 +288,14 @@ fn check_header(path: &Path, table: &Table) -> Result<()> {
             source: e,
         })?;
     if head.is_empty() {
-        return Err((table.foreign)(path.to_owned(), "the file is empty".into()));
+        return Err(table
+            .parent
+            .foreign(path.to_owned(), "the file is empty".into()));
     }
     if head != SQLITE_HEADER {
-        return Err((table.foreign)(
-            path.to_owned(),
-            "the file is not an SQLite database".into(),
-        ));
+        return Err(table
+            .parent
+            .foreign(path.to_owned(), "the file is not an SQLite database".into()));
     }
     Ok(())
 }

@@ -88,13 +88,16 @@ pub(crate) fn open(
     Ok((rows, config))
 }
 
-/// Every trial with its times and claim, in id order.
-fn dump_rows(study: &mut Postgres) -> Result<Vec<Row>> {
-    let sql = format!(
-        "SELECT {TRIAL_COLUMNS}, asked_unix_s, told_unix_s, owner, lease_until_unix_s FROM cdbo_trials WHERE study = $1 ORDER BY id"
-    );
-    let rows = study.with(|c, study| c.query(&sql, &[&study]))?;
-    let label = study.label();
+/// The statement that selects the study's (`$1`) trials with their times and claims, as
+/// `filter` (`AND …`, `ORDER BY …`) says.
+fn select_rows(filter: &str) -> String {
+    format!(
+        "SELECT {TRIAL_COLUMNS}, asked_unix_s, told_unix_s, owner, lease_until_unix_s FROM cdbo_trials WHERE study = $1 {filter}"
+    )
+}
+
+/// The trials with their times and claims, as [`select_rows`] reads them.
+fn to_rows(rows: &[postgres::Row], label: &Path) -> Result<Vec<Row>> {
     let err = |e| pg_error(label, e);
     rows.iter()
         .map(|r| {
@@ -114,45 +117,31 @@ impl Storage for Postgres {
         Ok(Box::new(Postgres::begin(self)?))
     }
 
-    fn history(&mut self) -> Result<Vec<Trial>> {
-        Ok(dump_rows(self)?.into_iter().map(|r| r.trial).collect())
-    }
-
-    fn dump(&mut self) -> Result<Dump> {
-        let (config, optimizer) = self.with(|c, study| {
+    fn settings_and_state(&mut self) -> Result<(String, String)> {
+        self.with(|c, study| {
             let row = c.query_one(
                 "SELECT config, optimizer_state FROM cdbo_studies WHERE name = $1",
                 &[&study],
             )?;
             Ok((row.try_get(0)?, row.try_get(1)?))
-        })?;
-        Ok(Dump {
-            config,
-            optimizer,
-            trials: dump_rows(self)?,
         })
+    }
+
+    fn rows(&mut self) -> Result<Vec<Row>> {
+        let sql = select_rows("ORDER BY id");
+        let rows = self.with(|c, study| c.query(&sql, &[&study]))?;
+        to_rows(&rows, self.label())
     }
 }
 
 impl Transaction for PgTransaction<'_, Trials> {
     fn pending(&mut self) -> Result<Vec<(Trial, Claim)>> {
-        let sql = format!(
-            "SELECT {TRIAL_COLUMNS}, owner, lease_until_unix_s FROM cdbo_trials WHERE study = $1 AND reward IS NULL ORDER BY id FOR UPDATE"
-        );
+        let sql = select_rows("AND reward IS NULL ORDER BY id FOR UPDATE");
         let rows = self.with(|tx, study| tx.query(&sql, &[&study]))?;
-        let label = self.label();
-        let err = |e| pg_error(label, e);
-        rows.iter()
-            .map(|r| {
-                let t = to_trial(r, label)?;
-                let c = Claim {
-                    trial: t.id,
-                    owner: r.try_get(6).map_err(err)?,
-                    lease_until: r.try_get(7).map_err(err)?,
-                };
-                Ok((t, c))
-            })
-            .collect()
+        Ok(to_rows(&rows, self.label())?
+            .into_iter()
+            .map(Row::pending)
+            .collect())
     }
 
     fn told_rewards(&mut self) -> Result<Vec<f64>> {
@@ -185,19 +174,13 @@ impl Transaction for PgTransaction<'_, Trials> {
         })
     }
 
-    fn add_trial(
-        &mut self,
-        weights: &str,
-        asked_unix_s: f64,
-        claim: Option<(&str, f64)>,
-    ) -> Result<i64> {
-        let (owner, until) = claim.unzip();
+    fn add_trial(&mut self, weights: &str, asked_unix_s: f64) -> Result<i64> {
         self.with(|tx, study| {
             tx.query_one(
-                "INSERT INTO cdbo_trials (study, id, weights, asked_unix_s, owner, lease_until_unix_s)
-                 SELECT $1, COALESCE(MAX(id), 0) + 1, $2, $3, $4, $5 FROM cdbo_trials WHERE study = $1
+                "INSERT INTO cdbo_trials (study, id, weights, asked_unix_s)
+                 SELECT $1, COALESCE(MAX(id), 0) + 1, $2, $3 FROM cdbo_trials WHERE study = $1
                  RETURNING id",
-                &[&study, &weights, &asked_unix_s, &owner, &until],
+                &[&study, &weights, &asked_unix_s],
             )?
             .try_get(0)
         })

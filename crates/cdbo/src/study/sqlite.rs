@@ -98,77 +98,48 @@ impl Storage for Sqlite {
         Ok(Box::new(Sqlite::begin(self)?))
     }
 
-    fn history(&mut self) -> Result<Vec<Trial>> {
-        Ok(dump_rows(self)?.into_iter().map(|r| r.trial).collect())
+    fn settings_and_state(&mut self) -> Result<(String, String)> {
+        let conn = self.conn();
+        let config = conn.query_row("SELECT value FROM meta WHERE key = 'config'", [], |r| {
+            r.get(0)
+        });
+        let state = config.and_then(|c| Ok((c, optimizer_state(conn)?)));
+        state.map_err(self.err())
     }
 
-    fn dump(&mut self) -> Result<Dump> {
-        let err = self.err();
-        let config = self
-            .conn()
-            .query_row("SELECT value FROM meta WHERE key = 'config'", [], |r| {
-                r.get(0)
-            })
-            .map_err(&err)?;
-        let optimizer = optimizer_state(self.conn()).map_err(err)?;
-        Ok(Dump {
-            config,
-            optimizer,
-            trials: dump_rows(self)?,
-        })
+    fn rows(&mut self) -> Result<Vec<Row>> {
+        select_rows(self.conn(), "ORDER BY id").map_err(self.err())
     }
 }
 
-/// Every trial with its times and claim, in id order.
-fn dump_rows(study: &Sqlite) -> Result<Vec<Row>> {
-    let err = study.err();
-    let conn = study.conn();
+/// The trials with their times and claims that `filter` (`WHERE …`, `ORDER BY …`) selects.
+fn select_rows(conn: &Connection, filter: &str) -> rusqlite::Result<Vec<Row>> {
     // A schema-1 study opened read-only is read as it is: it has no claim columns.
-    let claims = if user_version(conn).map_err(&err)? >= 2 {
+    let claims = if user_version(conn)? >= 2 {
         "owner, lease_until_unix_s"
     } else {
         "NULL, NULL"
     };
-    let mut stmt = conn
-        .prepare(&format!(
-            "SELECT {TRIAL_COLUMNS}, asked_unix_s, told_unix_s, {claims} FROM trials ORDER BY id"
-        ))
-        .map_err(&err)?;
-    let rows = stmt
-        .query_map([], |r| {
-            Ok(Row {
-                trial: row_to_trial(r)?,
-                asked_unix_s: r.get(6)?,
-                told_unix_s: r.get(7)?,
-                owner: r.get(8)?,
-                lease_until_unix_s: r.get(9)?,
-            })
+    let mut stmt = conn.prepare(&format!(
+        "SELECT {TRIAL_COLUMNS}, asked_unix_s, told_unix_s, {claims} FROM trials {filter}"
+    ))?;
+    let rows = stmt.query_map([], |r| {
+        Ok(Row {
+            trial: row_to_trial(r)?,
+            asked_unix_s: r.get(6)?,
+            told_unix_s: r.get(7)?,
+            owner: r.get(8)?,
+            lease_until_unix_s: r.get(9)?,
         })
-        .map_err(&err)?;
-    rows.collect::<rusqlite::Result<Vec<_>>>().map_err(err)
+    })?;
+    rows.collect()
 }
 
 impl Transaction for SqliteTransaction<'_, Trials> {
     fn pending(&mut self) -> Result<Vec<(Trial, Claim)>> {
-        let mut stmt = self
-            .tx()
-            .prepare(&format!(
-                "SELECT {TRIAL_COLUMNS}, owner, lease_until_unix_s FROM trials WHERE reward IS NULL ORDER BY id"
-            ))
-            .map_err(self.err())?;
-        let rows = stmt
-            .query_map([], |r| {
-                let t = row_to_trial(r)?;
-                let c = Claim {
-                    trial: t.id,
-                    owner: r.get(6)?,
-                    lease_until: r.get(7)?,
-                };
-                Ok((t, c))
-            })
-            .map_err(self.err())?;
-        rows.collect::<rusqlite::Result<Vec<_>>>()
-            .map_err(self.err())
+        let rows =
+            select_rows(self.tx(), "WHERE reward IS NULL ORDER BY id").map_err(self.err())?;
+        Ok(rows.into_iter().map(Row::pending).collect())
     }
 
     fn told_rewards(&mut self) -> Result<Vec<f64>> {
@@ -196,17 +167,11 @@ impl Transaction for SqliteTransaction<'_, Trials> {
         optimizer_state(self.tx()).map_err(self.err())
     }
 
-    fn add_trial(
-        &mut self,
-        weights: &str,
-        asked_unix_s: f64,
-        claim: Option<(&str, f64)>,
-    ) -> Result<i64> {
-        let (owner, until) = claim.unzip();
+    fn add_trial(&mut self, weights: &str, asked_unix_s: f64) -> Result<i64> {
         self.tx()
             .execute(
-                "INSERT INTO trials (weights, asked_unix_s, owner, lease_until_unix_s) VALUES (?1, ?2, ?3, ?4)",
-                params![weights, asked_unix_s, owner, until],
+                "INSERT INTO trials (weights, asked_unix_s) VALUES (?1, ?2)",
+                params![weights, asked_unix_s],
             )
             .map_err(self.err())?;
         Ok(self.tx().last_insert_rowid())

@@ -4,8 +4,8 @@
 //! [`crate::store`], and the rows a copy carries ([`Dump`]). What to store — asking, claiming,
 //! telling the optimiser — is [`super::Study`]'s and [`super::claim`]'s, the same for both.
 
-use crate::error::{Error, Result};
-use crate::store::{Kind, Rows, RowsTransaction, Table};
+use crate::error::Result;
+use crate::store::{Kind, Parent, Rows, RowsTransaction, Table};
 
 use super::Trial;
 use super::claim::Claim;
@@ -21,12 +21,9 @@ impl Kind for Trials {
         sqlite_upgrade: "ALTER TABLE trials ADD COLUMN owner TEXT;
                          ALTER TABLE trials ADD COLUMN lease_until_unix_s REAL;",
         postgres: "cdbo_trials",
-        parent: "study",
         done: "reward",
         lock: "SELECT 1 FROM cdbo_studies WHERE name = $1 FOR UPDATE",
-        made_on_open: false,
-        missing: |path| Error::NoStudy { path },
-        foreign: |path, reason| Error::NotAStudy { path, reason },
+        parent: Parent::Study,
     };
 }
 
@@ -57,6 +54,18 @@ pub(crate) struct Row {
     pub lease_until_unix_s: Option<f64>,
 }
 
+impl Row {
+    /// The pending trial and its claim.
+    pub(crate) fn pending(self) -> (Trial, Claim) {
+        let claim = Claim {
+            trial: self.trial.id,
+            owner: self.owner,
+            lease_until: self.lease_until_unix_s,
+        };
+        (self.trial, claim)
+    }
+}
+
 /// A told outcome as stored.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Told {
@@ -83,10 +92,23 @@ pub(crate) trait Storage: Rows {
     fn told(&mut self) -> Result<usize> {
         self.count(true)
     }
+    /// The settings and the optimiser's state, as stored (JSON).
+    fn settings_and_state(&mut self) -> Result<(String, String)>;
+    /// Every trial with its times and claim, in id order.
+    fn rows(&mut self) -> Result<Vec<Row>>;
     /// Every trial, in id order.
-    fn history(&mut self) -> Result<Vec<Trial>>;
+    fn history(&mut self) -> Result<Vec<Trial>> {
+        Ok(self.rows()?.into_iter().map(|r| r.trial).collect())
+    }
     /// Everything the study holds, for a copy.
-    fn dump(&mut self) -> Result<Dump>;
+    fn dump(&mut self) -> Result<Dump> {
+        let (config, optimizer) = self.settings_and_state()?;
+        Ok(Dump {
+            config,
+            optimizer,
+            trials: self.rows()?,
+        })
+    }
 }
 
 /// One write transaction on a study, under its write lock.
@@ -103,14 +125,9 @@ pub(crate) trait Transaction: RowsTransaction {
     fn trial(&mut self, id: i64) -> Result<Option<Trial>>;
     /// The optimiser's saved state (JSON).
     fn optimizer_state(&mut self) -> Result<String>;
-    /// Adds a pending trial with `weights` (JSON), asked at `asked_unix_s`, claimed by
-    /// `claim` = (owner, lease until) if given; returns its id (one more than the last).
-    fn add_trial(
-        &mut self,
-        weights: &str,
-        asked_unix_s: f64,
-        claim: Option<(&str, f64)>,
-    ) -> Result<i64>;
+    /// Adds a pending trial with `weights` (JSON), asked at `asked_unix_s`, unclaimed; returns
+    /// its id (one more than the last).
+    fn add_trial(&mut self, weights: &str, asked_unix_s: f64) -> Result<i64>;
     /// Records trial `id`'s outcome and the optimiser's new state.
     fn record(&mut self, id: i64, told: &Told, optimizer_state: &str) -> Result<()>;
 }

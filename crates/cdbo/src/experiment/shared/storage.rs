@@ -2,8 +2,8 @@
 //! the [`GridStorage`] and [`GridTransaction`] that an SQLite file ([`super::sqlite`]) and a
 //! PostgreSQL database ([`super::postgres`]) implement beside the claims of [`crate::store`].
 
-use crate::error::{Error, Result};
-use crate::store::{Kind, Rows, RowsTransaction, Table};
+use crate::error::Result;
+use crate::store::{Kind, Parent, Rows, RowsTransaction, Table};
 
 /// A grid's cells: done once their run's record is stored. PostgreSQL's lock is an advisory
 /// lock keyed by the grid's name, so that workers starting at once on a grid not stored yet
@@ -25,12 +25,9 @@ impl Kind for Cells {
                 finished_unix_s REAL);
             CREATE TABLE IF NOT EXISTS sessions (id INTEGER PRIMARY KEY, session TEXT NOT NULL);",
         postgres: "cdbo_grid_runs",
-        parent: "grid",
         done: "record",
         lock: "SELECT pg_advisory_xact_lock(hashtextextended('cdbo grid ' || $1, 0))",
-        made_on_open: true,
-        missing: |path| Error::NoGrid { path },
-        foreign: |path, reason| Error::NotAGrid { path, reason },
+        parent: Parent::Grid,
     };
 }
 
