@@ -26,9 +26,9 @@ impl<K: Kind> SqliteRows<K> {
     /// Opens the file at `path`, refusing one that is not SQLite or of a newer schema, then
     /// lets `read` check what it holds (given the schema version) before anything is written.
     /// Writable, the file is brought to [`SCHEMA_VERSION`] ([`Table::sqlite_upgrade`]), and a
-    /// missing or empty file is made where the kind is made on open ([`super::Parent::made_on_open`]). Read-only,
-    /// nothing is written, and a file or folder that is read-only works (then as an immutable
-    /// file, if SQLite cannot share it).
+    /// missing or empty file is made where the kind is made on open
+    /// ([`super::Parent::made_on_open`]). Read-only, nothing is written, and a file or folder
+    /// that is read-only works (then as an immutable file, if SQLite cannot share it).
     pub(crate) fn open<T>(
         path: &Path,
         writable: bool,
