@@ -143,7 +143,7 @@ impl Store for Files {
 
     fn database(&self, database: &str, known: &[Source]) -> Result<Vec<Source>> {
         let label = Location::parse(database, Some("*"))?.label();
-        let (studies, grids) = cdbo::study::postgres::names(database, &label)?;
+        let (studies, grids) = cdbo::store::postgres::names(database, &label)?;
         let at = |name: &String| Location::parse(database, Some(name));
         let shown = |l: &Location| {
             known

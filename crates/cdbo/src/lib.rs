@@ -16,7 +16,8 @@
 //! - [`method`]: the one registry of methods, their knobs and settings, and what they cost.
 //! - [`experiment`]: learning to race a track end to end, and the paper's experiment grid.
 //! - [`study`]: persistent ask/tell studies for a real car; [`evaluator`]: sources of laps;
-//!   [`serve`]: laps as a JSON-lines service.
+//!   [`serve`]: laps as a JSON-lines service; [`store`]: the claimed-row store (SQLite or
+//!   PostgreSQL) behind studies and shared grids.
 //! - [`torcs`]: the racing game TORCS as a source of laps (its robot, setup and lap runner).
 //! - [`benchmarks`]: standard test functions.
 //! - [`sizes`]: the bounds on every size a user gives.
@@ -77,6 +78,7 @@ pub mod serve;
 pub mod sim;
 mod simd;
 pub mod sizes;
+pub mod store;
 pub mod study;
 pub mod torcs;
 pub mod track;

@@ -1,7 +1,7 @@
 //! Persistent ask/tell studies for optimising a real car one lap at a time: every trial
 //! (asked weights, then the told outcome), the settings and the optimiser's [`Saved`] state
-//! after the last tell, kept in a [`storage::Storage`] — an SQLite file ([`sqlite`], the
-//! embedded default) or a PostgreSQL database ([`postgres`]), named by a [`Location`] — so
+//! after the last tell, kept in the claimed-row store ([`crate::store`]) — an SQLite file (the
+//! embedded default) or a PostgreSQL database, named by a [`Location`] — so
 //! that a told result is durable before `tell` returns, and a study survives crashes,
 //! `kill -9` and restarts, continuing with exactly the suggestion an uninterrupted run would
 //! make.
@@ -16,13 +16,12 @@
 //! rules are in [`claim`], apart from the storage. Reading commands open a study with
 //! [`Study::open_read_only`], which writes nothing.
 
-pub mod claim;
+pub use crate::store::claim;
 #[cfg(feature = "postgres")]
-pub mod postgres;
-pub(crate) mod rows;
+mod postgres;
 pub mod run;
-pub mod sqlite;
-pub mod storage;
+mod sqlite;
+mod storage;
 
 use std::cell::RefCell;
 use std::path::{Path, PathBuf};
@@ -34,14 +33,10 @@ pub use crate::evaluator::Outcome;
 use crate::method::{Method, Spec, resume};
 use crate::optimizers::{Optimizer, Saved};
 use claim::{Handout, Worker};
-pub use sqlite::BUSY_TIMEOUT;
-pub use storage::Location;
 use storage::{Dump, Storage, Told, Transaction};
 
-/// The schema this version writes and reads, the same for every back end (SQLite's
-/// `user_version`): 2 added the claims (`owner`, `lease_until_unix_s`); a version-1 study is
-/// upgraded when opened for writing.
-pub const SCHEMA_VERSION: i64 = 2;
+use crate::store::unix_now;
+pub use crate::store::{Location, SCHEMA_VERSION};
 
 /// What a worker is to do next, from [`Study::claim`].
 #[derive(Debug, Clone, PartialEq)]
@@ -108,6 +103,20 @@ pub struct Trial {
     pub failure: Option<String>,
     /// Where the lap failed (fraction), if told.
     pub x_fail: Option<f64>,
+}
+
+impl Trial {
+    /// A trial just asked: `weights` to drive, nothing told yet.
+    fn asked(id: i64, weights: Vec<f64>) -> Trial {
+        Trial {
+            id,
+            weights,
+            reward: None,
+            lap_time_s: None,
+            failure: None,
+            x_fail: None,
+        }
+    }
 }
 
 /// An open study.
@@ -204,12 +213,12 @@ impl Study {
     fn open_with(location: &Location, writable: bool) -> Result<Study> {
         let (storage, config_json): (Box<dyn Storage>, String) = match location {
             Location::Sqlite(path) => {
-                let (s, c) = sqlite::Sqlite::open(path, writable)?;
+                let (s, c) = sqlite::open(path, writable)?;
                 (Box::new(s), c)
             }
             #[cfg(feature = "postgres")]
             Location::Postgres { url, study } => {
-                let (s, c) = postgres::Postgres::open(url, study, &location.label(), writable)?;
+                let (s, c) = postgres::open(url, study, &location.label(), writable)?;
                 (Box::new(s), c)
             }
             #[cfg(not(feature = "postgres"))]
@@ -255,16 +264,9 @@ impl Study {
         let told = tx.told()?;
         let optimizer = load_optimizer(tx.as_mut(), &self.label, &mut self.optimizer, told)?;
         let weights = optimizer.ask()?;
-        let id = tx.add_trial(&weights_json(&weights)?, unix_now(), None)?;
+        let id = tx.add_trial(&weights_json(&weights)?, unix_now())?;
         tx.commit()?;
-        Ok(Trial {
-            id,
-            weights,
-            reward: None,
-            lap_time_s: None,
-            failure: None,
-            x_fail: None,
-        })
+        Ok(Trial::asked(id, weights))
     }
 
     /// The trial `worker` is to drive next, claimed for it until its lease runs out (renew it
@@ -313,19 +315,9 @@ impl Study {
                         None => return Ok(Next::Wait),
                     }
                 };
-                let id = tx.add_trial(
-                    &weights_json(&weights)?,
-                    now,
-                    Some((&worker.id, lease_until)),
-                )?;
-                Trial {
-                    id,
-                    weights,
-                    reward: None,
-                    lap_time_s: None,
-                    failure: None,
-                    x_fail: None,
-                }
+                let id = tx.add_trial(&weights_json(&weights)?, now)?;
+                tx.set_claim(id, &worker.id, lease_until)?;
+                Trial::asked(id, weights)
             }
         };
         tx.commit()?;
@@ -425,27 +417,12 @@ impl Study {
 /// Creates a study holding `dump` at `location`, in the back end the location names.
 fn create_from(location: &Location, dump: &Dump) -> Result<()> {
     match location {
-        Location::Sqlite(path) => sqlite::Sqlite::create(path, dump),
+        Location::Sqlite(path) => sqlite::create(path, dump),
         #[cfg(feature = "postgres")]
-        Location::Postgres { url, study } => {
-            postgres::Postgres::create(url, study, &location.label(), dump)
-        }
+        Location::Postgres { url, study } => postgres::create(url, study, &location.label(), dump),
         #[cfg(not(feature = "postgres"))]
         Location::Postgres { .. } => Err(location.without_postgres()),
     }
-}
-
-/// Refuses a study written with a newer schema than this version reads.
-pub(crate) fn check_version(label: &Path, version: i64) -> Result<()> {
-    if version > SCHEMA_VERSION {
-        return Err(Error::NotAStudy {
-            path: label.to_owned(),
-            reason: format!(
-                "written by a newer cdbo (study schema {version}, this version reads {SCHEMA_VERSION}); upgrade cdbo"
-            ),
-        });
-    }
-    Ok(())
 }
 
 /// A trial's weights as stored: JSON, whose numbers read back bit for bit.
@@ -499,12 +476,6 @@ fn beside(
         fantasy.tell(&w, lie)?;
     }
     Ok(None)
-}
-
-fn unix_now() -> f64 {
-    std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0.0, |d| d.as_secs_f64())
 }
 
 /// The optimiser as of `told` told trials: the one in memory if it is current (no other

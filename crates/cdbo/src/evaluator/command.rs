@@ -14,7 +14,7 @@ use std::time::{Duration, Instant};
 use super::{Evaluator, Outcome};
 use crate::error::{Error, Result};
 use crate::policy::RkhsPolicy;
-use crate::study::claim::process_exists;
+use crate::store::claim::process_exists;
 
 /// Points of the (x, a) table written with each policy.
 pub const TABLE_POINTS: usize = 1001;

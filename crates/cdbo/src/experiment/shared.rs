@@ -16,6 +16,7 @@
 #[cfg(feature = "postgres")]
 mod postgres;
 mod sqlite;
+mod storage;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -25,49 +26,10 @@ use super::grid::{ExperimentConfig, RunSpec};
 use super::record::{RunRecord, run};
 use crate::car::Car;
 use crate::error::{Error, Result};
-use crate::study::Location;
-use crate::study::claim::{self, Claim, Handout, Missed, Worker};
+use crate::store::claim::{self, Handout, Missed, Worker};
+use crate::store::{Location, unix_now};
 use crate::track::Track;
-
-/// A grid's rows in a database, with a lock that makes each [`GridTransaction`] see and change
-/// the grid alone.
-pub trait GridStorage: Send {
-    /// Where the grid lives, for messages (never with a password).
-    fn label(&self) -> &Path;
-    /// Starts a transaction holding the grid's write lock until it commits or is dropped.
-    fn begin(&mut self) -> Result<Box<dyn GridTransaction + '_>>;
-    /// Renews `owner`'s claim on unfinished cell `id` until `until`; false if the cell is
-    /// finished or no longer `owner`'s.
-    fn heartbeat(&mut self, id: i64, owner: &str, until: f64) -> Result<bool>;
-    /// The grid as stored (TOML), if the database holds it.
-    fn grid(&mut self) -> Result<Option<String>>;
-    /// The finished cells' records (JSON), in cell order.
-    fn records(&mut self) -> Result<Vec<String>>;
-    /// Number of unfinished cells, read without the write lock (a waiting worker's cheap poll).
-    fn unfinished_count(&mut self) -> Result<usize>;
-    /// The sessions logged (JSON of [`Session`]), in order.
-    fn sessions(&mut self) -> Result<Vec<String>>;
-    /// Logs a session.
-    fn add_session(&mut self, session: &str) -> Result<()>;
-}
-
-/// One write transaction on a grid, under its write lock.
-pub trait GridTransaction {
-    /// The grid as stored (TOML), if the database holds it.
-    fn grid(&mut self) -> Result<Option<String>>;
-    /// Stores the grid and one unclaimed cell per run (ids 1, 2, 3, … named `runs`).
-    fn create(&mut self, grid: &str, runs: &[String]) -> Result<()>;
-    /// The unfinished cells in id order, with their claims.
-    fn unfinished(&mut self) -> Result<Vec<Claim>>;
-    /// Number of finished cells.
-    fn finished(&mut self) -> Result<usize>;
-    /// Claims unfinished cell `id` for `owner` until `until`.
-    fn set_claim(&mut self, id: i64, owner: &str, until: f64) -> Result<()>;
-    /// Stores cell `id`'s record (JSON), finished at `now`; false if it had one already.
-    fn finish(&mut self, id: i64, record: &str, now: f64) -> Result<bool>;
-    /// Makes every change durable, then releases the lock.
-    fn commit(self: Box<Self>) -> Result<()>;
-}
+use storage::GridStorage;
 
 /// A cell of the grid to run: its row id and its run.
 #[derive(Debug, Clone, PartialEq)]
@@ -166,8 +128,8 @@ impl SharedGrid {
     pub fn claim(&mut self, worker: &Worker) -> Result<Next> {
         let mut tx = self.storage.begin()?;
         let now = unix_now();
-        let unfinished = tx.unfinished()?;
-        let finished = tx.finished()?;
+        let unfinished = tx.claims()?;
+        let finished = tx.count(true)?;
         match claim::hand_out(&unfinished, finished, Some(self.runs.len()), worker, now) {
             Handout::Done => Ok(Next::Done),
             // Every cell is a row from the start (finished + unfinished = all): never new.
@@ -224,7 +186,7 @@ impl SharedGrid {
     /// (finished, all) cells.
     pub fn progress(&mut self) -> Result<(usize, usize)> {
         let mut tx = self.storage.begin()?;
-        Ok((tx.finished()?, self.runs.len()))
+        Ok((tx.count(true)?, self.runs.len()))
     }
 
     /// The finished runs, in the grid's order: what an experiment folder's `runs/` holds.
@@ -314,7 +276,7 @@ pub fn work(
                 let start = std::time::Instant::now();
                 while start.elapsed() < interval {
                     std::thread::sleep(std::time::Duration::from_millis(50));
-                    if grid.storage.unfinished_count()? == 0 {
+                    if grid.storage.count(false)? == 0 {
                         return Ok(ran);
                     }
                 }
@@ -347,7 +309,7 @@ pub fn work(
 /// The storage `location` names, opened to write (tables created where missing) or to read.
 fn open_storage(location: &Location, writable: bool) -> Result<Box<dyn GridStorage>> {
     Ok(match location {
-        Location::Sqlite(path) => Box::new(sqlite::SqliteGrid::open(path, writable)?),
+        Location::Sqlite(path) => Box::new(sqlite::open(path, writable)?),
         #[cfg(feature = "postgres")]
         Location::Postgres { url, study } => Box::new(postgres::PostgresGrid::open(
             url,
@@ -366,18 +328,4 @@ fn parse_grid(text: &str, label: &Path) -> Result<ExperimentConfig> {
         path: label.to_owned(),
         reason: format!("its stored grid does not read: {e}"),
     })
-}
-
-/// Refuses a database written with a newer schema than this version reads, as a grid.
-fn check_version(label: &Path, version: i64) -> Result<()> {
-    crate::study::check_version(label, version).map_err(|e| match e {
-        Error::NotAStudy { path, reason } => Error::NotAGrid { path, reason },
-        e => e,
-    })
-}
-
-fn unix_now() -> f64 {
-    std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0.0, |d| d.as_secs_f64())
 }

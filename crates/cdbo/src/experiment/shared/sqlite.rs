@@ -1,99 +1,41 @@
-//! A grid in an SQLite file (one grid per file), for workers on one machine or a shared
-//! folder: tables `grid` (the grid's TOML), `runs` (one row per cell) and `sessions`, the
-//! schema version in `user_version` as a study's. Writers take SQLite's write lock for the
-//! whole transaction (`BEGIN IMMEDIATE`), as a study's do.
+//! A grid in an SQLite file (one grid per file; [`crate::store::sqlite`]), for workers on one
+//! machine or a shared folder: tables `grid` (the grid's TOML), `runs` (one claimed row per
+//! cell) and `sessions`, made by the first worker.
 
 use std::path::Path;
 
-use rusqlite::{Connection, OpenFlags, OptionalExtension, params};
+use rusqlite::{Connection, OptionalExtension, params};
 
-use super::{GridStorage, GridTransaction, check_version};
+use super::storage::{Cells, GridStorage, GridTransaction};
 use crate::error::{Error, Result};
-use crate::study::SCHEMA_VERSION;
-use crate::study::claim::Claim;
-use crate::study::rows::CELLS;
-use crate::study::rows::sqlite::{SqliteRows, SqliteRowsTransaction};
-use crate::study::sqlite::{
-    check_header, configure, read_only_connection, sql_error, user_version,
-};
-
-/// The tables, created together by the first worker.
-const SCHEMA: &str = "
-    CREATE TABLE IF NOT EXISTS grid (id INTEGER PRIMARY KEY CHECK (id = 1), grid TEXT NOT NULL);
-    CREATE TABLE IF NOT EXISTS runs (
-        id INTEGER PRIMARY KEY,
-        run TEXT NOT NULL,
-        record TEXT,
-        owner TEXT,
-        lease_until_unix_s REAL,
-        finished_unix_s REAL);
-    CREATE TABLE IF NOT EXISTS sessions (id INTEGER PRIMARY KEY, session TEXT NOT NULL);";
+use crate::store::sqlite::{SqliteRows, SqliteTransaction, sql_error};
 
 /// A grid in an SQLite file.
-pub struct SqliteGrid {
-    rows: SqliteRows,
-}
+type SqliteGrid = SqliteRows<Cells>;
 
-impl SqliteGrid {
-    /// Opens the grid file at `path`: to write, creating the file and its tables where
-    /// missing (an empty file counts as missing: another worker may have just made it); to
-    /// read, an existing grid file only. Refuses a file that is not SQLite, a database
-    /// without a grid (a study, say) and a newer schema, writing nothing.
-    pub fn open(path: &Path, writable: bool) -> Result<SqliteGrid> {
-        let err = |e| sql_error(path, e);
-        let empty = std::fs::metadata(path).map_or(true, |m| m.len() == 0);
-        if !empty {
-            check_header(path).map_err(as_grid)?;
-        } else if !writable {
-            return Err(Error::NoGrid {
-                path: path.to_owned(),
-            });
-        }
-        let conn = if writable {
-            Connection::open_with_flags(
-                path,
-                OpenFlags::SQLITE_OPEN_READ_WRITE | OpenFlags::SQLITE_OPEN_CREATE,
-            )
-            .map_err(err)?
-        } else {
-            read_only_connection(path).map_err(as_grid)?.0
-        };
-        conn.busy_timeout(crate::study::BUSY_TIMEOUT).map_err(err)?;
-        // Read before anything is written: a foreign database is left as it was.
-        check_version(path, user_version(&conn).map_err(err)?)?;
-        let tables: Vec<String> = conn
-            .prepare("SELECT name FROM sqlite_master WHERE type = 'table'")
-            .and_then(|mut s| s.query_map([], |r| r.get(0))?.collect())
-            .map_err(err)?;
+/// Opens the grid file at `path`: to write, creating the file and its tables where missing
+/// (an empty file counts as missing: another worker may have just made it); to read, an
+/// existing grid file only. Refuses a file that is not SQLite, a database without a grid (a
+/// study, say) and a newer schema, writing nothing.
+pub(super) fn open(path: &Path, writable: bool) -> Result<SqliteGrid> {
+    let (grid, ()) = SqliteGrid::open(path, writable, |conn, _| {
+        let tables: Vec<String> =
+            strings(conn, "SELECT name FROM sqlite_master WHERE type = 'table'")
+                .map_err(|e| sql_error::<Cells>(path, e))?;
         if !tables.is_empty() && !tables.iter().any(|t| t == "runs") {
             return Err(Error::NotAGrid {
                 path: path.to_owned(),
                 reason: "an SQLite database without a grid in it".into(),
             });
         }
-        if writable {
-            configure(&conn).map_err(err)?;
-            conn.execute_batch(&format!(
-                "BEGIN IMMEDIATE; {SCHEMA} PRAGMA user_version = {SCHEMA_VERSION}; COMMIT;"
-            ))
-            .map_err(err)?;
-        } else if tables.is_empty() {
+        if !writable && tables.is_empty() {
             return Err(Error::NoGrid {
                 path: path.to_owned(),
             });
         }
-        Ok(SqliteGrid {
-            rows: SqliteRows::new(path, conn, &CELLS),
-        })
-    }
-}
-
-/// A study's "not a cdbo study" as a grid's.
-fn as_grid(e: Error) -> Error {
-    match e {
-        Error::NotAStudy { path, reason } => Error::NotAGrid { path, reason },
-        e => e,
-    }
+        Ok(())
+    })?;
+    Ok(grid)
 }
 
 fn stored_grid(conn: &Connection) -> rusqlite::Result<Option<String>> {
@@ -107,65 +49,44 @@ fn strings(conn: &Connection, sql: &str) -> rusqlite::Result<Vec<String>> {
 }
 
 impl GridStorage for SqliteGrid {
-    fn label(&self) -> &Path {
-        self.rows.path()
-    }
-
     fn begin(&mut self) -> Result<Box<dyn GridTransaction + '_>> {
-        Ok(Box::new(SqliteGridTransaction {
-            rows: self.rows.begin()?,
-        }))
-    }
-
-    fn heartbeat(&mut self, id: i64, owner: &str, until: f64) -> Result<bool> {
-        self.rows.heartbeat(id, owner, until)
+        Ok(Box::new(SqliteGrid::begin(self)?))
     }
 
     fn grid(&mut self) -> Result<Option<String>> {
-        stored_grid(self.rows.conn()).map_err(self.rows.err())
+        stored_grid(self.conn()).map_err(self.err())
     }
 
     fn records(&mut self) -> Result<Vec<String>> {
         strings(
-            self.rows.conn(),
+            self.conn(),
             "SELECT record FROM runs WHERE record IS NOT NULL ORDER BY id",
         )
-        .map_err(self.rows.err())
-    }
-
-    fn unfinished_count(&mut self) -> Result<usize> {
-        self.rows.count(false)
+        .map_err(self.err())
     }
 
     fn sessions(&mut self) -> Result<Vec<String>> {
-        strings(self.rows.conn(), "SELECT session FROM sessions ORDER BY id")
-            .map_err(self.rows.err())
+        strings(self.conn(), "SELECT session FROM sessions ORDER BY id").map_err(self.err())
     }
 
     fn add_session(&mut self, session: &str) -> Result<()> {
-        self.rows
-            .conn()
+        self.conn()
             .execute(
                 "INSERT INTO sessions (session) VALUES (?1)",
                 params![session],
             )
-            .map_err(self.rows.err())?;
+            .map_err(self.err())?;
         Ok(())
     }
 }
 
-/// A write transaction on an SQLite grid.
-struct SqliteGridTransaction<'a> {
-    rows: SqliteRowsTransaction<'a>,
-}
-
-impl GridTransaction for SqliteGridTransaction<'_> {
+impl GridTransaction for SqliteTransaction<'_, Cells> {
     fn grid(&mut self) -> Result<Option<String>> {
-        stored_grid(self.rows.tx()).map_err(self.rows.err())
+        stored_grid(self.tx()).map_err(self.err())
     }
 
     fn create(&mut self, grid: &str, runs: &[String]) -> Result<()> {
-        let (tx, err) = (self.rows.tx(), self.rows.err());
+        let (tx, err) = (self.tx(), self.err());
         tx.execute("INSERT INTO grid (id, grid) VALUES (1, ?1)", params![grid])
             .map_err(&err)?;
         for (k, run) in runs.iter().enumerate() {
@@ -178,48 +99,14 @@ impl GridTransaction for SqliteGridTransaction<'_> {
         Ok(())
     }
 
-    fn unfinished(&mut self) -> Result<Vec<Claim>> {
-        let err = self.rows.err();
-        let mut stmt = self
-            .rows
-            .tx()
-            .prepare(
-                "SELECT id, owner, lease_until_unix_s FROM runs WHERE record IS NULL ORDER BY id",
-            )
-            .map_err(&err)?;
-        let rows = stmt
-            .query_map([], |r| {
-                Ok(Claim {
-                    trial: r.get(0)?,
-                    owner: r.get(1)?,
-                    lease_until: r.get(2)?,
-                })
-            })
-            .map_err(&err)?;
-        rows.collect::<rusqlite::Result<Vec<_>>>().map_err(err)
-    }
-
-    fn finished(&mut self) -> Result<usize> {
-        self.rows.count(true)
-    }
-
-    fn set_claim(&mut self, id: i64, owner: &str, until: f64) -> Result<()> {
-        self.rows.set_claim(id, owner, until)
-    }
-
     fn finish(&mut self, id: i64, record: &str, now: f64) -> Result<bool> {
         let n = self
-            .rows
             .tx()
             .execute(
                 "UPDATE runs SET record = ?1, finished_unix_s = ?2 WHERE id = ?3 AND record IS NULL",
                 params![record, now, id],
             )
-            .map_err(self.rows.err())?;
+            .map_err(self.err())?;
         Ok(n == 1)
-    }
-
-    fn commit(self: Box<Self>) -> Result<()> {
-        self.rows.commit()
     }
 }
