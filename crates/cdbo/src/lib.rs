@@ -17,10 +17,12 @@
 //!   [`serve`]: laps as a JSON-lines service.
 //! - [`torcs`]: the racing game TORCS as a source of laps (its robot, setup and lap runner).
 //! - [`benchmarks`]: standard test functions.
-//! - [`sizes`]: the bounds on every size a user gives, and the slow-size estimate.
+//! - [`sizes`]: the bounds on every size a user gives, and the slow-size estimate;
+//!   [`bounded`]: the bound on every input read, and its one reader.
 
 pub mod acquisition;
 pub mod benchmarks;
+pub mod bounded;
 pub mod car;
 pub mod ceiling;
 pub mod data_path;
