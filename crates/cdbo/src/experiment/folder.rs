@@ -155,4 +155,29 @@ mod tests {
         assert!(e.contains("sessions.jsonl:2: session"), "{e}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
+
+    /// An endless grid file or session log is refused at its bound, naming it.
+    #[test]
+    fn an_endless_grid_or_session_log_is_refused() {
+        let dir = scratch("endless");
+        for file in [GRID_FILE, SESSIONS_FILE] {
+            std::os::unix::fs::symlink("/dev/zero", dir.join(file)).unwrap();
+        }
+        let grid = ExperimentConfig::preset("quick").unwrap();
+        let e = claim(&dir, &grid).unwrap_err().to_string();
+        assert!(
+            e.ends_with(
+                "experiment.toml: the experiment grid file is larger than its bound of 1 MiB"
+            ),
+            "{e}"
+        );
+        let e = Session::load_all(std::slice::from_ref(&dir))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.ends_with("sessions.jsonl: the session log is larger than its bound of 64 MiB"),
+            "{e}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }
