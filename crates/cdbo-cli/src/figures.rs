@@ -318,7 +318,7 @@ where
 
 /// (distance, speed) rows of a `cdbo lap --trace` file.
 pub fn read_trace_speeds(path: &Path) -> Result<Vec<(f64, f64)>, Box<dyn std::error::Error>> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let text = cdbo::bounded::read_text(path, &cdbo::bounded::TRACE_FILE)?;
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
     let col = |name: &str| {

@@ -516,3 +516,160 @@ fn dashboard_refuses_bad_sources_and_a_port_in_use_in_one_line() {
         &["--bind", "localhost", "an address and port"],
     );
 }
+
+/// Runs, expects failure with stderr exactly one `error:` line refusing `input` as larger than
+/// `bound` (e.g. `16 MiB`).
+fn refused_as_too_large(args: &[&str], input: &str, bound: &str) {
+    let out = cdbo(args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{args:?} succeeded");
+    let lines: Vec<&str> = err.lines().collect();
+    assert_eq!(lines.len(), 1, "{args:?}: not one line: {err}");
+    assert!(lines[0].starts_with("error: "), "{args:?}: {err}");
+    assert!(
+        lines[0].contains(input)
+            && lines[0].ends_with(&format!("is larger than its bound of {bound}")),
+        "{args:?}: {:?} does not refuse {input} past {bound}",
+        lines[0]
+    );
+}
+
+/// Every file a command reads is read through its bound: an endless one (`/dev/zero`,
+/// `/dev/urandom`, or a link to them named as the flag expects) and one past its bound
+/// (a sparse file, as a car's category or a track's included entity) are refused in one line
+/// naming the file and the bound, instead of being read forever.
+#[test]
+fn endless_input_files_are_refused_at_their_bound() {
+    let dir = scratch("endless", "")
+        .parent()
+        .unwrap()
+        .join("endless-files");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let zero = |name: &str| {
+        let p = dir.join(name);
+        std::os::unix::fs::symlink("/dev/zero", &p).unwrap();
+        p.to_str().unwrap().to_owned()
+    };
+    let (json, xml, csv) = (zero("zero.json"), zero("zero.xml"), zero("zero.csv"));
+    let out = dir.join("out.json");
+    let out = out.to_str().unwrap();
+
+    refused_as_too_large(
+        &["lap", "--policy", "/dev/urandom"],
+        "/dev/urandom: the policy table",
+        "64 MiB",
+    );
+    refused_as_too_large(
+        &["lap", "--policy", &json],
+        "zero.json: the policy file",
+        "1 MiB",
+    );
+    refused_as_too_large(
+        &["lap", "--track", &xml],
+        "zero.xml: the track file",
+        "16 MiB",
+    );
+    refused_as_too_large(
+        &["lap", "--track", &csv],
+        "zero.csv: the track centre-line file",
+        "64 MiB",
+    );
+    refused_as_too_large(&["lap", "--car", &xml], "zero.xml: the car file", "16 MiB");
+    refused_as_too_large(
+        &["experiment", "/dev/zero"],
+        "/dev/zero: the experiment grid file",
+        "1 MiB",
+    );
+    refused_as_too_large(
+        &[
+            "policy",
+            "fit",
+            "--demo",
+            "/dev/zero",
+            "--kernels",
+            "10",
+            "-o",
+            out,
+        ],
+        "/dev/zero: the demonstration file",
+        "256 MiB",
+    );
+    refused_as_too_large(
+        &["policy", "table", "/dev/zero"],
+        "/dev/zero: the policy file",
+        "1 MiB",
+    );
+    refused_as_too_large(
+        &[
+            "study",
+            "create",
+            "s",
+            "--kernels",
+            "6",
+            "--demo",
+            "/dev/zero",
+        ],
+        "/dev/zero: the demonstration file",
+        "256 MiB",
+    );
+    refused_as_too_large(
+        &[
+            "plot",
+            "track",
+            "ridgeway",
+            "-o",
+            out,
+            "--trace",
+            "/dev/zero",
+        ],
+        "/dev/zero: the trace file",
+        "256 MiB",
+    );
+    std::fs::create_dir_all(dir.join("grid/runs")).unwrap();
+    std::os::unix::fs::symlink("/dev/zero", dir.join("grid/runs/run.json")).unwrap();
+    refused_as_too_large(
+        &["report", dir.join("grid").to_str().unwrap()],
+        "run.json: the run record",
+        "64 MiB",
+    );
+
+    // Files past their bound where only a regular file is read: a car's category file and a
+    // track's included entity, each a sparse file of 16 MiB and one byte.
+    let sparse = |path: &Path| {
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::File::create(path)
+            .and_then(|f| f.set_len((16 << 20) + 1))
+            .unwrap();
+    };
+    sparse(&dir.join("categories/big.xml"));
+    let car = dir.join("cars/c/c.xml");
+    std::fs::create_dir_all(car.parent().unwrap()).unwrap();
+    std::fs::write(
+        &car,
+        r#"<params name="c"><section name="Car"><attstr name="category" val="big"/></section></params>"#,
+    )
+    .unwrap();
+    refused_as_too_large(
+        &["lap", "--car", car.to_str().unwrap()],
+        "big.xml: the car category file",
+        "16 MiB",
+    );
+    sparse(&dir.join("tracks/surfaces.xml"));
+    let track = dir.join("tracks/t.xml");
+    std::fs::write(
+        &track,
+        TRACK.replacen(
+            "<params name=\"t\">",
+            "<!DOCTYPE params SYSTEM \"params.dtd\" [\n<!ENTITY surfaces SYSTEM \"surfaces.xml\">\n]>\n<params name=\"t\">&surfaces;",
+            1,
+        ),
+    )
+    .unwrap();
+    refused_as_too_large(
+        &["track", "info", track.to_str().unwrap()],
+        "surfaces.xml: the included entity file",
+        "16 MiB",
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

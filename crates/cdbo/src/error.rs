@@ -17,6 +17,17 @@ pub enum Error {
         /// The operating-system error.
         source: std::io::Error,
     },
+    /// An input (a file, a program's output) larger than the bound of its kind
+    /// ([`crate::bounded`]), refused after reading the bound and one byte.
+    #[error("{input}: the {what} is larger than its bound of {}", crate::bounded::show_bytes(*bound))]
+    InputTooLarge {
+        /// The file, or the program and which of its outputs.
+        input: String,
+        /// What the input is (`policy file`).
+        what: &'static str,
+        /// The bound, bytes.
+        bound: u64,
+    },
     /// A file was read but its content is invalid.
     #[error("{file}{}: {element}: {message}", line.map(|l| format!(":{l}")).unwrap_or_default())]
     Parse {

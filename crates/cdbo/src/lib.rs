@@ -20,7 +20,8 @@
 //!   PostgreSQL) behind studies and shared grids.
 //! - [`torcs`]: the racing game TORCS as a source of laps (its robot, setup and lap runner).
 //! - [`benchmarks`]: standard test functions.
-//! - [`sizes`]: the bounds on every size a user gives.
+//! - [`sizes`]: the bounds on every size a user gives; [`bounded`]: the bound on every input
+//!   read, and its one reader.
 //! - [`prelude`]: the names most programs need, in one import.
 //!
 //! # Learning a lap in twenty lines
@@ -56,6 +57,7 @@
 
 pub mod acquisition;
 pub mod benchmarks;
+pub mod bounded;
 pub mod car;
 pub mod ceiling;
 pub mod data_path;

@@ -13,6 +13,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 
 use super::{CliResult, Simulator, from_flag, game_track, load_track};
+use cdbo::bounded;
 use cdbo::car::catalog as cars;
 use cdbo::data_path::DataPath;
 use cdbo::experiment::folder::{self, Session};
@@ -84,13 +85,14 @@ fn read_grid(args: &ExperimentArgs) -> Result<(ExperimentConfig, String), String
         Some(c) => (c, args.config.clone()),
         None => {
             let path = PathBuf::from(&args.config);
-            let text = std::fs::read_to_string(&path).map_err(|e| {
-                format!(
-                    "{}: {e} (CONFIG is a TOML file or a preset: {})",
-                    path.display(),
-                    PRESETS.join(", ")
-                )
-            })?;
+            let text =
+                bounded::read_text(&path, &bounded::EXPERIMENT_GRID).map_err(|e| match e {
+                    cdbo::Error::Io { .. } => format!(
+                        "{e} (CONFIG is a TOML file or a preset: {})",
+                        PRESETS.join(", ")
+                    ),
+                    e => e.to_string(),
+                })?;
             let stem = path
                 .file_stem()
                 .map_or("grid".into(), |s| s.to_string_lossy().into_owned());

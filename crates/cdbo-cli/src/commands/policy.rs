@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use clap::Subcommand;
 
 use super::CliResult;
+use cdbo::bounded;
 use cdbo::policy::RkhsPolicy;
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 
@@ -79,7 +80,7 @@ pub fn run(cmd: &PolicyCommand) -> CliResult {
 
 /// Reads policy weights written by `cdbo policy fit`.
 pub fn read_policy(path: &Path) -> Result<RkhsPolicy, Box<dyn std::error::Error>> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let text = bounded::read_text(path, &bounded::POLICY_FILE)?;
     let p: RkhsPolicy = serde_json::from_str(&text)
         .map_err(|e| format!("{}: not policy weights: {e}", path.display()))?;
     Ok(
@@ -90,7 +91,7 @@ pub fn read_policy(path: &Path) -> Result<RkhsPolicy, Box<dyn std::error::Error>
 
 /// Reads a demonstration's (x, a) pairs ([`cdbo::policy::demo`]).
 pub fn read_demo(path: &Path) -> Result<Vec<(f64, f64)>, Box<dyn std::error::Error>> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let text = bounded::read_text(path, &bounded::DEMO_FILE)?;
     Ok(cdbo::policy::demo::parse(
         &text,
         &path.display().to_string(),

@@ -6,6 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use super::{Brake, Car, DEFAULT_ENGINE_BRAKE, DEFAULT_PAD_MU, Drive, Tyre, Wing};
+use crate::bounded;
 use crate::error::{Error, Result};
 use crate::params::{Params, Section};
 
@@ -14,7 +15,7 @@ use crate::params::{Params, Section};
 /// (`cars/models/NAME/NAME.xml` → `cars/categories/CAT.xml`). A missing category file is an
 /// error; pass `category` explicitly to choose one.
 pub fn read(path: &Path, category: Option<&Path>) -> Result<Car> {
-    let car = Params::read(path)?;
+    let car = Params::read(path, &bounded::CAR_FILE)?;
     let category_path = match category {
         Some(c) => Some(c.to_owned()),
         None => match car.section("Car").and_then(|c| c.str("category")) {
@@ -30,7 +31,7 @@ pub fn read(path: &Path, category: Option<&Path>) -> Result<Car> {
     };
     let merged = match category_path {
         Some(p) => {
-            let mut base = Params::read(&p)?;
+            let mut base = Params::read(&p, &bounded::CAR_CATEGORY_FILE)?;
             base.root.merge(&car.root);
             base.root.name = car.root.name.clone();
             base.file = car.file.clone();

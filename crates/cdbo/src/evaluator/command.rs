@@ -4,14 +4,18 @@
 //! "table": [[x, a], …]}` — to a file, and the command runs through `sh -c` with `{policy}`
 //! replaced by that file's (quoted) path. Its standard output gives the reward: a number, or a
 //! JSON object with `reward` (or `reward_mps`), or `{"failed": true, "at": x, "reason": …}`.
-//! A non-zero exit, a timeout or output that parses as neither is a failed lap with the reason.
+//! A non-zero exit, a timeout, output that parses as neither or an output past its bound
+//! ([`bounded::LAP_COMMAND_OUTPUT`], the command then stopped) is a failed lap with the reason.
 
 use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
+use std::sync::{Arc, OnceLock};
+use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use super::{Evaluator, Outcome};
+use crate::bounded;
 use crate::error::{Error, Result};
 use crate::policy::RkhsPolicy;
 use crate::store::claim::process_exists;
@@ -170,26 +174,22 @@ impl CommandEvaluator {
                 line: line.clone(),
                 source,
             })?;
-        let mut pipe_out = child.stdout.take();
-        let mut pipe_err = child.stderr.take();
-        let out = std::thread::spawn(move || {
-            let mut s = String::new();
-            if let Some(p) = pipe_out.as_mut() {
-                let _ = p.read_to_string(&mut s);
-            }
-            s
-        });
-        let err = std::thread::spawn(move || {
-            let mut s = String::new();
-            if let Some(p) = pipe_err.as_mut() {
-                let _ = p.read_to_string(&mut s);
-            }
-            s
-        });
+        // Each output is read through its bound; the first refused stops the command.
+        let refused = Arc::new(OnceLock::new());
+        let out = read_output(child.stdout.take(), &line, "standard output", &refused);
+        let err = read_output(child.stderr.take(), &line, "standard error", &refused);
         let start = Instant::now();
         let status = loop {
             match child.try_wait() {
                 Ok(Some(status)) => break status,
+                Ok(None) if refused.get().is_some() => {
+                    let _ = child.kill();
+                    let _ = child.wait();
+                    return Ok(Outcome::Failed {
+                        at: None,
+                        reason: refused.get().cloned(),
+                    });
+                }
                 Ok(None) if start.elapsed() > self.timeout => {
                     let _ = child.kill();
                     let _ = child.wait();
@@ -207,6 +207,12 @@ impl CommandEvaluator {
         };
         let stdout = out.join().unwrap_or_default();
         let stderr = err.join().unwrap_or_default();
+        if let Some(why) = refused.get() {
+            return Ok(Outcome::Failed {
+                at: None,
+                reason: Some(why.clone()),
+            });
+        }
         if !status.success() {
             let tail: String = stderr
                 .trim()
@@ -223,6 +229,33 @@ impl CommandEvaluator {
         }
         Ok(parse_output(&stdout))
     }
+}
+
+/// Reads `which` output of the command `line` on a thread of its own, through
+/// [`bounded::LAP_COMMAND_OUTPUT`], as text (empty if it is not UTF-8 or cannot be read); a
+/// refusal is set in `refused`, for the command to be stopped and the lap failed with it.
+fn read_output(
+    pipe: Option<impl Read + Send + 'static>,
+    line: &str,
+    which: &str,
+    refused: &Arc<OnceLock<String>>,
+) -> JoinHandle<String> {
+    let name = format!("`sh -c {line}` ({which})");
+    let refused = Arc::clone(refused);
+    std::thread::spawn(move || {
+        let Some(pipe) = pipe else {
+            return String::new();
+        };
+        match bounded::read(pipe, &name, &bounded::LAP_COMMAND_OUTPUT) {
+            Ok(bytes) => String::from_utf8(bytes).unwrap_or_default(),
+            Err(e) => {
+                if matches!(e, Error::InputTooLarge { .. }) {
+                    let _ = refused.set(e.to_string());
+                }
+                String::new()
+            }
+        }
+    })
 }
 
 #[cfg(test)]
@@ -285,5 +318,30 @@ mod tests {
             panic!()
         };
         assert!(reason.unwrap().contains("timeout"));
+    }
+
+    /// A command whose output never ends is stopped at the output's bound, long before its
+    /// timeout: a failed lap saying which output, and the bound.
+    #[test]
+    fn an_endless_output_fails_the_lap_at_its_bound() {
+        let dir = crate::scratch::dir("command-endless");
+        let mut e = CommandEvaluator {
+            template: "yes".into(),
+            timeout: Duration::from_secs(600),
+            files: dir.join("p"),
+            lengthscale: 0.5,
+        };
+        for (template, which) in [("yes", "standard output"), ("yes >&2", "standard error")] {
+            e.template = template.into();
+            let Outcome::Failed { reason, .. } = e.evaluate(1, &[0.1, 0.2]).unwrap() else {
+                panic!("{template}")
+            };
+            assert_eq!(
+                reason.unwrap(),
+                format!(
+                    "`sh -c {template}` ({which}): the lap command's output is larger than its bound of 16 MiB"
+                )
+            );
+        }
     }
 }

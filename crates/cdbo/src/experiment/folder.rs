@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::grid::ExperimentConfig;
+use crate::bounded;
 use crate::error::{Error, Result};
 
 /// The grid's file in an experiment folder.
@@ -26,21 +27,21 @@ pub fn claim(dir: &Path, config: &ExperimentConfig) -> Result<()> {
     };
     std::fs::create_dir_all(dir).map_err(io(dir))?;
     let file = dir.join(GRID_FILE);
-    match std::fs::read_to_string(&file) {
+    match bounded::read_text(&file, &bounded::EXPERIMENT_GRID) {
         Ok(old) => {
             if ExperimentConfig::from_toml(&old, &file.display().to_string())? != *config {
                 return Err(Error::DifferentGrid { path: file });
             }
             Ok(())
         }
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+        Err(Error::Io { source, .. }) if source.kind() == std::io::ErrorKind::NotFound => {
             let text = toml::to_string(config).map_err(|e| Error::Io {
                 path: file.clone(),
                 source: std::io::Error::other(e),
             })?;
             std::fs::write(&file, text).map_err(io(&file))
         }
-        Err(source) => Err(Error::Io { path: file, source }),
+        Err(e) => Err(e),
     }
 }
 
@@ -84,10 +85,12 @@ impl Session {
         let mut sessions = Vec::new();
         for dir in dirs {
             let path = dir.join(SESSIONS_FILE);
-            let text = match std::fs::read_to_string(&path) {
+            let text = match bounded::read_text(&path, &bounded::SESSION_LOG) {
                 Ok(text) => text,
-                Err(e) if e.kind() == std::io::ErrorKind::NotFound => continue,
-                Err(source) => return Err(Error::Io { path, source }),
+                Err(Error::Io { source, .. }) if source.kind() == std::io::ErrorKind::NotFound => {
+                    continue;
+                }
+                Err(e) => return Err(e),
             };
             sessions.extend(Session::parse_log(&text, &path.display().to_string())?);
         }
@@ -150,6 +153,31 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("sessions.jsonl:2: session"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// An endless grid file or session log is refused at its bound, naming it.
+    #[test]
+    fn an_endless_grid_or_session_log_is_refused() {
+        let dir = scratch("endless");
+        for file in [GRID_FILE, SESSIONS_FILE] {
+            std::os::unix::fs::symlink("/dev/zero", dir.join(file)).unwrap();
+        }
+        let grid = ExperimentConfig::preset("quick").unwrap();
+        let e = claim(&dir, &grid).unwrap_err().to_string();
+        assert!(
+            e.ends_with(
+                "experiment.toml: the experiment grid file is larger than its bound of 1 MiB"
+            ),
+            "{e}"
+        );
+        let e = Session::load_all(std::slice::from_ref(&dir))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.ends_with("sessions.jsonl: the session log is larger than its bound of 64 MiB"),
+            "{e}"
+        );
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use super::grid::{ExperimentConfig, RunSpec};
 use super::race::{LapRecord, RaceConfig, race};
+use crate::bounded;
 use crate::car::Car;
 use crate::error::{Error, Result};
 use crate::track::Track;
@@ -82,10 +83,7 @@ impl RunRecord {
 
     /// Loads one saved run.
     pub fn load(path: &Path) -> Result<RunRecord> {
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-            path: path.to_owned(),
-            source,
-        })?;
+        let text = bounded::read_text(path, &bounded::RUN_RECORD)?;
         RunRecord::parse(&text, &path.display().to_string())
     }
 

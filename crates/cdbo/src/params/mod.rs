@@ -17,6 +17,7 @@ pub mod units;
 use std::path::Path;
 use std::sync::Arc;
 
+use crate::bounded::{self, Bound};
 use crate::error::{Error, Result};
 
 /// A value of an attribute, already converted to SI for numbers.
@@ -71,9 +72,10 @@ pub struct Params {
 }
 
 impl Params {
-    /// Reads and parses a file, resolving its external entities relative to its folder.
-    pub fn read(path: &Path) -> Result<Params> {
-        let text = read_text(path)?;
+    /// Reads and parses a file, a `bound` kind of file ([`crate::bounded`]), resolving its
+    /// external entities relative to its folder (each an [`bounded::ENTITY_FILE`]).
+    pub fn read(path: &Path, bound: &Bound) -> Result<Params> {
+        let text = read_text(path, bound)?;
         Params::parse(&text, &path.display().to_string(), path.parent())
     }
 
@@ -364,7 +366,7 @@ fn expand_entities(
             let rel = quoted.get(1).copied().unwrap_or_default();
             match dir.map(|d| d.join(rel)) {
                 Some(p) if p.is_file() => {
-                    let body = read_text(&p)?;
+                    let body = read_text(&p, &bounded::ENTITY_FILE)?;
                     strip_xml_decl(&body).replace(['\n', '\r'], " ")
                 }
                 Some(p) => {
@@ -473,13 +475,10 @@ fn is_xml_name(s: &str) -> bool {
         && chars.all(|c| c.is_alphanumeric() || matches!(c, '-' | '.' | '_' | ':'))
 }
 
-/// Reads a file as text: UTF-8, or Latin-1 where it is not valid UTF-8 (see the module doc).
-pub fn read_text(path: &Path) -> Result<String> {
-    let bytes = std::fs::read(path).map_err(|source| Error::Io {
-        path: path.to_owned(),
-        source,
-    })?;
-    Ok(decode(bytes))
+/// Reads a file, a `bound` kind of file ([`crate::bounded`]), as text: UTF-8, or Latin-1
+/// where it is not valid UTF-8 (see the module doc).
+pub fn read_text(path: &Path, bound: &Bound) -> Result<String> {
+    Ok(decode(bounded::read_file(path, bound)?))
 }
 
 /// Decodes bytes as UTF-8, or as Latin-1 (each byte the character of that code) when they are
@@ -552,6 +551,33 @@ mod tests {
         assert_eq!(b.path, "A/B");
         assert!((b.require_num("angle").unwrap() - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
         assert_eq!(p.warnings.len(), 1, "{:?}", p.warnings);
+    }
+
+    /// A file and the entity file it includes are each read through their bound: a file
+    /// past its bound is refused, naming it, what it is and the bound (a sparse file stands
+    /// for a large one).
+    #[test]
+    fn a_file_or_an_included_entity_past_its_bound_is_refused() {
+        let dir = crate::scratch::dir("params-bound");
+        let big = dir.join("big.xml");
+        std::fs::File::create(&big)
+            .and_then(|f| f.set_len(bounded::ENTITY_FILE.bytes + 1))
+            .unwrap();
+        let including = SAMPLE.replace("does-not-exist.xml", "big.xml");
+        let e = Params::parse(&including, "sample.xml", Some(&dir))
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            format!(
+                "{}: the included entity file is larger than its bound of 16 MiB",
+                big.display()
+            )
+        );
+        let e = Params::read(&big, &bounded::TRACK_FILE)
+            .unwrap_err()
+            .to_string();
+        assert!(e.ends_with("big.xml: the track file is larger than its bound of 16 MiB"));
     }
 
     #[test]

@@ -3,6 +3,7 @@
 
 use std::path::Path;
 
+use crate::bounded;
 use crate::drive::{Observation, Pedal};
 use crate::error::{Error, Result};
 
@@ -39,10 +40,7 @@ impl PolicyTable {
 
     /// Reads `x,a` rows (a header line and `#` comments are skipped).
     pub fn read_csv(path: &Path) -> Result<PolicyTable> {
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-            path: path.to_owned(),
-            source,
-        })?;
+        let text = bounded::read_text(path, &bounded::POLICY_TABLE)?;
         PolicyTable::parse_csv(&text, &path.display().to_string())
     }
 

@@ -143,11 +143,14 @@ pub fn process_exists(_pid: u32) -> bool {
 }
 
 fn host_name() -> String {
-    std::fs::read_to_string("/proc/sys/kernel/hostname")
-        .map(|h| h.trim().replace('/', "_"))
-        .ok()
-        .filter(|h| !h.is_empty())
-        .unwrap_or_else(|| "localhost".into())
+    crate::bounded::read_text(
+        std::path::Path::new("/proc/sys/kernel/hostname"),
+        &crate::bounded::SYSTEM_LINE,
+    )
+    .map(|h| h.trim().replace('/', "_"))
+    .ok()
+    .filter(|h| !h.is_empty())
+    .unwrap_or_else(|| "localhost".into())
 }
 
 /// The constant lie told for a lap in flight: the lowest reward told so far (0, a failed lap,

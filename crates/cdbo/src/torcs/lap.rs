@@ -8,7 +8,7 @@
 //! failure margins; see `torcs-robot/cdbo.cpp`) and the JSON line the robot writes.
 
 use std::fmt::Write as _;
-use std::io::Read;
+use std::io::{Read, Seek, SeekFrom};
 use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -18,6 +18,7 @@ use std::time::{Duration, Instant};
 use serde::Deserialize;
 
 use super::{Game, ROBOT};
+use crate::bounded;
 use crate::car::Car;
 use crate::error::{Error, Result};
 use crate::policy::RkhsPolicy;
@@ -301,7 +302,7 @@ impl Game {
             Ok(status) => status,
             Err(hung) => return Ok(Err(hung)),
         };
-        let line = std::fs::read_to_string(&output).unwrap_or_default();
+        let line = game_file(&output)?;
         let Some(line) = line.lines().rfind(|l| !l.trim().is_empty()) else {
             return Ok(Err(format!(
                 "the game ended ({status}) without a lap: {}",
@@ -413,10 +414,7 @@ impl Game {
             .join("drivers")
             .join(robot)
             .join(format!("{robot}.xml"));
-        let original = std::fs::read_to_string(&xml).map_err(|source| Error::Io {
-            path: xml.clone(),
-            source,
-        })?;
+        let original = bounded::read_text(&xml, &bounded::DRIVER_FILE)?;
         let n = LAPS.fetch_add(1, Ordering::Relaxed);
         let dir = LapDir(
             self.root
@@ -468,13 +466,13 @@ impl Game {
                 message: why,
             })?;
         // "Sim Time: T [s], Leader Laps: 1, ..." is printed as the first lap ends.
-        let stdout = std::fs::read_to_string(dir.0.join("stdout.txt")).unwrap_or_default();
+        let stdout = game_file(&dir.0.join("stdout.txt"))?;
         let first = stdout
             .lines()
             .find(|l| l.contains("Leader Laps:    1") || l.contains("Leader Laps: 1,"))
             .and_then(|l| l.split_whitespace().nth(2))
             .and_then(|t| t.parse::<f64>().ok());
-        let best = find_number(&dir.0.join("results"), "best lap time");
+        let best = find_number(&dir.0.join("results"), "best lap time")?;
         match (first, best) {
             (Some(first), Some(best)) => Ok((first, best)),
             _ => Err(Error::External {
@@ -488,25 +486,39 @@ impl Game {
     }
 }
 
-/// The value of the first `<attnum name="NAME" val="V"/>` in the XML files under `dir`.
-fn find_number(dir: &Path, name: &str) -> Option<f64> {
+/// The value of the first `<attnum name="NAME" val="V"/>` in the XML files under `dir`
+/// (each read as a [`game_file`]).
+fn find_number(dir: &Path, name: &str) -> Result<Option<f64>> {
     let key = format!("name=\"{name}\" val=\"");
-    for entry in std::fs::read_dir(dir).ok()?.filter_map(|e| e.ok()) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Ok(None);
+    };
+    for entry in entries.filter_map(|e| e.ok()) {
         let path = entry.path();
         let found = if path.is_dir() {
-            find_number(&path, name)
+            find_number(&path, name)?
         } else {
-            let text = std::fs::read_to_string(&path).unwrap_or_default();
+            let text = game_file(&path)?;
             text.find(&key).and_then(|i| {
                 let rest = &text[i + key.len()..];
                 rest[..rest.find('"')?].parse().ok()
             })
         };
         if found.is_some() {
-            return found;
+            return Ok(found);
         }
     }
-    None
+    Ok(None)
+}
+
+/// A file the game or its robot wrote, through [`bounded::GAME_OUTPUT`]: its text, empty
+/// when it is missing, unreadable or not UTF-8 (the lap then says what it lacks), refused
+/// when it is past the bound.
+fn game_file(path: &Path) -> Result<String> {
+    match bounded::read_text(path, &bounded::GAME_OUTPUT) {
+        Err(e @ Error::InputTooLarge { .. }) => Err(e),
+        read => Ok(read.unwrap_or_default()),
+    }
 }
 
 /// cdbo's time limit, 30 s + L / (4 m/s), with L the game's track length; 30 min if the track
@@ -526,10 +538,7 @@ fn default_time_limit(install: &crate::torcs::Install, track: &str, category: &s
 /// The robot's trace: a header, then one row per driver step in the columns of
 /// `cdbo lap --trace`.
 pub fn read_trace(path: &Path) -> Result<Vec<TracePoint>> {
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-        path: path.to_owned(),
-        source,
-    })?;
+    let text = bounded::read_text(path, &bounded::TRACE_FILE)?;
     let file = path.display().to_string();
     let mut points = Vec::new();
     for (i, line) in text.lines().enumerate().skip(1) {
@@ -577,14 +586,16 @@ fn kill_group(group: i32) {
     }
 }
 
-/// The last line of a file, at most 300 bytes of it.
+/// The last line of a file, at most 300 bytes of it: only its last 300 bytes are read.
 fn tail(path: &Path) -> String {
+    const TAIL: u64 = 300;
     let mut text = String::new();
     if let Ok(mut f) = std::fs::File::open(path) {
+        let len = f.metadata().map_or(0, |m| m.len());
+        let _ = f.seek(SeekFrom::Start(len.saturating_sub(TAIL)));
         let mut buf = Vec::new();
-        let _ = f.read_to_end(&mut buf);
-        let start = buf.len().saturating_sub(300);
-        text = String::from_utf8_lossy(&buf[start..]).into_owned();
+        let _ = f.take(TAIL).read_to_end(&mut buf);
+        text = String::from_utf8_lossy(&buf).into_owned();
     }
     text.lines()
         .rfind(|l| !l.trim().is_empty())

@@ -16,10 +16,11 @@ pub mod lap;
 pub mod race;
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Command, Stdio};
 
 pub use lap::{GamePedal, LapRequest};
 
+use crate::bounded;
 use crate::error::{Error, Result};
 
 /// The robot's source, compiled by [`setup`].
@@ -68,15 +69,31 @@ impl Install {
         Ok(install)
     }
 
-    /// The installed package's version (`dpkg-query`), or "unknown".
+    /// The installed package's version (`dpkg-query`, its output read through
+    /// [`bounded::SYSTEM_LINE`]), or "unknown".
     pub fn version(&self) -> String {
-        Command::new("dpkg-query")
+        let Ok(mut child) = Command::new("dpkg-query")
             .args(["-W", "-f", "${Version}", "torcs"])
-            .output()
-            .ok()
-            .filter(|o| o.status.success() && !o.stdout.is_empty())
-            .map(|o| String::from_utf8_lossy(&o.stdout).into_owned())
-            .unwrap_or_else(|| "unknown".into())
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+        else {
+            return "unknown".into();
+        };
+        let version = child
+            .stdout
+            .take()
+            .map(|out| bounded::read(out, "dpkg-query", &bounded::SYSTEM_LINE));
+        if !matches!(version, Some(Ok(_))) {
+            let _ = child.kill();
+        }
+        match (child.wait(), version) {
+            (Ok(status), Some(Ok(v))) if status.success() && !v.is_empty() => {
+                String::from_utf8_lossy(&v).into_owned()
+            }
+            _ => "unknown".into(),
+        }
     }
 
     /// The category folder of a track (`road` for forza), from `tracks/CATEGORY/NAME/NAME.xml`.
@@ -195,7 +212,8 @@ impl Game {
     /// The tree in `cache` (`cache/tree`), when it has been set up with this robot.
     pub fn open(install: Install, cache: &Path) -> Result<Game> {
         let root = cache.join("tree");
-        let stamp = std::fs::read_to_string(root.join(STAMP)).unwrap_or_default();
+        let stamp =
+            bounded::read_text(&root.join(STAMP), &bounded::SYSTEM_LINE).unwrap_or_default();
         if stamp != robot_stamp() {
             let why = if stamp.is_empty() {
                 "is not set up"
@@ -310,7 +328,7 @@ fn build_tree(install: &Install, sdk: &Path, dir: &Path) -> Result<()> {
     let source = dir.join("cdbo.cpp");
     std::fs::write(&source, ROBOT_SOURCE).map_err(io(&source))?;
     let include = sdk.join("include");
-    let output = Command::new("c++")
+    let mut compiler = Command::new("c++")
         .args(["-O2", "-shared", "-fPIC", "-o"])
         .arg(robot_lib.join(format!("{ROBOT}.so")))
         .arg(&source)
@@ -319,14 +337,30 @@ fn build_tree(install: &Install, sdk: &Path, dir: &Path) -> Result<()> {
         .arg("-L")
         .arg(install.lib_dir.join("lib"))
         .args(["-lrobottools", "-ltgf"])
-        .output()
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
         .map_err(|e| {
             Error::Setup(format!(
                 "cannot run the C++ compiler `c++` ({e}): install it with `apt-get install g++`"
             ))
         })?;
-    if !output.status.success() {
-        let stderr = String::from_utf8_lossy(&output.stderr);
+    // Its messages through their bound; the compiler is stopped if they pass it.
+    let messages = match compiler.stderr.take() {
+        Some(pipe) => bounded::read(pipe, "c++ (standard error)", &bounded::COMPILER_OUTPUT),
+        None => Ok(Vec::new()),
+    };
+    if messages.is_err() {
+        let _ = compiler.kill();
+    }
+    let status = compiler.wait().map_err(|source| Error::Command {
+        line: "c++".into(),
+        source,
+    })?;
+    let messages = messages?;
+    if !status.success() {
+        let stderr = String::from_utf8_lossy(&messages);
         let first = stderr
             .lines()
             .find(|l| l.contains("error"))

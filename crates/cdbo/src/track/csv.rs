@@ -12,6 +12,7 @@ use std::path::Path;
 
 use super::spline::PeriodicSpline;
 use super::{Closure, MAX_LENGTH_M, Sample, TARGET_DS, Track};
+use crate::bounded;
 use crate::error::{Error, Result};
 
 /// Width of the moving average applied to the curvature (m).
@@ -19,10 +20,7 @@ pub const CURVATURE_WINDOW_M: f64 = 10.0;
 
 /// Reads a TUMFTM centre-line CSV file.
 pub fn read(path: &Path) -> Result<Track> {
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-        path: path.to_owned(),
-        source,
-    })?;
+    let text = bounded::read_text(path, &bounded::TRACK_CSV)?;
     let name = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())

@@ -22,12 +22,13 @@
 use std::path::Path;
 
 use super::{Ends, MAX_LENGTH_M, Piece, Track};
+use crate::bounded;
 use crate::error::Result;
 use crate::params::{Params, Section};
 
 /// Reads a TORCS track file; `ends` says what to do when it does not close.
 pub fn read(path: &Path, ends: Ends) -> Result<Track> {
-    let params = Params::read(path)?;
+    let params = Params::read(path, &bounded::TRACK_FILE)?;
     from_params(&params, &path.display().to_string(), ends)
 }
 
