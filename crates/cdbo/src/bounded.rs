@@ -13,10 +13,7 @@
 use std::io::Read;
 use std::path::Path;
 
-use crate::error::{Error, Result};
-
-/// One mebibyte.
-const MIB: u64 = 1 << 20;
+use crate::error::{Error, MIB, Result};
 
 /// One kind of input and the most of it cdbo reads.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -156,15 +153,6 @@ pub fn read_text(path: &Path, bound: &Bound) -> Result<String> {
     })
 }
 
-/// `bytes` as the refusals say them: `16 MiB`, `4 KiB`, or a count of bytes.
-pub fn show_bytes(bytes: u64) -> String {
-    match bytes {
-        b if b >= MIB && b % MIB == 0 => format!("{} MiB", b / MIB),
-        b if b >= 1024 && b % 1024 == 0 => format!("{} KiB", b / 1024),
-        b => format!("{b} bytes"),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -234,8 +222,8 @@ mod tests {
 
     #[test]
     fn sizes_are_said_in_their_unit() {
-        assert_eq!(show_bytes(256 * MIB), "256 MiB");
-        assert_eq!(show_bytes(4096), "4 KiB");
-        assert_eq!(show_bytes(1000), "1000 bytes");
+        assert_eq!(crate::error::show_bytes(256 * MIB), "256 MiB");
+        assert_eq!(crate::error::show_bytes(4096), "4 KiB");
+        assert_eq!(crate::error::show_bytes(1000), "1000 bytes");
     }
 }

@@ -17,9 +17,9 @@ pub enum Error {
         /// The operating-system error.
         source: std::io::Error,
     },
-    /// An input (a file, a program's output) larger than the bound of its kind
-    /// ([`crate::bounded`]), refused after reading the bound and one byte.
-    #[error("{input}: the {what} is larger than its bound of {}", crate::bounded::show_bytes(*bound))]
+    /// An input (a file, a program's output) larger than the bound of its kind, refused after
+    /// reading the bound and one byte.
+    #[error("{input}: the {what} is larger than its bound of {}", show_bytes(*bound))]
     InputTooLarge {
         /// The file, or the program and which of its outputs.
         input: String,
@@ -307,3 +307,15 @@ fn postgres_message(e: &postgres::Error) -> String {
         None => e.to_string(),
     }
 }
+
+/// `bytes` as the refusals say them: `16 MiB`, `4 KiB`, or a count of bytes.
+pub(crate) fn show_bytes(bytes: u64) -> String {
+    match bytes {
+        b if b >= MIB && b % MIB == 0 => format!("{} MiB", b / MIB),
+        b if b >= 1024 && b % 1024 == 0 => format!("{} KiB", b / 1024),
+        b => format!("{b} bytes"),
+    }
+}
+
+/// A mebibyte.
+pub(crate) const MIB: u64 = 1 << 20;
