@@ -118,7 +118,8 @@ pub fn race(
     let mut callback_error: Option<PyErr> = None;
     let outcome = py
         .detach(|| {
-            cdbo::experiment::race::race(track, &car, &config, |r| {
+            let venue = cdbo::venue::Venue::simulator(track.clone(), &car);
+            cdbo::experiment::race::race(&venue, &track, &car, &config, |r| {
                 if let (Some(cb), None) = (&progress, &callback_error) {
                     Python::attach(|py| {
                         if let Err(e) = record(py, r).and_then(|d| cb.call1(py, (d,))) {

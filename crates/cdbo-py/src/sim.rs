@@ -7,7 +7,6 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyType};
 
 use cdbo::car::Car;
-use cdbo::experiment::race::demonstrate;
 use cdbo::limit::{Limit, limit_lap};
 use cdbo::policy::RkhsPolicy;
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
@@ -408,7 +407,7 @@ impl PySimulator {
         py: Python<'py>,
         speed: f64,
     ) -> PyResult<(PyLapResult, Array<'py>, Array<'py>)> {
-        let (lap, pairs) = py.detach(|| demonstrate(&self.sim, speed));
+        let (lap, pairs) = py.detach(|| self.sim.demonstrate(speed));
         let (x, a) = pairs.into_iter().unzip();
         Ok((
             PyLapResult::new(py, lap, false)?,

@@ -18,7 +18,8 @@
 //! - [`study`]: persistent ask/tell studies for a real car; [`evaluator`]: sources of laps;
 //!   [`serve`]: laps as a JSON-lines service; [`store`]: the claimed-row store (SQLite or
 //!   PostgreSQL) behind studies and shared grids.
-//! - [`torcs`]: the racing game TORCS as a source of laps (its robot, setup and lap runner).
+//! - [`torcs`]: the racing game TORCS as a source of laps (its robot, setup and lap runner);
+//!   [`venue`]: where a race's laps are driven, the simulator or the game.
 //! - [`benchmarks`]: standard test functions.
 //! - [`sizes`]: the bounds on every size a user gives; [`bounded`]: the bound on every input
 //!   read, and its one reader.
@@ -35,7 +36,7 @@
 //! # fn main() -> cdbo::Result<()> {
 //! let track = Track::builtin("ridgeway")?;
 //! let sim = Simulator::new(track, &Car::spirit_300());
-//! let (demo, pairs) = demonstrate(&sim, 15.0);
+//! let (demo, pairs) = sim.demonstrate(15.0);
 //! let kernels = 30;
 //! let w0 = RkhsPolicy::fit(&pairs, kernels, default_lengthscale(kernels), DEFAULT_RIDGE)?;
 //! let mut optimizer = Spec::race(Method::PatternSearch)
@@ -84,5 +85,6 @@ pub mod store;
 pub mod study;
 pub mod torcs;
 pub mod track;
+pub mod venue;
 
 pub use error::{Error, Result};

@@ -262,7 +262,8 @@ fn cdbo_never_re_drives_a_lap() {
         ..Default::default()
     };
     let car = cdbo::car::Car::spirit_300();
-    let outcome = cdbo::experiment::race::race(track, &car, &config, |_| {}).unwrap();
+    let venue = cdbo::venue::Venue::simulator(track.clone(), &car);
+    let outcome = cdbo::experiment::race::race(&venue, &track, &car, &config, |_| {}).unwrap();
     let times: Vec<f64> = outcome.laps.iter().filter_map(|l| l.lap_time_s).collect();
     for (k, t) in times.iter().enumerate() {
         assert!(

@@ -645,7 +645,8 @@ fn a_study_told_the_laps_length_drives_the_races_laps() {
         seed: 3,
         ..RaceConfig::default()
     };
-    let raced = race(track(), &car, &config, |_| {}).unwrap();
+    let venue = cdbo::venue::Venue::simulator(track(), &car);
+    let raced = race(&venue, &track(), &car, &config, |_| {}).unwrap();
     let race_rewards: Vec<f64> = raced.laps.iter().map(|l| l.reward_mps).collect();
     assert!(race_rewards[1..].contains(&0.0), "no pushed lap failed");
     let sim = cdbo::sim::Simulator::new(track(), &car);

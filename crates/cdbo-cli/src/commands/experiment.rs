@@ -18,7 +18,7 @@ use cdbo::car::catalog as cars;
 use cdbo::data_path::DataPath;
 use cdbo::experiment::folder::{self, Session};
 use cdbo::experiment::grid::{ExperimentConfig, PRESETS, Shard};
-use cdbo::experiment::record::{RunRecord, Venue, run_at};
+use cdbo::experiment::record::{Grounds, RunRecord, run_at};
 use cdbo::experiment::shared::{Progress, SharedGrid, work};
 use cdbo::study::Location;
 use cdbo::study::claim::{DEFAULT_LEASE, Missed, Worker};
@@ -110,15 +110,15 @@ fn read_grid(args: &ExperimentArgs) -> Result<(ExperimentConfig, String), String
 fn load_tracks(
     runs: &[cdbo::experiment::grid::RunSpec],
     data: &DataPath,
-    venue: &Venue,
+    grounds: &Grounds,
 ) -> Result<BTreeMap<String, Track>, String> {
     let mut tracks: BTreeMap<String, Track> = BTreeMap::new();
     for r in runs {
         if !tracks.contains_key(&r.track) {
-            let t = match venue {
-                Venue::Simulator => load_track(&r.track, data)
+            let t = match grounds {
+                Grounds::Simulator => load_track(&r.track, data)
                     .map_err(|e| format!("{e}{}", track_hint(&r.track)))?,
-                Venue::Torcs { game, .. } => {
+                Grounds::Torcs { game, .. } => {
                     game.install
                         .track_category(&r.track)
                         .map_err(|e| e.to_string())?;
@@ -133,18 +133,18 @@ fn load_tracks(
 
 /// Where the grid's laps are driven, and the car as cdbo reads it: in the game, the game's
 /// car (car1-trb1 unless --car names another) from the game's own files.
-fn venue(
+fn grounds(
     args: &ExperimentArgs,
     data: &DataPath,
     simulator: Simulator,
-) -> Result<(Venue, cdbo::car::Car), Box<dyn std::error::Error>> {
+) -> Result<(Grounds, cdbo::car::Car), Box<dyn std::error::Error>> {
     match simulator {
-        Simulator::Cdbo => Ok((Venue::Simulator, cars::find(&args.car, data)?)),
+        Simulator::Cdbo => Ok((Grounds::Simulator, cars::find(&args.car, data)?)),
         Simulator::Torcs => {
             let game = cdbo::torcs::Game::ready()?;
             let car = simulator.car(&args.car).to_owned();
             let read = game.car(&car)?;
-            Ok((Venue::Torcs { game, car }, read))
+            Ok((Grounds::Torcs { game, car }, read))
         }
     }
 }
@@ -224,8 +224,8 @@ pub fn run_grid(args: &ExperimentArgs, data: &DataPath, simulator: Simulator) ->
         }
     });
     let skipped = shard_size - runs.len();
-    let (venue, car) = venue(args, data, simulator)?;
-    let tracks = load_tracks(&runs, data, &venue)?;
+    let (grounds, car) = grounds(args, data, simulator)?;
+    let tracks = load_tracks(&runs, data, &grounds)?;
     let jobs = args
         .jobs
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
@@ -247,7 +247,7 @@ pub fn run_grid(args: &ExperimentArgs, data: &DataPath, simulator: Simulator) ->
     pool.install(|| {
         runs.par_iter().try_for_each(|spec| -> Result<(), String> {
             let track = tracks[&spec.track].clone();
-            let record = run_at(spec, &config, track, &car, &venue, |_| bar.inc(1))
+            let record = run_at(spec, &config, track, &car, &grounds, |_| bar.inc(1))
                 .map_err(|e| format!("{}: {e}", spec.id()))?;
             record.save(&out).map_err(|e| e.to_string())?;
             let k = done.fetch_add(1, Ordering::Relaxed) + 1;
@@ -302,7 +302,7 @@ fn shared_grid(
     // Everything a worker needs is checked before the grid is stored.
     let car = cars::find(&args.car, data)?;
     let tracks = if args.worker {
-        load_tracks(&config.runs(), data, &Venue::Simulator)?
+        load_tracks(&config.runs(), data, &Grounds::Simulator)?
     } else {
         BTreeMap::new()
     };

@@ -24,6 +24,7 @@ use cdbo::car::{Car, catalog as cars};
 use cdbo::data_path::DataPath;
 use cdbo::method::Method;
 use cdbo::track::{Ends, Track, builtin, catalog as tracks};
+use cdbo::venue::Venue;
 
 /// `--method`'s parser: the registry's names, each with its one-line description in `--help`.
 pub fn method_parser() -> impl clap::builder::TypedValueParser<Value = Method> {
@@ -53,6 +54,27 @@ impl Simulator {
             _ => spec,
         }
     }
+}
+
+/// Where `--simulator` drives the laps of `setup`'s track and car, and cdbo's reading of them
+/// (for the limit and the plots): in the game, the game's own track and car files.
+pub fn venue(
+    setup: &Setup,
+    data: &DataPath,
+    simulator: Simulator,
+) -> Result<(Venue, Track, Car), Box<dyn std::error::Error>> {
+    Ok(match simulator {
+        Simulator::Cdbo => {
+            let (track, car) = setup.load(data)?;
+            (Venue::simulator(track.clone(), &car), track, car)
+        }
+        Simulator::Torcs => {
+            let game = cdbo::torcs::Game::ready()?;
+            let venue = Venue::game(&game, &setup.track, simulator.car(&setup.car))?;
+            let car = venue.car().cloned().unwrap_or_else(Car::spirit_300);
+            (venue, game_track(&setup.track, &game, data)?, car)
+        }
+    })
 }
 
 /// Prefixes a library error with the command-line flag its value came from (the library

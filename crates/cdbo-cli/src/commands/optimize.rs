@@ -11,11 +11,11 @@ use super::study::InitialPolicy;
 use super::{CliResult, Simulator};
 use cdbo::evaluator::Evaluator;
 use cdbo::evaluator::command::CommandEvaluator;
-use cdbo::evaluator::torcs::TorcsEvaluator;
 use cdbo::study::claim::{DEFAULT_LEASE, Worker};
 use cdbo::study::run::Event;
 use cdbo::study::{Location, Outcome, Study};
 use cdbo::torcs::GamePedal;
+use cdbo::torcs::evaluator::TorcsEvaluator;
 
 #[derive(Debug, Args)]
 pub struct OptimizeArgs {

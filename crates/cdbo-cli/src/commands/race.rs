@@ -99,26 +99,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     if let Some(w) = cdbo::method::cost::slow_race_warning(args.method, args.kernels, args.laps) {
         eprintln!("warning: {w}");
     }
-    // In the game, the track and car are the game's, read by cdbo for the limit and plots.
-    let game = match simulator {
-        Simulator::Torcs => {
-            let game = cdbo::torcs::Game::ready()?;
-            let req = game.request(
-                &args.setup.track,
-                simulator.car(&args.setup.car),
-                cdbo::torcs::GamePedal::Demo(args.demo_speed),
-            )?;
-            Some((game, req))
-        }
-        Simulator::Cdbo => None,
-    };
-    let (track, car) = match &game {
-        Some((g, req)) => (
-            super::game_track(&args.setup.track, g, data)?,
-            req.car.clone(),
-        ),
-        None => args.setup.load(data)?,
-    };
+    let (venue, track, car) = super::venue(&args.setup, data, simulator)?;
     let track_name = track.name.clone();
     let out = args.out.clone().unwrap_or_else(|| {
         PathBuf::from("runs").join(format!(
@@ -150,11 +131,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
             100.0 * r.best_mps / limit_reward
         ));
     };
-    let outcome = match &game {
-        Some((g, req)) => cdbo::torcs::race::race(g, req, &track, &config, progress),
-        None => race(track.clone(), &car, &config, progress),
-    }
-    .map_err(|e| match e {
+    let outcome = race(&venue, &track, &car, &config, progress).map_err(|e| match e {
         cdbo::Error::DemoFailed { .. } => from_flag("--demo-speed")(e),
         e => e.into(),
     })?;
@@ -164,18 +141,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     let (_, ceiling_mps) = cdbo::ceiling::tracked_profile(&ceiling_sim, &outcome.limit)?;
     write_outputs(&out, &outcome)?;
     // The speed plots re-drive the initial and best policies where the race was driven.
-    let mut sim = cdbo::sim::Simulator::new(track.clone(), &car);
-    sim.config.trace = true;
-    let drive = |p: &RkhsPolicy| -> Result<cdbo::sim::LapResult, cdbo::Error> {
-        match &game {
-            Some((g, req)) => {
-                let mut req = req.clone();
-                req.record = true;
-                cdbo::torcs::race::drive(g, &req, cdbo::torcs::GamePedal::Rkhs(p.clone()))
-            }
-            None => Ok(sim.lap(&mut p.pedal())),
-        }
-    };
+    let drive = |p: &RkhsPolicy| venue.drive(p);
     write_plots(&out, &track, &outcome, &drive)?;
     let best_lap = outcome
         .laps

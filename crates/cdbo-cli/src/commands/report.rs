@@ -14,7 +14,6 @@ use crate::figures::{LineChart, Panels, draw, speed_chart};
 use cdbo::car::catalog as cars;
 use cdbo::data_path::DataPath;
 use cdbo::experiment::folder::Session;
-use cdbo::experiment::race::demonstrate;
 use cdbo::experiment::record::RunRecord;
 use cdbo::experiment::shared::SharedGrid;
 use cdbo::experiment::summary::{Curve, cell_means, claims, curves, times};
@@ -138,7 +137,7 @@ pub fn run(args: &ReportArgs, data: &DataPath) -> CliResult {
         ));
         if let Some(best) = best_cdbo_run(&records, track) {
             let sim = cdbo::sim::Simulator::new(load_track(track, data)?, &car);
-            let (_, demo) = demonstrate(&sim, best.demo_speed);
+            let (_, demo) = sim.demonstrate(best.demo_speed);
             let names = best_policy_figures(&out, track, sim, &car, &demo, best)?;
             figures.push((
                 format!(

@@ -8,14 +8,10 @@ use clap::Args;
 use super::{CliResult, Setup, Simulator};
 use cdbo::data_path::DataPath;
 use cdbo::evaluator::Evaluator;
-use cdbo::evaluator::simulator::SimEvaluator;
-use cdbo::evaluator::torcs::TorcsEvaluator;
-use cdbo::experiment::race::demonstrate;
 use cdbo::optimizers::{DEFAULT_BOX_RADIUS, SearchBox};
 use cdbo::policy::RkhsPolicy;
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 use cdbo::serve::{Info, Server};
-use cdbo::torcs::{Game, GamePedal};
 use cdbo::track::Track;
 
 #[derive(Debug, Args)]
@@ -31,38 +27,13 @@ pub struct ServeSimArgs {
 }
 
 pub fn run(args: &ServeSimArgs, data: &DataPath, simulator: Simulator) -> CliResult {
-    let lengthscale = default_lengthscale(args.kernels);
-    match simulator {
-        Simulator::Cdbo => {
-            let (track, car) = args.setup.load(data)?;
-            let limit = cdbo::limit::limit_lap(&track, &car);
-            let sim = cdbo::sim::Simulator::new(track, &car);
-            let (_, demo) = demonstrate(&sim, args.demo_speed);
-            let track = sim.track.clone();
-            let evaluator = SimEvaluator { sim, lengthscale };
-            serve(args, &track, &limit, &demo, evaluator)
-        }
-        // In the game: the demonstration and every lap a fresh game process; the limit on
-        // cdbo's reading of the game's track.
-        Simulator::Torcs => {
-            let game = Game::ready()?;
-            let car = simulator.car(&args.setup.car);
-            let mut request =
-                game.request(&args.setup.track, car, GamePedal::Demo(args.demo_speed))?;
-            let track = super::game_track(&args.setup.track, &game, data)?;
-            let limit = cdbo::limit::limit_lap(&track, &request.car);
-            request.record = true;
-            let demo = cdbo::torcs::race::drive(&game, &request, request.pedal.clone())?;
-            request.record = false;
-            let pairs: Vec<(f64, f64)> = demo.trace.iter().map(|p| (p.x, p.pedal)).collect();
-            let evaluator = TorcsEvaluator {
-                game,
-                request,
-                lengthscale,
-            };
-            serve(args, &track, &limit, &pairs, evaluator)
-        }
-    }
+    // In the game, the demonstration and every lap are a fresh game process, and the limit is
+    // on cdbo's reading of the game's track.
+    let (venue, track, car) = super::venue(&args.setup, data, simulator)?;
+    let limit = cdbo::limit::limit_lap(&track, &car);
+    let (_, demo) = venue.demonstrate(args.demo_speed)?;
+    let evaluator = venue.evaluator(default_lengthscale(args.kernels));
+    serve(args, &track, &limit, &demo, evaluator)
 }
 
 /// Fits w₀ to the demonstration's (x, a) pairs and answers requests with `evaluator`'s laps.

@@ -20,6 +20,7 @@ use cdbo::experiment::race::{RaceConfig, race};
 use cdbo::policy::RkhsPolicy;
 use cdbo::sim::{LapResult, Simulator};
 use cdbo::torcs::{Game, GamePedal, LapRequest};
+use cdbo::venue::Venue;
 
 #[derive(Debug, Args)]
 pub struct CompareArgs {
@@ -183,7 +184,7 @@ fn compare_track(
         let mut req: LapRequest = base.clone();
         req.pedal = pedal;
         req.record = record;
-        cdbo::torcs::race::drive(game, &req, req.pedal.clone())
+        cdbo::torcs::evaluator::drive(game, &req, req.pedal.clone())
     };
     let mut demos = Vec::new();
     for &v in &args.demo {
@@ -206,7 +207,13 @@ fn compare_track(
         seed: args.seed,
         ..RaceConfig::default()
     };
-    let learned = race(track.clone(), &car, &config, |_| {})?;
+    let learned = race(
+        &Venue::simulator(track.clone(), &car),
+        &track,
+        &car,
+        &config,
+        |_| {},
+    )?;
     let best = learned.best.clone();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(args.seed);
     let drawn: Vec<RkhsPolicy> = (0..args.policies)

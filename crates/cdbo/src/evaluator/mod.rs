@@ -4,7 +4,6 @@
 
 pub mod command;
 pub mod simulator;
-pub mod torcs;
 
 use serde::{Deserialize, Serialize};
 
@@ -23,6 +22,17 @@ pub trait Evaluator {
     /// each file removed and its process. Called before a worker's first lap.
     fn remove_leftovers(&mut self) -> Vec<(std::path::PathBuf, u32)> {
         Vec::new()
+    }
+}
+
+/// A boxed evaluator is one (a [`crate::venue::Venue`]'s, say).
+impl<E: Evaluator + ?Sized> Evaluator for Box<E> {
+    fn evaluate(&mut self, trial: i64, weights: &[f64]) -> Result<Outcome> {
+        (**self).evaluate(trial, weights)
+    }
+
+    fn remove_leftovers(&mut self) -> Vec<(std::path::PathBuf, u32)> {
+        (**self).remove_leftovers()
     }
 }
 

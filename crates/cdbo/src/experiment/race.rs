@@ -4,17 +4,16 @@
 use serde::{Deserialize, Serialize};
 
 use crate::car::Car;
-use crate::drive::demo::SpeedHold;
 use crate::error::{Error, Result};
-use crate::evaluator::simulator::SimEvaluator;
 use crate::evaluator::{Evaluator, Outcome};
 use crate::limit::{Limit, limit_lap};
 use crate::method::{Method, Spec};
 use crate::policy::RkhsPolicy;
 use crate::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
-use crate::sim::{FailureReason, LapResult, Simulator};
+use crate::sim::{FailureReason, LapResult};
 use crate::study::run::{Event, InMemory, run};
 use crate::track::Track;
+use crate::venue::Venue;
 
 /// Settings of a race.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -98,39 +97,33 @@ pub struct RaceOutcome {
     pub limit: Limit,
 }
 
-/// Drives the demonstration and records its (x, a) pairs at every driver step.
-pub fn demonstrate(sim: &Simulator, speed: f64) -> (LapResult, Vec<(f64, f64)>) {
-    let mut s = sim.clone();
-    s.config.trace = true;
-    let lap = s.lap(&mut SpeedHold::new(speed));
-    let pairs = lap.trace.iter().map(|p| (p.x, p.pedal)).collect();
-    (lap, pairs)
-}
-
-/// Runs a race in cdbo's simulator; `progress` is called after every lap.
+/// Runs a race where `venue` drives its laps, on `track` with `car` (cdbo's reading of them,
+/// for the limit); `progress` is called after every lap.
 pub fn race(
-    track: Track,
+    venue: &Venue,
+    track: &Track,
     car: &Car,
     config: &RaceConfig,
     progress: impl FnMut(&LapRecord),
 ) -> Result<RaceOutcome> {
-    let limit = limit_lap(&track, car);
-    let sim = Simulator::new(track, car);
-    let demo = demonstrate(&sim, config.demo_speed);
-    let mut evaluator = SimEvaluator {
-        lengthscale: default_lengthscale(config.kernels),
-        sim,
-    };
-    let track_name = evaluator.sim.track.name.clone();
-    race_with(&track_name, demo, limit, config, &mut evaluator, progress)
+    let limit = limit_lap(track, car);
+    let demo = venue.demonstrate(config.demo_speed)?;
+    let mut evaluator = venue.evaluator(default_lengthscale(config.kernels));
+    race_with(
+        &track.name,
+        demo,
+        limit,
+        config,
+        evaluator.as_mut(),
+        progress,
+    )
 }
 
-/// Runs a race whose laps `evaluator` drives (cdbo's simulator, the game TORCS, ...) with
-/// policies of length-scale [`default_lengthscale`]`(config.kernels)`, from a demonstration
-/// already driven there (its lap and (x, a) pairs); `progress` is called after every lap.
-/// The laps go through the one lap loop ([`crate::study::run`]) with an in-memory trial
-/// source.
-pub fn race_with(
+/// Runs a race whose laps `evaluator` drives with policies of length-scale
+/// [`default_lengthscale`]`(config.kernels)`, from a demonstration already driven there (its
+/// lap and (x, a) pairs); `progress` is called after every lap. The laps go through the one
+/// lap loop ([`crate::study::run`]) with an in-memory trial source.
+fn race_with(
     track_name: &str,
     (demo, demo_pairs): (LapResult, Vec<(f64, f64)>),
     limit: Limit,

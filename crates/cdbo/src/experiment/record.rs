@@ -13,6 +13,7 @@ use crate::bounded;
 use crate::car::Car;
 use crate::error::{Error, Result};
 use crate::track::Track;
+use crate::venue::Venue;
 
 /// A finished run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -125,14 +126,14 @@ impl RunRecord {
 
 /// Where a grid's laps are driven.
 #[derive(Debug, Clone, Default)]
-pub enum Venue {
+pub enum Grounds {
     /// cdbo's simulator.
     #[default]
     Simulator,
     /// The game TORCS: every lap (the demonstration's too) a fresh game process driven by
-    /// cdbo's robot ([`crate::torcs::race`]); the car by its TORCS name, the track by the
-    /// run's. The record's limit is cdbo's reading of the game's track; it has no ceiling
-    /// (that is a lap in cdbo's simulator).
+    /// cdbo's robot ([`Venue::Game`]); the car by its TORCS name, the track by the run's. The
+    /// record's limit is cdbo's reading of the game's track; it has no ceiling (that is a lap
+    /// in cdbo's simulator).
     Torcs {
         /// The set-up game.
         game: crate::torcs::Game,
@@ -149,17 +150,17 @@ pub fn run(
     car: &Car,
     progress: impl FnMut(&LapRecord),
 ) -> Result<RunRecord> {
-    run_at(spec, grid, track, car, &Venue::Simulator, progress)
+    run_at(spec, grid, track, car, &Grounds::Simulator, progress)
 }
 
-/// Races one run of the grid where `venue` drives its laps (`track` and `car` are cdbo's
-/// reading of them, for the limit); `progress` is called after every lap.
+/// Races one run of the grid on `grounds` (`track` and `car` are cdbo's reading of them, for
+/// the limit); `progress` is called after every lap.
 pub fn run_at(
     spec: &RunSpec,
     grid: &ExperimentConfig,
     track: Track,
     car: &Car,
-    venue: &Venue,
+    grounds: &Grounds,
     progress: impl FnMut(&LapRecord),
 ) -> Result<RunRecord> {
     let start = std::time::Instant::now();
@@ -174,19 +175,14 @@ pub fn run_at(
         knob: Some(grid.knob_of(method)),
     };
     let (track_name, length_m) = (track.name.clone(), track.length);
-    let (outcome, ceiling_reward_mps) = match venue {
-        Venue::Simulator => {
-            let ceiling_sim = crate::sim::Simulator::new(track.clone(), car);
-            let outcome = race(track, car, &config, progress)?;
-            let (_, ceiling) = crate::ceiling::tracked_profile(&ceiling_sim, &outcome.limit)?;
-            (outcome, Some(ceiling))
-        }
-        Venue::Torcs { game, car } => {
-            let demo = crate::torcs::GamePedal::Demo(config.demo_speed);
-            let request = game.request(&spec.track, car, demo)?;
-            let outcome = crate::torcs::race::race(game, &request, &track, &config, progress)?;
-            (outcome, None)
-        }
+    let venue = match grounds {
+        Grounds::Simulator => Venue::simulator(track.clone(), car),
+        Grounds::Torcs { game, car } => Venue::game(game, &spec.track, car)?,
+    };
+    let outcome = race(&venue, &track, car, &config, progress)?;
+    let ceiling_reward_mps = match venue {
+        Venue::Simulator(sim) => Some(crate::ceiling::tracked_profile(&sim, &outcome.limit)?.1),
+        Venue::Game { .. } => None,
     };
     Ok(RunRecord {
         spec: spec.clone(),

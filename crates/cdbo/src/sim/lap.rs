@@ -17,6 +17,7 @@ use serde::Serialize;
 
 use super::vehicle::{Controls, State, Vehicle};
 use crate::car::Car;
+use crate::drive::demo::SpeedHold;
 use crate::drive::steering::{Steering, wrap_angle};
 use crate::drive::{Observation, Pedal};
 use crate::track::{Frame, Track};
@@ -203,6 +204,16 @@ impl Simulator {
         self.config
             .time_limit
             .unwrap_or(30.0 + self.track.length / 4.0)
+    }
+
+    /// The demonstration (paper Sec. V): the lap of a speed hold at `speed` (m/s), traced, and
+    /// its (x, a) pairs at every driver step, which w₀ is fitted to.
+    pub fn demonstrate(&self, speed: f64) -> (LapResult, Vec<(f64, f64)>) {
+        let mut traced = self.clone();
+        traced.config.trace = true;
+        let lap = traced.lap(&mut SpeedHold::new(speed));
+        let pairs = lap.trace.iter().map(|p| (p.x, p.pedal)).collect();
+        (lap, pairs)
     }
 
     /// Drives one lap with `pedal` and the steering controller.

@@ -12,8 +12,8 @@
 //! points are handed over from the car's [`crate::sim::vehicle::Vehicle`]), the same ABS and
 //! traction control, and the same failure rules, judged from the game's car state.
 
+pub mod evaluator;
 pub mod lap;
-pub mod race;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};

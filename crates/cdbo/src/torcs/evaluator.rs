@@ -1,10 +1,11 @@
 //! The game TORCS as an evaluator: one lap of the RKHS policy with the given weights, driven
-//! by cdbo's robot in a fresh game process ([`crate::torcs`]).
+//! by cdbo's robot in a fresh game process.
 
-use super::{Evaluator, Outcome};
+use super::{Game, GamePedal, LapRequest};
 use crate::error::Result;
+use crate::evaluator::{Evaluator, Outcome};
 use crate::policy::RkhsPolicy;
-use crate::torcs::{Game, GamePedal, LapRequest};
+use crate::sim::lap::{Failure, FailureReason, LapResult};
 
 /// Laps in TORCS with RKHS policies of a fixed length-scale.
 #[derive(Debug, Clone)]
@@ -33,4 +34,30 @@ impl Evaluator for TorcsEvaluator {
             }
         })
     }
+}
+
+/// A lap the game did not drive (it hung and was killed, or crashed) counts as a failed lap
+/// at the time limit; the reason goes to standard error.
+fn failed_lap(reason: &str) -> LapResult {
+    eprintln!("warning: TORCS drove no lap: {reason}");
+    LapResult {
+        completed: false,
+        lap_time_s: None,
+        reward_mps: 0.0,
+        failure: Some(Failure {
+            reason: FailureReason::TimeLimit,
+            x: 0.0,
+            distance_m: 0.0,
+            time_s: 0.0,
+        }),
+        simulated_s: 0.0,
+        trace: Vec::new(),
+    }
+}
+
+/// Drives `req` with `pedal`: the game's lap, or a failed lap if it drove none.
+pub fn drive(game: &Game, req: &LapRequest, pedal: GamePedal) -> Result<LapResult> {
+    let mut req = req.clone();
+    req.pedal = pedal;
+    Ok(game.lap(&req)?.unwrap_or_else(|reason| failed_lap(&reason)))
 }
