@@ -192,6 +192,19 @@ fn the_robots_decisions_are_the_rust_ones_on_recorded_laps() {
         let a = pedal_command(v);
         calls.check("pedal", "pedal_command", &[v], &[a], Agree::Exactly);
     }
+    // The tables at their own points, where the segment changes (there a value far below
+    // its neighbour's tells the two sides apart), and beyond their ends.
+    let steep = PolicyTable::new(vec![(0.0, 1.0), (0.5, 1e-17), (0.75, -0.5)]).unwrap();
+    for t in [&table, &steep] {
+        let mut args = vec![t.points().len() as f64];
+        args.extend(t.points().iter().flat_map(|&(x, a)| [x, a]));
+        for x in t.points().iter().map(|&(x, _)| x).chain([-0.5, 1.5]) {
+            let args = [&args[..], &[x]].concat();
+            calls.check("table", "table", &args, &[t.action(x)], Agree::Exactly);
+        }
+    }
+    let mut table_args = vec![table.points().len() as f64];
+    table_args.extend(table.points().iter().flat_map(|&(x, a)| [x, a]));
 
     // The gearbox as the robot is handed it (torcs/lap.rs): total ratios and the shift map.
     let map = sim.vehicle.shift_map();
@@ -223,9 +236,7 @@ fn the_robots_decisions_are_the_rust_ones_on_recorded_laps() {
                 calls.check(&at, "rkhs", &args, &[raw], Agree::Exactly);
                 calls.check(&at, "rkhs", &args, &[pedal.raw(p.x)], Agree::Within(1e-12));
             }
-            let mut args = vec![table.points().len() as f64];
-            args.extend(table.points().iter().flat_map(|&(x, a)| [x, a]));
-            args.push(p.x);
+            let args = [&table_args[..], &[p.x]].concat();
             calls.check(&at, "table", &args, &[table.action(p.x)], Agree::Exactly);
 
             // The demonstrator's speed hold on the recorded speeds, its integral carried.

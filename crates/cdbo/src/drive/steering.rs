@@ -7,6 +7,10 @@
 //! pure pursuit for wheelbase L, so the loop's bandwidth is independent of speed) and
 //! K_i = [`KI`]. The integral term removes the steady offset that tyre slip leaves in long
 //! corners; it is frozen while the output saturates.
+//!
+//! The look-ahead, the [`bearing`] and the [`steering_law`] are pure functions so that the
+//! TORCS robot's `torcs-robot/drive.hpp`, which finds its target on the game's track, can be
+//! checked against them (`tests/robot_drive.rs`).
 
 use super::pi_control;
 use crate::sim::vehicle::State;
