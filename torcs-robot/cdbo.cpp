@@ -13,7 +13,9 @@
  * (crates/cdbo/src/sim/powertrain.rs) from shift points it is given; ABS and traction control
  * ease the pedals as cdbo's vehicle does; the lap fails by cdbo's rules (sim/lap.rs), judged
  * from the game's car state. On completion or failure it writes one JSON line and ends the
- * game process at once.
+ * game process at once. The decisions themselves (pedal, steering law, gearbox, launch clutch)
+ * are the pure functions of drive.hpp, checked against cdbo's Rust by its tests; this file
+ * reads the game's state for them and applies their commands.
  *
  * Settings: the file named by the attribute "settings" of section "cdbo" in
  * drivers/cdbo/cdbo.xml, relative to the game's local directory (-l) unless absolute. One
@@ -51,18 +53,18 @@
 #include <tgf.h>
 #include <track.h>
 
+#include "drive.hpp"
+
 namespace {
 
-const double kDemoKp = 0.5;  // drive/demo.rs KP
-const double kDemoKi = 0.1;  // drive/demo.rs KI
+using drive::clamp;
+
 const double kSpinSlipTan = 0.5773502691896258;  // 1 / tan 60 deg (sim/lap.rs)
 const double kSpinMinSpeed = 3.0;
 const double kBackwardsDistance = 10.0;
 const double kStallSpeed = 0.5;
 const double kStallTime = 5.0;
 const double kSlipSpeedFloor = 2.0;  // sim/vehicle.rs SLIP_SPEED_FLOOR
-const double kLaunchTime = 2.0;      // s, the clutch's closing while pulling away
-const double kLaunchSpeed = 5.0;     // m/s, added to the road speed when closing it
 
 struct Settings {
     std::string output = "lap.jsonl";
@@ -88,9 +90,10 @@ struct Lap {
     double start_time = -1.0, last_time = 0.0;
     double distance = 0.0, farthest = 0.0, last_station = 0.0, slow_for = 0.0;
     double steer_integral = 0.0, demo_integral = 0.0;
-    int gear = 0;             // 0-based, as in cdbo
-    double shifting = 0.0;    // time left in a shift (s)
-    double launch_time = 0.0; // time with throttle in first gear (s)
+    drive::Gearbox gearbox = {};  // points into cfg, set once the settings are read
+    size_t gear = 0;              // 0-based, as in cdbo
+    double shifting = 0.0;        // time left in a shift (s)
+    double launch_time = 0.0;     // time with throttle in first gear (s)
     bool done = false;
 };
 
@@ -179,57 +182,31 @@ bool read_settings(const std::string &path, Settings *s, std::string *error) {
                     (p == "constant" && s->pedal_args.size() == 1) ||
                     (p == "rkhs" && s->pedal_args.size() >= 3 && s->pedal_args[0] > 0) ||
                     (p == "table" && s->pedal_args.size() >= 2 && s->pedal_args.size() % 2 == 0);
+    for (size_t i = 2; pedal_ok && p == "table" && i < s->pedal_args.size(); i += 2) {
+        pedal_ok = s->pedal_args[i] > s->pedal_args[i - 2];
+    }
     if (!pedal_ok) {
-        *error = path + ": pedal must be 'demo V', 'constant A', 'rkhs L W1 W2 ...' or 'table X1 A1 ...'";
+        *error = path + ": pedal must be 'demo V', 'constant A', 'rkhs L W1 W2 ...' or "
+                        "'table X1 A1 ...' with x increasing";
         return false;
     }
     return true;
 }
 
-double clamp(double v, double lo, double hi) { return v < lo ? lo : (v > hi ? hi : v); }
-
-/// pi(x) = clamp(sum_i w_i k(x, i/(M-1)), -1, 1), k the Matern-3/2 kernel (policy/rkhs.rs).
-double rkhs(const std::vector<double> &args, double x) {
-    double l = args[0];
-    size_t m = args.size() - 1;
-    double sum = 0.0;
-    for (size_t i = 0; i < m; i++) {
-        double r = std::sqrt(3.0) * std::fabs(x - double(i) / double(m - 1)) / l;
-        sum += args[i + 1] * (1.0 + r) * std::exp(-r);
-    }
-    return sum;
-}
-
-/// Linear interpolation in an (x, a) table, held flat beyond its ends (policy/table.rs).
-double table(const std::vector<double> &args, double x) {
-    size_t n = args.size() / 2;
-    if (x <= args[0]) return args[1];
-    for (size_t i = 1; i < n; i++) {
-        double x1 = args[2 * i];
-        if (x <= x1) {
-            double x0 = args[2 * i - 2], a0 = args[2 * i - 1], a1 = args[2 * i + 1];
-            return x1 > x0 ? a0 + (a1 - a0) * (x - x0) / (x1 - x0) : a1;
-        }
-    }
-    return args[2 * n - 1];
-}
-
+/// The pedal command a in [-1, 1] at lap fraction x.
 double pedal(double x, double speed, double dt) {
     const std::vector<double> &a = lap.cfg.pedal_args;
     double v;
     if (lap.cfg.pedal == "demo") {
-        double e = a[0] - speed;
-        double raw = kDemoKp * e + kDemoKi * (lap.demo_integral + e * dt);
-        if (std::fabs(raw) < 1.0) lap.demo_integral += e * dt;
-        v = kDemoKp * e + kDemoKi * lap.demo_integral;
+        v = drive::speed_hold(a[0], speed, dt, lap.demo_integral);
     } else if (lap.cfg.pedal == "constant") {
         v = a[0];
     } else if (lap.cfg.pedal == "rkhs") {
-        v = rkhs(a, x);
+        v = drive::rkhs_raw(a.data() + 1, a.size() - 1, a[0], x);
     } else {
-        v = table(a, x);
+        v = drive::table_action(a.data(), a.size() / 2, x);
     }
-    return std::isnan(v) ? 0.0 : clamp(v, -1.0, 1.0);
+    return drive::pedal_command(v);
 }
 
 /// The centre-line point s metres from the start line (wrapped onto the lap).
@@ -261,17 +238,11 @@ void centre_point(double s, double *px, double *py) {
 
 /// The road-wheel angle (rad) of cdbo's look-ahead PI steering (drive/steering.rs).
 double steer(tCarElt *car, double speed, double dt) {
-    double d = std::fmax(lap.cfg.lookahead_time * speed, lap.cfg.lookahead_min);
+    double d = drive::lookahead(lap.cfg.lookahead_time, lap.cfg.lookahead_min, speed);
     double tx, ty;
     centre_point(car->_distFromStartLine + d, &tx, &ty);
-    double dx = tx - car->_pos_X, dy = ty - car->_pos_Y;
-    double cy = std::cos(car->_yaw), sy = std::sin(car->_yaw);
-    double e = std::atan2(cy * dy - sy * dx, cy * dx + sy * dy);
-    double kp = 2.0 * lap.cfg.wheelbase / d;
-    double lock = car->_steerLock;
-    double raw = kp * e + lap.cfg.ki * (lap.steer_integral + e * dt);
-    if (std::fabs(raw) < lock) lap.steer_integral += e * dt;
-    return clamp(kp * e + lap.cfg.ki * lap.steer_integral, -lock, lock);
+    double e = drive::bearing(tx - car->_pos_X, ty - car->_pos_Y, std::sin(car->_yaw), std::cos(car->_yaw));
+    return drive::steering_law(e, d, lap.cfg.wheelbase, lap.cfg.ki, car->_steerLock, lap.steer_integral, dt);
 }
 
 /// Spin of an axle (rad/s): the mean of its two wheels (0, 1 front; 2, 3 rear).
@@ -279,52 +250,24 @@ double axle_omega(tCarElt *car, int axle) {
     return 0.5 * (car->_wheelSpinVel(2 * axle) + car->_wheelSpinVel(2 * axle + 1));
 }
 
-/// The engine speed at which to leave gear g at a throttle (sim/powertrain.rs
-/// ShiftMap::upshift): linear between the levels, full throttle's when coasting or braking.
-double upshift_at(size_t g, double throttle) {
-    const Settings &c = lap.cfg;
-    size_t n = c.throttle_levels;
-    const double *row = &c.upshift[g * n];
-    if (throttle <= 0.0 || throttle >= 1.0 || n < 2) return row[n - 1];
-    double f = throttle * double(n - 1);
-    size_t k = std::min(size_t(f), n - 2);
-    double t = f - double(k);
-    return row[k] + (row[k + 1] - row[k]) * t;
-}
-
-/// cdbo's automatic gearbox (sim/powertrain.rs Gearbox::update).
+/// cdbo's automatic gearbox on the driven wheels' spin, the time left in a shift counted down
+/// by the driver step first (cdbo's simulator counts it down every physics step).
 void choose_gear(tCarElt *car, double throttle, double dt) {
-    const Settings &c = lap.cfg;
     lap.shifting = std::fmax(lap.shifting - dt, 0.0);
-    if (lap.shifting > 0.0) return;
-    double w = c.driven[0] * axle_omega(car, 0) + c.driven[1] * axle_omega(car, 1);
-    size_t g = lap.gear;
-    if (g + 1 < c.ratios.size() && w * c.ratios[g] >= upshift_at(g, throttle)) {
-        lap.gear++;
-        lap.shifting = c.shift_time;
-    } else if (g > 0 && w * c.ratios[g - 1] < c.downshift_margin * upshift_at(g - 1, throttle)) {
-        lap.gear--;
-        lap.shifting = c.shift_time;
-    }
+    double w = lap.cfg.driven[0] * axle_omega(car, 0) + lap.cfg.driven[1] * axle_omega(car, 1);
+    drive::gear_update(lap.gearbox, lap.gear, lap.shifting, w, throttle);
 }
 
 /// The clutch while pulling away in first gear. cdbo's powertrain lets the clutch slip below
 /// idle with the engine giving its idle torque; the game's engine gives no torque below idle
 /// and drives the wheels only while it turns faster, so a standing car with the clutch closed
 /// barely creeps. As the game's own robots do, the clutch starts open and closes over
-/// kLaunchTime of throttle, sooner once the engine passes half its red line with the car
-/// rolling; after first gear it stays closed.
+/// drive::kLaunchTime of throttle, sooner once the engine passes half its red line with the
+/// car rolling; after first gear it stays closed.
 double launch_clutch(tCarElt *car, double throttle, double dt) {
-    if (lap.gear != 0) return 0.0;
-    if (throttle > 0.0) lap.launch_time += dt;
-    double ramp = clamp(1.0 - lap.launch_time / kLaunchTime, 0.0, 1.0);
-    double red = car->_enginerpmRedLine;
-    double above_half = car->_enginerpm - 0.5 * red;
-    if (above_half <= 0.0 || red <= 0.0) return ramp;
-    double ratio = lap.cfg.ratios[0];
-    double wheel_speed_at_red = std::fabs(car->_wheelRadius(2) * red / ratio);
-    double rolling = (kLaunchSpeed + std::fmax(0.0, car->_speed_x)) / wheel_speed_at_red;
-    return std::fmin(ramp, std::fmax(0.0, 1.0 - rolling * 2.0 * above_half / red));
+    drive::LaunchCar c = {car->_enginerpm, car->_enginerpmRedLine, lap.cfg.ratios[0],
+                          car->_wheelRadius(2), car->_speed_x};
+    return drive::launch_clutch(lap.gear, throttle, dt, lap.launch_time, c);
 }
 
 /// Longitudinal slip of an axle, (omega R - v) / max(|v|, v0).
@@ -394,6 +337,9 @@ void new_track(int, tTrack *track, void *, void **settings, tSituation *) {
         }
     }
     if (h) GfParmReleaseHandle(h);
+    const Settings &c = lap.cfg;
+    lap.gearbox = {c.ratios.data(), c.ratios.size(), c.upshift.data(), c.throttle_levels,
+                   c.downshift_margin, c.shift_time};
     if (lap.cfg.time_limit <= 0.0) lap.cfg.time_limit = 30.0 + track->length / 4.0;
 }
 
@@ -482,7 +428,7 @@ void drive(int, tCarElt *car, tSituation *s) {
     car->_steerCmd = delta / car->_steerLock;
     car->_accelCmd = throttle;
     car->_brakeCmd = brake;
-    car->_gearCmd = lap.gear + 1;
+    car->_gearCmd = int(lap.gear) + 1;
     car->_clutchCmd = launch_clutch(car, throttle, dt);
 
     if (lap.trace) {

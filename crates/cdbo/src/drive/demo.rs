@@ -4,7 +4,7 @@
 //! a = clamp(K_p·e + K_i·∫e dt, −1, 1), e = v_target − v, with the integral frozen while the
 //! output saturates (anti-windup).
 
-use super::{Observation, Pedal};
+use super::{Observation, Pedal, pi_control};
 
 /// The paper's demonstration speed (m/s).
 pub const DEFAULT_TARGET_SPEED: f64 = 15.0;
@@ -37,11 +37,6 @@ impl Pedal for SpeedHold {
     fn pedal(&mut self, obs: &Observation) -> f64 {
         let dt = obs.time - self.last_time.unwrap_or(obs.time);
         self.last_time = Some(obs.time);
-        let e = self.target - obs.speed;
-        let raw = KP * e + KI * (self.integral + e * dt);
-        if raw.abs() < 1.0 {
-            self.integral += e * dt;
-        }
-        (KP * e + KI * self.integral).clamp(-1.0, 1.0)
+        pi_control(KP, KI, 1.0, &mut self.integral, self.target - obs.speed, dt)
     }
 }

@@ -43,3 +43,28 @@ impl<F: Fn(f64) -> f64> Pedal for PolicyPedal<F> {
         (self.0)(obs.x).clamp(-1.0, 1.0)
     }
 }
+
+/// The pedal command a driver step applies for a pedal's value `a`: held in [−1, 1], NaN
+/// taken as 0 (coasting). The TORCS robot's `drive::pedal_command` is the same.
+#[inline]
+pub fn pedal_command(a: f64) -> f64 {
+    let a = a.clamp(-1.0, 1.0);
+    if a.is_nan() { 0.0 } else { a }
+}
+
+/// One step of a PI controller with anti-windup, the law of the demonstrator's speed hold
+/// ([`demo`]) and of the steering ([`steering`]): for the error e over `dt` seconds,
+/// u = clamp(K_p·e + K_i·I, −u_max, u_max), where the integral I += e·dt only while the
+/// unclamped output with the new integral, K_p·e + K_i·(I + e·dt), lies strictly inside
+/// ±u_max (it is frozen while the output saturates). Updates `integral` and returns u.
+///
+/// The TORCS robot's `drive::pi_control` (`torcs-robot/drive.hpp`) is the same arithmetic,
+/// checked against this by `tests/robot_drive.rs`.
+#[inline]
+pub fn pi_control(kp: f64, ki: f64, limit: f64, integral: &mut f64, e: f64, dt: f64) -> f64 {
+    let raw = kp * e + ki * (*integral + e * dt);
+    if raw.abs() < limit {
+        *integral += e * dt;
+    }
+    (kp * e + ki * *integral).clamp(-limit, limit)
+}

@@ -7,7 +7,12 @@
 //! pure pursuit for wheelbase L, so the loop's bandwidth is independent of speed) and
 //! K_i = [`KI`]. The integral term removes the steady offset that tyre slip leaves in long
 //! corners; it is frozen while the output saturates.
+//!
+//! The look-ahead, the [`bearing`] and the [`steering_law`] are pure functions so that the
+//! TORCS robot's `torcs-robot/drive.hpp`, which finds its target on the game's track, can be
+//! checked against them (`tests/robot_drive.rs`).
 
+use super::pi_control;
 use crate::sim::vehicle::State;
 use crate::track::{Projection, Track};
 
@@ -47,7 +52,9 @@ impl Steering {
         Steering::default()
     }
 
-    /// The road-wheel angle (rad) for the car in `state` at `proj`, after `dt` seconds.
+    /// The road-wheel angle (rad) for the car in `state` at `proj`, after `dt` seconds: the
+    /// [`steering_law`] on the [`bearing`] of the centre-line point [`Self::lookahead`]
+    /// metres ahead of the car's station.
     pub fn update(
         &mut self,
         track: &Track,
@@ -57,19 +64,41 @@ impl Steering {
         proj: &Projection,
         dt: f64,
     ) -> f64 {
-        let d = (self.lookahead_time * state.speed()).max(self.lookahead_min);
+        let d = self.lookahead(state.speed());
         let (tx, ty) = track.point_at(proj.s + d);
-        // The angle from the car's heading (cos ψ, sin ψ) to the target, in (−π, π].
-        let (dx, dy) = (tx - state.x, ty - state.y);
-        let (sy, cy) = state.yaw_sin_cos;
-        let e = (cy * dy - sy * dx).atan2(cy * dx + sy * dy);
-        let kp = 2.0 * wheelbase / d;
-        let raw = kp * e + self.ki * (self.integral + e * dt);
-        if raw.abs() < steer_lock {
-            self.integral += e * dt;
-        }
-        (kp * e + self.ki * self.integral).clamp(-steer_lock, steer_lock)
+        let e = bearing(tx - state.x, ty - state.y, state.yaw_sin_cos);
+        steering_law(e, d, wheelbase, self.ki, steer_lock, &mut self.integral, dt)
     }
+
+    /// The look-ahead distance d = max(d_min, t_la·v) (m) at speed v (m/s).
+    #[inline]
+    pub fn lookahead(&self, speed: f64) -> f64 {
+        (self.lookahead_time * speed).max(self.lookahead_min)
+    }
+}
+
+/// The angle (rad, in (−π, π]) from a heading (cos ψ, sin ψ), given as `yaw_sin_cos`
+/// = (sin ψ, cos ψ), to the vector (dx, dy): atan2(cos ψ·dy − sin ψ·dx, cos ψ·dx + sin ψ·dy).
+#[inline]
+pub fn bearing(dx: f64, dy: f64, yaw_sin_cos: (f64, f64)) -> f64 {
+    let (sy, cy) = yaw_sin_cos;
+    (cy * dy - sy * dx).atan2(cy * dx + sy * dy)
+}
+
+/// The PI law on the bearing e (rad) of a target d metres ahead: δ = [`pi_control`] with
+/// K_p = 2L/d (L the wheelbase), K_i = `ki` and the limit ±`steer_lock`; updates the
+/// `integral` of e over `dt` seconds.
+#[inline]
+pub fn steering_law(
+    e: f64,
+    d: f64,
+    wheelbase: f64,
+    ki: f64,
+    steer_lock: f64,
+    integral: &mut f64,
+    dt: f64,
+) -> f64 {
+    pi_control(2.0 * wheelbase / d, ki, steer_lock, integral, e, dt)
 }
 
 /// An angle wrapped into (−π, π].

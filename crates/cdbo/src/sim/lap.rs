@@ -19,7 +19,7 @@ use super::vehicle::{Controls, State, Vehicle};
 use crate::car::Car;
 use crate::drive::demo::SpeedHold;
 use crate::drive::steering::{Steering, wrap_angle};
-use crate::drive::{Observation, Pedal};
+use crate::drive::{Observation, Pedal, pedal_command};
 use crate::track::{Frame, Track};
 
 /// Why a lap failed.
@@ -251,14 +251,11 @@ impl Simulator {
                 until_driver = cfg.driver_every;
                 let t = step as f64 * cfg.dt;
                 let x = (distance / track.length).clamp(0.0, 1.0);
-                let a = pedal
-                    .pedal(&Observation {
-                        x,
-                        speed: state.speed(),
-                        time: t,
-                    })
-                    .clamp(-1.0, 1.0);
-                let a = if a.is_nan() { 0.0 } else { a };
+                let a = pedal_command(pedal.pedal(&Observation {
+                    x,
+                    speed: state.speed(),
+                    time: t,
+                }));
                 let steer = steering.update(
                     track,
                     car.wheelbase,

@@ -148,13 +148,18 @@ impl Gearbox {
     }
 
     /// Chooses the gear for a driven-wheel speed ω (rad/s) and the throttle in [0, 1]; starts
-    /// a shift when it changes.
+    /// a shift when it changes. Nothing while a shift is under way; else up when the engine
+    /// speed ω·gᵢ·g_f reaches the up-shift point of gear i at this throttle, down when the
+    /// lower gear's ω·gᵢ₋₁·g_f is below [`DOWNSHIFT_MARGIN`] times its up-shift point. The
+    /// TORCS robot's `drive::gear_update` (`torcs-robot/drive.hpp`) is the same arithmetic,
+    /// checked against this by `tests/robot_drive.rs`.
     pub fn update(&mut self, car: &Car, map: &ShiftMap, wheel_omega: f64, throttle: f64) {
         if self.shifting > 0.0 {
             return;
         }
+        // The gear's total ratio first, as the TORCS robot is handed it (drive.hpp).
         let fd = car.final_drive;
-        let engine = |gear: usize| wheel_omega * car.gears[gear] * fd;
+        let engine = |gear: usize| wheel_omega * (car.gears[gear] * fd);
         if self.gear + 1 < car.gears.len() && engine(self.gear) >= map.upshift(self.gear, throttle)
         {
             self.gear += 1;

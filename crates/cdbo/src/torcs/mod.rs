@@ -1,8 +1,8 @@
 //! TORCS, the racing game, as a source of laps.
 //!
 //! [`Install`] finds the game Debian installs (`apt-get install torcs libplib-dev`);
-//! [`setup`] compiles cdbo's robot driver (`torcs-robot/cdbo.cpp`, built into this library)
-//! against the TORCS robot headers and lays out a private game tree in a cache folder —
+//! [`setup`] compiles cdbo's robot driver (`torcs-robot/cdbo.cpp` and its TORCS-free
+//! `drive.hpp`, built into this library) against the TORCS robot headers and lays out a private game tree in a cache folder —
 //! symlinks to the installed game plus the robot, nothing written outside the cache, no root;
 //! [`Game::lap`] drives one lap in a fresh game process ([`lap`]).
 //!
@@ -10,10 +10,14 @@
 //! the demonstrator or a constant), the look-ahead PI steering of
 //! [`crate::drive::steering`], the automatic gearbox of [`crate::sim::powertrain`] (its shift
 //! points are handed over from the car's [`crate::sim::vehicle::Vehicle`]), the same ABS and
-//! traction control, and the same failure rules, judged from the game's car state.
+//! traction control, and the same failure rules, judged from the game's car state. Its
+//! decisions are the pure functions of [`ROBOT_HEADER`], which `tests/robot_drive.rs` checks
+//! against the Rust ones (and the robot's own launch clutch against [`launch`]) on states
+//! recorded from laps of the simulator.
 
 pub mod evaluator;
 pub mod lap;
+pub mod launch;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -23,8 +27,16 @@ pub use lap::{GamePedal, LapRequest};
 use crate::bounded;
 use crate::error::{Error, Result};
 
-/// The robot's source, compiled by [`setup`].
+/// The robot's source, compiled by [`setup`]; it includes [`ROBOT_HEADER`].
 pub const ROBOT_SOURCE: &str = include_str!("../../../../torcs-robot/cdbo.cpp");
+/// The robot's decisions as pure functions of numbers (`drive.hpp`, no TORCS header needed),
+/// written beside [`ROBOT_SOURCE`] by [`setup`].
+pub const ROBOT_HEADER: &str = include_str!("../../../../torcs-robot/drive.hpp");
+/// The file name [`ROBOT_SOURCE`] includes [`ROBOT_HEADER`] by.
+pub const ROBOT_HEADER_NAME: &str = "drive.hpp";
+/// The C++ compiler's flags for the robot's arithmetic: no fused multiply-adds, so that
+/// [`ROBOT_HEADER`] computes what cdbo's Rust does, operation for operation.
+pub const ROBOT_CXXFLAGS: &[&str] = &["-O2", "-ffp-contract=off"];
 /// The robot module's name (`drivers/cdbo/cdbo.so`).
 pub const ROBOT: &str = "cdbo";
 /// The car TORCS laps use unless told otherwise.
@@ -199,10 +211,10 @@ pub struct Game {
 /// The stamp file naming the robot source a tree was built from.
 const STAMP: &str = "robot.stamp";
 
-/// A fingerprint of the robot source (FNV-1a), written when the tree is built.
+/// A fingerprint of the robot source and its header (FNV-1a), written when the tree is built.
 fn robot_stamp() -> String {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for b in ROBOT_SOURCE.bytes() {
+    for b in ROBOT_SOURCE.bytes().chain(ROBOT_HEADER.bytes()) {
         h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
     }
     format!("{h:016x}\n")
@@ -327,9 +339,12 @@ fn build_tree(install: &Install, sdk: &Path, dir: &Path) -> Result<()> {
 
     let source = dir.join("cdbo.cpp");
     std::fs::write(&source, ROBOT_SOURCE).map_err(io(&source))?;
+    let header = dir.join(ROBOT_HEADER_NAME);
+    std::fs::write(&header, ROBOT_HEADER).map_err(io(&header))?;
     let include = sdk.join("include");
     let mut compiler = Command::new("c++")
-        .args(["-O2", "-shared", "-fPIC", "-o"])
+        .args(ROBOT_CXXFLAGS)
+        .args(["-shared", "-fPIC", "-o"])
         .arg(robot_lib.join(format!("{ROBOT}.so")))
         .arg(&source)
         .arg("-I")
@@ -373,6 +388,7 @@ fn build_tree(install: &Install, sdk: &Path, dir: &Path) -> Result<()> {
         )));
     }
     std::fs::remove_file(&source).map_err(io(&source))?;
+    std::fs::remove_file(&header).map_err(io(&header))?;
     let stamp = dir.join(STAMP);
     std::fs::write(&stamp, robot_stamp()).map_err(io(&stamp))?;
     Ok(())

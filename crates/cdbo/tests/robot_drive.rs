@@ -1,0 +1,381 @@
+//! The TORCS robot's decisions against cdbo's Rust, without TORCS.
+//!
+//! The robot's pure functions (`torcs-robot/drive.hpp`, embedded as
+//! [`cdbo::torcs::ROBOT_HEADER`]) are compiled with `g++ -std=c++17` and the robot's own
+//! flags into the harness `torcs-robot/tests/harness.cpp`, which answers one line per call.
+//! The calls replay states recorded from two laps of cdbo's simulator on the default track
+//! (the 15 m/s demonstration, and a policy learned by `cdbo race`): at every driver step the
+//! policy's action (RKHS and table), the speed hold, the steering's look-ahead, bearing and
+//! PI law, the gearbox and the launch clutch, each given the state the Rust controller had
+//! (integrals, gear, time left in a shift), and the answers must equal the Rust definitions
+//! bit for bit (within 1e-12 of the simulator's O(1) form of the RKHS policy). Skips with a
+//! message where `g++` is missing.
+//!
+//! A new function of the header (a second policy action, a path-tracking steering law) is
+//! checked by a line in the harness's table and a `Calls::check` here.
+
+mod common;
+
+use std::path::PathBuf;
+use std::process::Command;
+use std::sync::OnceLock;
+
+use cdbo::car::Car;
+use cdbo::drive::demo::{self, SpeedHold};
+use cdbo::drive::steering::{self, Steering};
+use cdbo::drive::{Observation, Pedal, pedal_command, pi_control};
+use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
+use cdbo::policy::{PolicyTable, RkhsPolicy};
+use cdbo::sim::powertrain::{DOWNSHIFT_MARGIN, Gearbox, THROTTLE_LEVELS};
+use cdbo::sim::{Simulator, TracePoint};
+use cdbo::torcs::launch::{LaunchCar, launch_clutch};
+use cdbo::torcs::{ROBOT_CXXFLAGS, ROBOT_HEADER, ROBOT_HEADER_NAME};
+use cdbo::track::builtin::DEFAULT;
+use common::builtin;
+
+/// The harness's source, compiled beside the header.
+const HARNESS: &str = include_str!("../../../torcs-robot/tests/harness.cpp");
+/// A learned policy: the best of `cdbo race --json` (CDBO on the default track, seed 0, 300
+/// laps, 24.34 m/s), its length-scale 1/29 and its 30 weights.
+const LEARNED: (f64, [f64; 30]) = (
+    0.034482758620689655,
+    [
+        1.0641935240508373,
+        -0.552209437603064,
+        0.39737706462869254,
+        -0.22612357403233868,
+        0.2318491940587588,
+        -0.08783018565320701,
+        0.1799846092031936,
+        0.08823076096878231,
+        0.06008581492620754,
+        -0.03510880485140942,
+        0.014032493668274491,
+        0.03842972593254364,
+        -0.01555217527011259,
+        0.006939230444046079,
+        0.023595772316496934,
+        -0.022239163710396363,
+        0.032779890285182495,
+        0.40065277003391686,
+        -0.03368045512971343,
+        0.018328611710277512,
+        0.09199815070649396,
+        0.13270067441629768,
+        0.16445167220422624,
+        -0.02913228630920575,
+        -0.03473832665035548,
+        0.08198499555188739,
+        0.07361647656740286,
+        0.04497488429748811,
+        0.14391674585206982,
+        0.03969755361446362,
+    ],
+);
+
+/// The compiled harness (built once for the tests here), or `None` (with a message) where
+/// there is no `g++`.
+fn harness() -> Option<PathBuf> {
+    static HARNESS_EXE: OnceLock<Option<PathBuf>> = OnceLock::new();
+    let exe = HARNESS_EXE.get_or_init(|| {
+        if Command::new("g++").arg("--version").output().is_err() {
+            return None;
+        }
+        let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("robot_drive");
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join(ROBOT_HEADER_NAME), ROBOT_HEADER).unwrap();
+        std::fs::write(dir.join("harness.cpp"), HARNESS).unwrap();
+        let exe = dir.join("harness");
+        let out = Command::new("g++")
+            .arg("-std=c++17")
+            .args(ROBOT_CXXFLAGS)
+            .arg("-o")
+            .arg(&exe)
+            .arg(dir.join("harness.cpp"))
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "the harness did not compile:\n{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        Some(exe)
+    });
+    if exe.is_none() {
+        eprintln!("skipping: g++ is not installed (apt-get install g++)");
+    }
+    exe.clone()
+}
+
+/// How closely the C++ must agree.
+#[derive(Debug, Clone, Copy)]
+enum Agree {
+    /// The same bits.
+    Exactly,
+    /// Within this absolute difference.
+    Within(f64),
+}
+
+/// Calls to the harness and the answers the Rust definitions give.
+#[derive(Default)]
+struct Calls {
+    input: String,
+    expected: Vec<(String, Vec<f64>, Agree)>,
+}
+
+impl Calls {
+    /// Calls `name` with `args`; the answer must be `expected`.
+    fn check(&mut self, what: &str, name: &str, args: &[f64], expected: &[f64], agree: Agree) {
+        self.input.push_str(name);
+        for a in args {
+            self.input.push_str(&format!(" {a:?}"));
+        }
+        self.input.push('\n');
+        self.expected
+            .push((format!("{what}: {name} {args:?}"), expected.to_vec(), agree));
+    }
+
+    /// Runs the harness on every call and compares; returns the number of calls.
+    fn run(&self, exe: &PathBuf) -> usize {
+        let input = exe.with_extension("in");
+        std::fs::write(&input, &self.input).unwrap();
+        let out = Command::new(exe)
+            .stdin(std::fs::File::open(&input).unwrap())
+            .output()
+            .unwrap();
+        let text = String::from_utf8(out.stdout).unwrap();
+        assert!(out.status.success(), "the harness failed: {text}");
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), self.expected.len());
+        for (line, (what, expected, agree)) in lines.iter().zip(&self.expected) {
+            let got: Vec<f64> = line.split(' ').map(|v| v.parse().unwrap()).collect();
+            assert_eq!(got.len(), expected.len(), "{what}: {line}");
+            for (g, e) in got.iter().zip(expected) {
+                let ok = match agree {
+                    Agree::Exactly => g.to_bits() == e.to_bits(),
+                    Agree::Within(tol) => (g - e).abs() <= *tol,
+                };
+                assert!(ok, "{what}: C++ {got:?}, Rust {expected:?}");
+            }
+        }
+        self.expected.len()
+    }
+}
+
+/// A lap of the simulator with its trace.
+fn lap(sim: &Simulator, pedal: &mut dyn Pedal) -> Vec<TracePoint> {
+    let r = sim.lap(pedal);
+    assert!(r.completed, "{:?}", r.failure);
+    r.trace
+}
+
+#[test]
+fn the_robots_decisions_are_the_rust_ones_on_recorded_laps() {
+    let Some(exe) = harness() else { return };
+    let car = Car::spirit_300();
+    let mut sim = Simulator::new(builtin(DEFAULT), &car);
+    sim.config.trace = true;
+    let track = &sim.track;
+    let demo = lap(&sim, &mut SpeedHold::new(15.0));
+    // The learned policy, and the demonstration's fit (the policy learning starts from).
+    let pairs: Vec<(f64, f64)> = demo.iter().map(|p| (p.x, p.pedal)).collect();
+    let fit = RkhsPolicy::fit(&pairs, 30, default_lengthscale(30), DEFAULT_RIDGE).unwrap();
+    let policy = RkhsPolicy::new(LEARNED.1.to_vec(), LEARNED.0).unwrap();
+    let fast = lap(&sim, &mut policy.pedal());
+    let table = PolicyTable::new(policy.table(201)).unwrap();
+    let (learned_pedal, fit_pedal) = (policy.pedal(), fit.pedal());
+
+    let mut calls = Calls::default();
+    // The pedal's value as a step applies it, at the edges.
+    for v in [f64::NAN, -3.0, -1.0, -0.25, -0.0, 0.0, 0.7, 1.0, 2.5] {
+        let a = pedal_command(v);
+        calls.check("pedal", "pedal_command", &[v], &[a], Agree::Exactly);
+    }
+    // The tables at their own points, where the segment changes (there a value far below
+    // its neighbour's tells the two sides apart), and beyond their ends.
+    let steep = PolicyTable::new(vec![(0.0, 1.0), (0.5, 1e-17), (0.75, -0.5)]).unwrap();
+    for t in [&table, &steep] {
+        let mut args = vec![t.points().len() as f64];
+        args.extend(t.points().iter().flat_map(|&(x, a)| [x, a]));
+        for x in t.points().iter().map(|&(x, _)| x).chain([-0.5, 1.5]) {
+            let args = [&args[..], &[x]].concat();
+            calls.check("table", "table", &args, &[t.action(x)], Agree::Exactly);
+        }
+    }
+    let mut table_args = vec![table.points().len() as f64];
+    table_args.extend(table.points().iter().flat_map(|&(x, a)| [x, a]));
+
+    // The gearbox as the robot is handed it (torcs/lap.rs): total ratios and the shift map.
+    let map = sim.vehicle.shift_map();
+    let ratios: Vec<f64> = car.gears.iter().map(|g| g * car.final_drive).collect();
+    let gears = [ratios.len() as f64]
+        .into_iter()
+        .chain(ratios.iter().copied())
+        .chain([THROTTLE_LEVELS as f64])
+        .chain(map.upshift.iter().flatten().copied())
+        .chain([DOWNSHIFT_MARGIN, car.shift_time])
+        .collect::<Vec<f64>>();
+    let steer = Steering::new();
+    let dt = sim.config.dt * sim.config.driver_every as f64;
+    let (mut upshifts, mut downshifts, mut top_gear, mut slipping) = (0, 0, 0, 0);
+    for (lap, trace) in [("demonstration", &demo), ("learned policy", &fast)] {
+        let (mut hold, mut hold_integral) = (SpeedHold::new(15.0), 0.0);
+        let (mut steer_integral, mut hint) = (0.0, 0);
+        let (mut gearbox, mut launch_time) = (Gearbox::new(), 0.0);
+        let mut last_t = trace[0].t;
+        for p in trace.iter() {
+            let at = format!("{lap} at t = {} s", p.t);
+            // The policies at the recorded lap fraction: the direct sum bit for bit, the
+            // simulator's O(1) form within 1e-12.
+            for (rkhs, pedal) in [(&policy, &learned_pedal), (&fit, &fit_pedal)] {
+                let mut args = vec![rkhs.lengthscale, rkhs.kernels() as f64];
+                args.extend(&rkhs.weights);
+                args.push(p.x);
+                let raw = rkhs.raw(p.x);
+                calls.check(&at, "rkhs", &args, &[raw], Agree::Exactly);
+                calls.check(&at, "rkhs", &args, &[pedal.raw(p.x)], Agree::Within(1e-12));
+            }
+            let args = [&table_args[..], &[p.x]].concat();
+            calls.check(&at, "table", &args, &[table.action(p.x)], Agree::Exactly);
+
+            // The demonstrator's speed hold on the recorded speeds, its integral carried.
+            let step = p.t - last_t;
+            last_t = p.t;
+            let before = hold_integral;
+            let e = 15.0 - p.speed;
+            let a = pi_control(demo::KP, demo::KI, 1.0, &mut hold_integral, e, step);
+            let live = hold.pedal(&Observation {
+                x: p.x,
+                speed: p.speed,
+                time: p.t,
+            });
+            assert_eq!(a.to_bits(), live.to_bits(), "{at}: the speed hold");
+            let recorded = if std::ptr::eq(trace, &demo) {
+                a
+            } else {
+                pedal_command(learned_pedal.raw(p.x))
+            };
+            assert_eq!(
+                recorded.to_bits(),
+                p.pedal.to_bits(),
+                "{at}: the recorded pedal"
+            );
+            let args = [before, 15.0, p.speed, step];
+            calls.check(
+                &at,
+                "speed_hold",
+                &args,
+                &[a, hold_integral],
+                Agree::Exactly,
+            );
+
+            // The steering, from the recorded position, speed and heading: the car's yaw is
+            // the recorded heading error off the road's heading where it projects.
+            let proj = track.project(p.pos_x, p.pos_y, hint);
+            hint = proj.index;
+            let yaw = p.heading_error + track.sample(proj.index).heading;
+            let (sin, cos) = yaw.sin_cos();
+            let d = steer.lookahead(p.speed);
+            let args = [steer.lookahead_time, steer.lookahead_min, p.speed];
+            calls.check(&at, "lookahead", &args, &[d], Agree::Exactly);
+            let (tx, ty) = track.point_at(proj.s + d);
+            let (dx, dy) = (tx - p.pos_x, ty - p.pos_y);
+            let e = steering::bearing(dx, dy, (sin, cos));
+            calls.check(&at, "bearing", &[dx, dy, sin, cos], &[e], Agree::Exactly);
+            let before = steer_integral;
+            let (wheelbase, lock) = (car.wheelbase, car.steer_lock);
+            let delta =
+                steering::steering_law(e, d, wheelbase, steer.ki, lock, &mut steer_integral, dt);
+            // The replay is the simulator's steering (up to the rounding of the rebuilt yaw).
+            assert!(
+                (delta - p.steer).abs() < 1e-12,
+                "{at}: {delta} vs {}",
+                p.steer
+            );
+            let args = [before, e, d, wheelbase, steer.ki, lock, dt];
+            calls.check(
+                &at,
+                "steering_law",
+                &args,
+                &[delta, steer_integral],
+                Agree::Exactly,
+            );
+
+            // The gearbox on the rolling wheels' spin at the recorded speed and throttle, the
+            // shift's time counted down by the driver step as the robot does.
+            let throttle = p.pedal.max(0.0);
+            let w = p.speed / car.rear_tyre.radius;
+            gearbox.shifting = (gearbox.shifting - step).max(0.0);
+            let (gear, shifting) = (gearbox.gear, gearbox.shifting);
+            let point = map.upshift(gear, throttle);
+            gearbox.update(&car, map, w, throttle);
+            upshifts += usize::from(gearbox.gear > gear);
+            downshifts += usize::from(gearbox.gear < gear);
+            top_gear = top_gear.max(gearbox.gear);
+            let mut args = vec![gear as f64, shifting];
+            args.extend(&gears);
+            args.extend([w, throttle]);
+            let out = [gearbox.gear as f64, gearbox.shifting, point];
+            calls.check(&at, "gear_update", &args, &out, Agree::Exactly);
+
+            // The launch clutch in the gear chosen, with the recorded engine speed.
+            let engine = LaunchCar {
+                engine_speed: p.rpm * std::f64::consts::PI / 30.0,
+                red_line: car.rev_limiter,
+                first_ratio: ratios[0],
+                wheel_radius: car.rear_tyre.radius,
+                speed_x: p.speed,
+            };
+            let before = launch_time;
+            let c = launch_clutch(gearbox.gear, throttle, step, &mut launch_time, &engine);
+            slipping += usize::from(c > 0.0 && c < 1.0);
+            let mut args = vec![before, gearbox.gear as f64, throttle, step];
+            args.extend([engine.engine_speed, engine.red_line, engine.first_ratio]);
+            args.extend([engine.wheel_radius, engine.speed_x]);
+            calls.check(
+                &at,
+                "launch_clutch",
+                &args,
+                &[c, launch_time],
+                Agree::Exactly,
+            );
+        }
+    }
+    // The states span the decisions: every gear both ways, a slipping clutch, a fast lap.
+    assert_eq!(top_gear + 1, car.gears.len());
+    assert!(
+        upshifts >= 2 * top_gear && downshifts >= top_gear,
+        "{upshifts} up, {downshifts} down"
+    );
+    assert!(slipping >= 10, "{slipping} steps with the clutch slipping");
+    let fastest = fast.iter().map(|p| p.speed).fold(0.0, f64::max);
+    assert!(fastest > 25.0, "{fastest} m/s");
+
+    let n = calls.run(&exe);
+    assert!(n > 10 * (demo.len() + fast.len()), "{n} calls");
+}
+
+/// The harness refuses what it does not know: a misspelt call or a short line fails the
+/// run instead of answering something.
+#[test]
+fn the_harness_refuses_unknown_and_short_calls() {
+    let Some(exe) = harness() else { return };
+    for (i, input) in [
+        "no_such_function 1 2\n",
+        "bearing 1 2 3\n",
+        "lookahead 1 2 3 4\n",
+    ]
+    .iter()
+    .enumerate()
+    {
+        let path = exe.with_extension(format!("bad{i}"));
+        std::fs::write(&path, input).unwrap();
+        let out = Command::new(&exe)
+            .stdin(std::fs::File::open(&path).unwrap())
+            .output()
+            .unwrap();
+        assert!(!out.status.success(), "{input:?} was answered");
+        assert!(String::from_utf8_lossy(&out.stdout).starts_with("error"));
+    }
+}

@@ -1,0 +1,191 @@
+/*
+ * cdbo: the robot's driving decisions, as pure functions of numbers.
+ *
+ * Copyright (C) 2026 the cdbo authors.
+ *
+ * This program is free software; you can redistribute it and/or modify it under the terms of
+ * the GNU General Public License as published by the Free Software Foundation; either version
+ * 2 of the License, or (at your option) any later version. See COPYING.
+ *
+ * Everything the robot (cdbo.cpp) decides from numbers it has gathered: the pedal (the policy
+ * pi(x), the demonstrator's speed hold), the steering law, the gearbox and the launch clutch.
+ * No TORCS header is needed: cdbo.cpp reads the game's car and track and calls these, and
+ * crates/cdbo/tests/robot_drive.rs compiles this header alone into a harness
+ * (tests/harness.cpp) and checks each function against its Rust definition, named on each,
+ * on states recorded from laps of cdbo's simulator. Each is written with the Rust's
+ * arithmetic, operation for operation, so the two agree bit for bit; compile with
+ * -ffp-contract=off (no fused multiply-adds, which Rust never makes).
+ *
+ * State a controller keeps between driver steps (an integral, the gear) is passed by
+ * reference and updated, as the Rust functions take `&mut`.
+ *
+ * To add a function (a second policy action, another steering law): write it here, add a
+ * line to the table in tests/harness.cpp that reads its inputs and prints its outputs, and a
+ * case in crates/cdbo/tests/robot_drive.rs that sends it recorded states and compares the
+ * answers with the Rust definition.
+ */
+
+#ifndef CDBO_DRIVE_HPP
+#define CDBO_DRIVE_HPP
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+
+namespace drive {
+
+/// v held in [lo, hi] (Rust's f64::clamp, for lo <= hi; NaN stays NaN).
+inline double clamp(double v, double lo, double hi) { return v < lo ? lo : (v > hi ? hi : v); }
+
+/// One step of a PI controller with anti-windup (drive/mod.rs pi_control): for the error e
+/// over dt seconds, u = clamp(kp e + ki I, -limit, limit), the integral I += e dt only while
+/// kp e + ki (I + e dt) lies strictly inside +-limit.
+inline double pi_control(double kp, double ki, double limit, double &integral, double e, double dt) {
+    double raw = kp * e + ki * (integral + e * dt);
+    if (std::fabs(raw) < limit) integral += e * dt;
+    return clamp(kp * e + ki * integral, -limit, limit);
+}
+
+// ---- The pedal ------------------------------------------------------------------------------
+
+/// sqrt(3), as policy/rkhs.rs SQRT_3.
+constexpr double kSqrt3 = 1.7320508075688772;
+
+/// w^T phi(x) before clamping (policy/rkhs.rs RkhsPolicy::raw): the sum over the m >= 2
+/// weights of w_i (1 + a) e^-a, a = sqrt(3) |x - i h| / l, h = 1 / (m - 1).
+inline double rkhs_raw(const double *weights, std::size_t m, double lengthscale, double x) {
+    double h = 1.0 / double(m - 1);
+    double sum = -0.0;  // the neutral element Rust's f64 sum starts from
+    for (std::size_t i = 0; i < m; i++) {
+        double a = kSqrt3 * (std::fabs(x - double(i) * h) / lengthscale);
+        sum += weights[i] * ((1.0 + a) * std::exp(-a));
+    }
+    return sum;
+}
+
+/// pi(x) of an (x, a) table of n >= 1 points, xa = x1 a1 x2 a2 ... with x increasing: linear
+/// in between, held beyond the ends (policy/table.rs PolicyTable::action, interp.rs linear).
+inline double table_action(const double *xa, std::size_t n, double x) {
+    std::size_t i = 0;  // the number of points at or left of x
+    while (i < n && xa[2 * i] <= x) i++;
+    if (i == 0) return xa[1];
+    if (i >= n) return xa[2 * n - 1];
+    double x0 = xa[2 * i - 2], a0 = xa[2 * i - 1], x1 = xa[2 * i], a1 = xa[2 * i + 1];
+    return a0 + (a1 - a0) * (x - x0) / (x1 - x0);
+}
+
+/// The demonstrator's gains (drive/demo.rs KP, KI).
+constexpr double kSpeedHoldKp = 0.5;
+constexpr double kSpeedHoldKi = 0.1;
+
+/// The demonstrator holding `target` m/s at `speed` (drive/demo.rs SpeedHold::pedal): the
+/// PI control of the speed error with limit 1.
+inline double speed_hold(double target, double speed, double dt, double &integral) {
+    return pi_control(kSpeedHoldKp, kSpeedHoldKi, 1.0, integral, target - speed, dt);
+}
+
+/// The pedal command a driver step uses (sim/lap.rs Simulator::lap): the pedal's value held
+/// in [-1, 1], NaN taken as 0.
+inline double pedal_command(double v) { return std::isnan(v) ? 0.0 : clamp(v, -1.0, 1.0); }
+
+// ---- The steering ---------------------------------------------------------------------------
+
+/// The look-ahead distance max(d_min, t_la v) (m) (drive/steering.rs Steering::lookahead).
+inline double lookahead(double lookahead_time, double lookahead_min, double speed) {
+    return std::fmax(lookahead_time * speed, lookahead_min);
+}
+
+/// The angle from the heading (cos yaw, sin yaw) to (dx, dy), in (-pi, pi]
+/// (drive/steering.rs bearing).
+inline double bearing(double dx, double dy, double sin_yaw, double cos_yaw) {
+    return std::atan2(cos_yaw * dy - sin_yaw * dx, cos_yaw * dx + sin_yaw * dy);
+}
+
+/// The road-wheel angle (rad) for the bearing e of a target d metres ahead
+/// (drive/steering.rs steering_law): PI control with kp = 2 L / d, ki, limit +-steer_lock.
+inline double steering_law(double e, double d, double wheelbase, double ki, double steer_lock,
+                           double &integral, double dt) {
+    return pi_control(2.0 * wheelbase / d, ki, steer_lock, integral, e, dt);
+}
+
+// ---- The gearbox ----------------------------------------------------------------------------
+
+/// A car's automatic gearbox: its gears and shift points (sim/powertrain.rs ShiftMap).
+struct Gearbox {
+    const double *ratios;     ///< total ratio engine -> wheel of each forward gear
+    std::size_t gears;        ///< the number of forward gears
+    const double *upshift;    ///< per gear a row of `levels` up-shift engine speeds (rad/s)
+    std::size_t levels;       ///< throttle levels of a row, a = k / (levels - 1)
+    double downshift_margin;  ///< hysteresis of the down-shift
+    double shift_time;        ///< (s) the drive is cut this long at a shift
+};
+
+/// The engine speed (rad/s) at which to leave `gear` at a throttle in [0, 1], linear between
+/// the levels; at 0 or less, or 1 and more, full throttle's (ShiftMap::upshift; a row of one
+/// level, which cdbo never hands over, is that point at every throttle).
+inline double upshift_at(const Gearbox &box, std::size_t gear, double throttle) {
+    std::size_t n = box.levels;
+    const double *row = box.upshift + gear * n;
+    if (throttle <= 0.0 || throttle >= 1.0 || n < 2) return row[n - 1];
+    double f = throttle * double(n - 1);
+    std::size_t k = std::min(std::size_t(f), n - 2);
+    double t = f - double(k);
+    return row[k] + (row[k + 1] - row[k]) * t;
+}
+
+/// The gear (0-based) for the driven wheels' spin w (rad/s) and the throttle
+/// (sim/powertrain.rs Gearbox::update): nothing while `shifting` (s) is left of a shift;
+/// else up when w times the gear's ratio reaches its up-shift point, down when w times the
+/// lower gear's ratio is below the margin times the lower gear's point; a shift starts
+/// `shift_time` of shifting.
+inline void gear_update(const Gearbox &box, std::size_t &gear, double &shifting, double w,
+                        double throttle) {
+    if (shifting > 0.0) return;
+    if (gear + 1 < box.gears && w * box.ratios[gear] >= upshift_at(box, gear, throttle)) {
+        gear++;
+        shifting = box.shift_time;
+    } else if (gear > 0 &&
+               w * box.ratios[gear - 1] < box.downshift_margin * upshift_at(box, gear - 1, throttle)) {
+        gear--;
+        shifting = box.shift_time;
+    }
+}
+
+// ---- The launch clutch ----------------------------------------------------------------------
+
+/// (s) the clutch's closing over throttle time while pulling away (torcs/launch.rs).
+constexpr double kLaunchTime = 2.0;
+/// (m/s) added to the road speed when closing it early (torcs/launch.rs).
+constexpr double kLaunchSpeed = 5.0;
+
+/// What the launch clutch reads of the car (torcs/launch.rs LaunchCar).
+struct LaunchCar {
+    double engine_speed;  ///< (rad/s)
+    double red_line;      ///< (rad/s) the engine's red line
+    double first_ratio;   ///< total ratio engine -> wheel of first gear
+    double wheel_radius;  ///< (m) of a driven wheel
+    double speed_x;       ///< (m/s) forward speed
+};
+
+/// The clutch command in [0, 1] (1 = open) while pulling away in first gear
+/// (torcs/launch.rs launch_clutch): 0 after first gear; in it, `launch_time` counts the time
+/// with throttle, and the clutch closes over kLaunchTime of it,
+/// ramp = clamp(1 - time / kLaunchTime, 0, 1), sooner once the engine passes half its red
+/// line: min(ramp, max(0, 1 - rolling 2 (w - red / 2) / red)), rolling the road speed plus
+/// kLaunchSpeed over the first gear's road speed at the red line.
+inline double launch_clutch(std::size_t gear, double throttle, double dt, double &launch_time,
+                            const LaunchCar &car) {
+    if (gear != 0) return 0.0;
+    if (throttle > 0.0) launch_time += dt;
+    double ramp = clamp(1.0 - launch_time / kLaunchTime, 0.0, 1.0);
+    double red = car.red_line;
+    double above_half = car.engine_speed - 0.5 * red;
+    if (above_half <= 0.0 || red <= 0.0) return ramp;
+    double wheel_speed_at_red = std::fabs(car.wheel_radius * red / car.first_ratio);
+    double rolling = (kLaunchSpeed + std::fmax(0.0, car.speed_x)) / wheel_speed_at_red;
+    return std::fmin(ramp, std::fmax(0.0, 1.0 - rolling * 2.0 * above_half / red));
+}
+
+}  // namespace drive
+
+#endif

@@ -1,0 +1,147 @@
+/*
+ * The test harness of drive.hpp: crates/cdbo/tests/robot_drive.rs compiles it beside the
+ * header (no TORCS needed) and checks the answers against cdbo's Rust.
+ *
+ * Copyright (C) 2026 the cdbo authors. GPL-2-or-later, as the robot (see ../COPYING).
+ *
+ * Reads lines "NAME V1 V2 ..." from standard input and answers each with one line of the
+ * function's outputs, %.17g (which reads back exactly); a list of numbers is given as its
+ * length, then its numbers; state the function updates (an integral, the gear) is given
+ * before the inputs and printed after the outputs. An unknown name or a short line is
+ * answered "error ..." and ends the harness with status 1.
+ */
+
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <functional>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "drive.hpp"
+
+namespace {
+
+/// The numbers of one input line, read in order.
+struct Args {
+    std::vector<double> v;
+    std::size_t next = 0;
+    bool short_line = false;
+
+    double num() {
+        if (next < v.size()) return v[next++];
+        short_line = true;
+        return 0.0;
+    }
+    std::size_t count() { return std::size_t(num()); }
+    /// A list of n numbers (at least one element's room, so that a short line stays safe).
+    std::vector<double> list(std::size_t n) {
+        std::vector<double> out(n ? n : 1);
+        for (std::size_t i = 0; i < n; i++) out[i] = num();
+        return out;
+    }
+};
+
+using Case = std::function<std::vector<double>(Args &)>;
+
+/// Each function of drive.hpp: its inputs as read, its outputs (then updated state) as printed.
+const std::map<std::string, Case> kCases = {
+    {"rkhs",  // L M W1..WM X -> w^T phi(x)
+     [](Args &a) {
+         double l = a.num();
+         std::size_t m = a.count();
+         std::vector<double> w = a.list(m);
+         return std::vector<double>{drive::rkhs_raw(w.data(), m, l, a.num())};
+     }},
+    {"table",  // N X1 A1 .. XN AN X -> pi(x)
+     [](Args &a) {
+         std::size_t n = a.count();
+         std::vector<double> xa = a.list(2 * n);
+         return std::vector<double>{drive::table_action(xa.data(), n, a.num())};
+     }},
+    {"pedal_command",  // V -> a
+     [](Args &a) { return std::vector<double>{drive::pedal_command(a.num())}; }},
+    {"speed_hold",  // INTEGRAL TARGET SPEED DT -> a INTEGRAL'
+     [](Args &a) {
+         double integral = a.num(), target = a.num(), speed = a.num(), dt = a.num();
+         double out = drive::speed_hold(target, speed, dt, integral);
+         return std::vector<double>{out, integral};
+     }},
+    {"lookahead",  // T_LA D_MIN SPEED -> d
+     [](Args &a) {
+         double t = a.num(), d_min = a.num();
+         return std::vector<double>{drive::lookahead(t, d_min, a.num())};
+     }},
+    {"bearing",  // DX DY SIN COS -> e
+     [](Args &a) {
+         double dx = a.num(), dy = a.num(), s = a.num();
+         return std::vector<double>{drive::bearing(dx, dy, s, a.num())};
+     }},
+    {"steering_law",  // INTEGRAL E D L KI LOCK DT -> delta INTEGRAL'
+     [](Args &a) {
+         double integral = a.num(), e = a.num(), d = a.num(), l = a.num(), ki = a.num(),
+                lock = a.num(), dt = a.num();
+         double out = drive::steering_law(e, d, l, ki, lock, integral, dt);
+         return std::vector<double>{out, integral};
+     }},
+    {"gear_update",  // GEAR SHIFTING N R1..RN K U11..UNK MARGIN SHIFT_TIME W THROTTLE
+                     //   -> GEAR' SHIFTING' upshift_at(gear, throttle)
+     [](Args &a) {
+         std::size_t gear = a.count();
+         double shifting = a.num();
+         std::size_t n = a.count();
+         std::vector<double> ratios = a.list(n);
+         std::size_t k = a.count();
+         std::vector<double> up = a.list(n * k);
+         double margin = a.num(), shift_time = a.num(), w = a.num(), throttle = a.num();
+         drive::Gearbox box = {ratios.data(), n, up.data(), k, margin, shift_time};
+         if (a.short_line || gear >= n) return std::vector<double>{};
+         double point = drive::upshift_at(box, gear, throttle);
+         drive::gear_update(box, gear, shifting, w, throttle);
+         return std::vector<double>{double(gear), shifting, point};
+     }},
+    {"launch_clutch",  // LAUNCH_TIME GEAR THROTTLE DT W RED RATIO1 RADIUS VX -> c LAUNCH_TIME'
+     [](Args &a) {
+         double launch_time = a.num();
+         std::size_t gear = a.count();
+         double throttle = a.num(), dt = a.num();
+         drive::LaunchCar car;
+         car.engine_speed = a.num();
+         car.red_line = a.num();
+         car.first_ratio = a.num();
+         car.wheel_radius = a.num();
+         car.speed_x = a.num();
+         double c = drive::launch_clutch(gear, throttle, dt, launch_time, car);
+         return std::vector<double>{c, launch_time};
+     }},
+};
+
+}  // namespace
+
+int main() {
+    std::string line;
+    for (int ch; (ch = std::getchar()) != EOF;) {
+        if (ch != '\n') {
+            line.push_back(char(ch));
+            continue;
+        }
+        std::istringstream in(line);
+        line.clear();
+        std::string name, word;
+        in >> name;
+        Args args;
+        while (in >> word) args.v.push_back(std::strtod(word.c_str(), nullptr));
+        auto found = kCases.find(name);
+        std::vector<double> out;
+        if (found != kCases.end()) out = found->second(args);
+        if (found == kCases.end() || args.short_line || args.next != args.v.size() || out.empty()) {
+            std::printf("error: '%s' with %zu numbers\n", name.c_str(), args.v.size());
+            return 1;
+        }
+        for (std::size_t i = 0; i < out.size(); i++) std::printf(i ? " %.17g" : "%.17g", out[i]);
+        std::printf("\n");
+    }
+    return 0;
+}
