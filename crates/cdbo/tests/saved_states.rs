@@ -42,7 +42,11 @@ fn states_saved_before_the_shell_resume_and_ask_as_the_uninterrupted_run() {
         assert_eq!(resumed.best(), uninterrupted.best(), "{method}");
         let next: Vec<f64> = serde_json::from_str(next).unwrap();
         assert_eq!(resumed.ask().unwrap(), next, "{method}: as saved");
-        assert_eq!(uninterrupted.ask().unwrap(), next, "{method}: uninterrupted");
+        assert_eq!(
+            uninterrupted.ask().unwrap(),
+            next,
+            "{method}: uninterrupted"
+        );
         for _ in 0..6 {
             let (a, b) = (resumed.ask().unwrap(), uninterrupted.ask().unwrap());
             assert_eq!(a, b, "{method}: the resumed run diverged");

@@ -19,15 +19,13 @@ pub trait Proposer {
     type Note: Clone + std::fmt::Debug;
     /// The method's own saved state.
     type State: Clone + Serialize;
-    /// The kind of the saved state ([`Saved::kind`]).
-    const KIND: &'static str;
-    /// Whether the saved state keeps the shell's record (`evaluations` and `best`, flattened
-    /// beside the method's fields: [`Recorded`]); otherwise the method's state holds the told
-    /// laps, and its resume rebuilds the record from them.
-    const SAVES_RECORD: bool;
+    /// The kind of the saved state and where the shell's record goes.
+    const SAVED_AS: SavedAs;
 
-    /// The method's name on the command line.
-    fn name(&self) -> &'static str;
+    /// The method's name on the command line: the kind of its saved state unless it says.
+    fn name(&self) -> &'static str {
+        Self::SAVED_AS.kind()
+    }
 
     /// Number of weights.
     fn dim(&self) -> usize;
@@ -53,6 +51,26 @@ pub trait Proposer {
 
     /// The method's state, to save.
     fn state(&self) -> Cow<'_, Self::State>;
+}
+
+/// How a method's state is saved: under which kind ([`Saved::kind`]), and where the shell's
+/// record of the told laps goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SavedAs {
+    /// The method's state holds its told laps, and its resume rebuilds the record from them.
+    Laps(&'static str),
+    /// The record (`evaluations` and `best`) is flattened beside the method's fields
+    /// ([`Recorded`]).
+    WithRecord(&'static str),
+}
+
+impl SavedAs {
+    /// The kind of the saved state.
+    pub fn kind(self) -> &'static str {
+        match self {
+            SavedAs::Laps(kind) | SavedAs::WithRecord(kind) => kind,
+        }
+    }
 }
 
 /// Weights proposed for the next lap, with the proposer's note on them.
@@ -137,7 +155,7 @@ impl Told {
 }
 
 /// A method's saved state with the shell's record flattened beside its fields (`evaluations`,
-/// `best`): the saved form of the methods whose state kept them ([`Proposer::SAVES_RECORD`]).
+/// `best`): the saved form of the methods whose state kept them ([`SavedAs::WithRecord`]).
 /// It reads as the method's state.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Recorded<S, T = Told> {
@@ -277,16 +295,15 @@ impl<P: Proposer> Optimizer for AskTell<P> {
 
     fn save(&self) -> Saved {
         let state = self.proposer.state();
-        if P::SAVES_RECORD {
-            Saved::new(
-                P::KIND,
+        match P::SAVED_AS {
+            SavedAs::Laps(kind) => Saved::new(kind, &state),
+            SavedAs::WithRecord(kind) => Saved::new(
+                kind,
                 &Recorded {
                     state,
                     told: Cow::Borrowed(&self.told),
                 },
-            )
-        } else {
-            Saved::new(P::KIND, &state)
+            ),
         }
     }
 }

@@ -30,7 +30,7 @@ use std::borrow::Cow;
 use rand_distr::{Distribution, Normal};
 use serde::{Deserialize, Serialize};
 
-use super::ask_tell::{AskTell, Lap, Proposal, Proposer, Told};
+use super::ask_tell::{AskTell, Lap, Proposal, Proposer, SavedAs, Told};
 use super::cmaes_ascent::CmaesSearch;
 use super::coordinate_ascent::{Ascent, AxisSearch, GpAcquisition};
 use super::{SearchBox, rng_for};
@@ -459,18 +459,13 @@ impl BoProposer {
 impl Proposer for BoProposer {
     type Note = f64;
     type State = BoState;
-    const KIND: &'static str = SAVED_KIND;
-    const SAVES_RECORD: bool = false;
+    const SAVED_AS: SavedAs = SavedAs::Laps(SAVED_KIND);
 
     fn name(&self) -> &'static str {
         match self.state.config.maximiser {
             Maximiser::CoordinateAscent(_) => CDBO,
             Maximiser::Cmaes(_) => BO_CMAES,
         }
-    }
-
-    fn dim(&self) -> usize {
-        self.state.w0.len()
     }
 
     fn propose(&mut self, told: &Told) -> Result<Proposal<f64>> {
@@ -482,6 +477,10 @@ impl Proposer for BoProposer {
     fn observe(&mut self, lap: &Lap<'_>, asked: Option<&Proposal<f64>>, _: &Told) -> Result<()> {
         let bound = asked.map_or(self.state.lengthscale_max, |p| p.note);
         self.add(lap.weights, lap.reward, bound)
+    }
+
+    fn dim(&self) -> usize {
+        self.state.w0.len()
     }
 
     fn state(&self) -> Cow<'_, BoState> {

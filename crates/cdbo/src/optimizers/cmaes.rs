@@ -23,7 +23,7 @@ use serde::{Deserialize, Serialize};
 
 use std::borrow::Cow;
 
-use super::ask_tell::{AskTell, Lap, Proposal, Proposer, Recorded, Told};
+use super::ask_tell::{AskTell, Lap, Proposal, Proposer, Recorded, SavedAs, Told};
 use super::{SearchBox, rng_for};
 use crate::error::{Error, Result};
 
@@ -476,16 +476,7 @@ impl CmaesProposer {
 impl Proposer for CmaesProposer {
     type Note = ();
     type State = CmaesProgress;
-    const KIND: &'static str = NAME;
-    const SAVES_RECORD: bool = true;
-
-    fn name(&self) -> &'static str {
-        NAME
-    }
-
-    fn dim(&self) -> usize {
-        self.state.mean.len()
-    }
+    const SAVED_AS: SavedAs = SavedAs::WithRecord(NAME);
 
     fn propose(&mut self, _: &Told) -> Result<Proposal<()>> {
         Ok(Proposal::plain(self.point(self.state.fitness.len())))
@@ -499,6 +490,10 @@ impl Proposer for CmaesProposer {
     fn observe(&mut self, lap: &Lap<'_>, _: Option<&Proposal<()>>, told: &Told) -> Result<()> {
         let fitness = lap.failure.map_or(-lap.reward, |f| 1.0 - f.at);
         self.tell_ranked(lap.weights, fitness, told)
+    }
+
+    fn dim(&self) -> usize {
+        self.state.mean.len()
     }
 
     fn state(&self) -> Cow<'_, CmaesProgress> {

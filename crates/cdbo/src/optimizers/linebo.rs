@@ -18,7 +18,7 @@ use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
 use std::borrow::Cow;
 
-use super::ask_tell::{AskTell, Lap, Proposal, Proposer, Told};
+use super::ask_tell::{AskTell, Lap, Proposal, Proposer, SavedAs, Told};
 use super::{SearchBox, rng_for};
 use crate::acquisition::ucb::{DEFAULT_BETA, ucb};
 use crate::error::{Error, Result};
@@ -246,16 +246,7 @@ impl LineBoProposer {
 impl Proposer for LineBoProposer {
     type Note = ();
     type State = LineBoState;
-    const KIND: &'static str = NAME;
-    const SAVES_RECORD: bool = false;
-
-    fn name(&self) -> &'static str {
-        NAME
-    }
-
-    fn dim(&self) -> usize {
-        self.state.w0.len()
-    }
+    const SAVED_AS: SavedAs = SavedAs::Laps(NAME);
 
     fn propose(&mut self, _: &Told) -> Result<Proposal<()>> {
         if self.state.observations.is_empty() {
@@ -290,6 +281,10 @@ impl Proposer for LineBoProposer {
             self.line = self.line_through(origin, self.line.index + 1);
         }
         self.maybe_refit()
+    }
+
+    fn dim(&self) -> usize {
+        self.state.w0.len()
     }
 
     fn state(&self) -> Cow<'_, LineBoState> {

@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use std::borrow::Cow;
 
-use super::ask_tell::{AskTell, Lap, Proposal, Proposer, Recorded, Told};
+use super::ask_tell::{AskTell, Lap, Proposal, Proposer, Recorded, SavedAs, Told};
 use super::{SearchBox, rng_for};
 use crate::error::{Error, Result};
 
@@ -93,16 +93,7 @@ impl RandomSearch {
 impl Proposer for RandomProposer {
     type Note = ();
     type State = RandomProgress;
-    const KIND: &'static str = NAME;
-    const SAVES_RECORD: bool = true;
-
-    fn name(&self) -> &'static str {
-        NAME
-    }
-
-    fn dim(&self) -> usize {
-        self.state.start.len()
-    }
+    const SAVED_AS: SavedAs = SavedAs::WithRecord(NAME);
 
     fn propose(&mut self, told: &Told) -> Result<Proposal<()>> {
         let s = &self.state;
@@ -120,6 +111,10 @@ impl Proposer for RandomProposer {
 
     fn observe(&mut self, _: &Lap<'_>, _: Option<&Proposal<()>>, _: &Told) -> Result<()> {
         Ok(())
+    }
+
+    fn dim(&self) -> usize {
+        self.state.start.len()
     }
 
     fn state(&self) -> Cow<'_, RandomProgress> {

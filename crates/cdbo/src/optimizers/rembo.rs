@@ -15,7 +15,7 @@ use std::borrow::Cow;
 use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
 
-use super::ask_tell::{AskTell, Lap, Proposal, Proposer, Told};
+use super::ask_tell::{AskTell, Lap, Proposal, Proposer, SavedAs, Told};
 use super::bo::{Bo, BoConfig, BoState, Maximiser};
 use super::coordinate_ascent::AxisSearch;
 use super::{Optimizer, rng_for};
@@ -178,8 +178,7 @@ impl RemboProposer {
 impl Proposer for RemboProposer {
     type Note = Vec<f64>;
     type State = RemboState;
-    const KIND: &'static str = SAVED_KIND;
-    const SAVES_RECORD: bool = false;
+    const SAVED_AS: SavedAs = SavedAs::Laps(SAVED_KIND);
 
     fn name(&self) -> &'static str {
         match self.config.embedding_dim {
@@ -187,10 +186,6 @@ impl Proposer for RemboProposer {
             10 => NAME_10D,
             _ => SAVED_KIND,
         }
-    }
-
-    fn dim(&self) -> usize {
-        self.w0.len()
     }
 
     fn propose(&mut self, _: &Told) -> Result<Proposal<Vec<f64>>> {
@@ -218,6 +213,10 @@ impl Proposer for RemboProposer {
     /// Its tell needs the embedded point of its last ask.
     fn takes_any_weights(&self) -> bool {
         false
+    }
+
+    fn dim(&self) -> usize {
+        self.w0.len()
     }
 
     fn state(&self) -> Cow<'_, RemboState> {

@@ -24,7 +24,7 @@ use rand::seq::SliceRandom;
 use serde::{Deserialize, Serialize};
 use std::borrow::Cow;
 
-use super::ask_tell::{AskTell, Lap, Proposal, Proposer, Told};
+use super::ask_tell::{AskTell, Lap, Proposal, Proposer, SavedAs, Told};
 use super::{SearchBox, rng_for};
 use crate::acquisition::thompson;
 use crate::error::{Error, Result};
@@ -344,16 +344,7 @@ impl TurboProposer {
 impl Proposer for TurboProposer {
     type Note = ();
     type State = TurboState;
-    const KIND: &'static str = NAME;
-    const SAVES_RECORD: bool = false;
-
-    fn name(&self) -> &'static str {
-        NAME
-    }
-
-    fn dim(&self) -> usize {
-        self.state.w0.len()
-    }
+    const SAVED_AS: SavedAs = SavedAs::Laps(NAME);
 
     fn propose(&mut self, _: &Told) -> Result<Proposal<()>> {
         let w = if self.state.observations.is_empty() {
@@ -374,6 +365,10 @@ impl Proposer for TurboProposer {
             .push((lap.weights.to_vec(), lap.reward));
         self.update_region(u, lap.reward)?;
         self.maybe_refit()
+    }
+
+    fn dim(&self) -> usize {
+        self.state.w0.len()
     }
 
     fn state(&self) -> Cow<'_, TurboState> {

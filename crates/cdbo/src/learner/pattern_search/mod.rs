@@ -57,7 +57,7 @@ use rand::seq::SliceRandom;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-use crate::optimizers::ask_tell::{AskTell, Lap, Proposal, Proposer, Recorded, Told};
+use crate::optimizers::ask_tell::{AskTell, Lap, Proposal, Proposer, Recorded, SavedAs, Told};
 use crate::optimizers::{DEFAULT_BOX_RADIUS, SearchBox, rng_for};
 use push::Push;
 
@@ -528,16 +528,7 @@ impl PatternSearchProposer {
 impl Proposer for PatternSearchProposer {
     type Note = ();
     type State = PatternSearchProgress;
-    const KIND: &'static str = NAME;
-    const SAVES_RECORD: bool = true;
-
-    fn name(&self) -> &'static str {
-        NAME
-    }
-
-    fn dim(&self) -> usize {
-        self.state.start.len()
-    }
+    const SAVED_AS: SavedAs = SavedAs::WithRecord(NAME);
 
     fn propose(&mut self, told: &Told) -> Result<Proposal<()>> {
         let (weight, before) = match &self.state.next {
@@ -632,6 +623,10 @@ impl Proposer for PatternSearchProposer {
             }
         }
         Ok(())
+    }
+
+    fn dim(&self) -> usize {
+        self.state.start.len()
     }
 
     fn state(&self) -> Cow<'_, PatternSearchProgress> {
