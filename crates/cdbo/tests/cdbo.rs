@@ -235,8 +235,9 @@ mod cmaes {
             let x = a.ask().unwrap();
             a.tell(&x, f(&x)).unwrap();
         }
-        let saved = serde_json::to_string(a.state()).unwrap();
-        let mut b = Cmaes::resume(serde_json::from_str(&saved).unwrap()).unwrap();
+        let saved = serde_json::to_string(&a.save()).unwrap();
+        let saved: cdbo::optimizers::Saved = serde_json::from_str(&saved).unwrap();
+        let mut b = Cmaes::resume(saved.state("CMA-ES").unwrap()).unwrap();
         for _ in 0..30 {
             let (xa, xb) = (a.ask().unwrap(), b.ask().unwrap());
             assert_eq!(xa, xb);

@@ -25,12 +25,15 @@
 //! [`REPEAT_VARIANCE`]·σ_f² plus twice the jitter) is run again with the observations scoring
 //! −∞: with noise 0 a repeated lap teaches nothing, and every later ascent would end there.
 
+use std::borrow::Cow;
+
 use rand_distr::{Distribution, Normal};
 use serde::{Deserialize, Serialize};
 
+use super::ask_tell::{AskTell, Lap, Proposal, Proposer, SavedAs, Told};
 use super::cmaes_ascent::CmaesSearch;
 use super::coordinate_ascent::{Ascent, AxisSearch, GpAcquisition};
-use super::{Best, Optimizer, Saved, SearchBox, check_tell, rng_for};
+use super::{SearchBox, rng_for};
 use crate::acquisition::Acquisition;
 use crate::acquisition::ucb::DEFAULT_BETA;
 use crate::error::{Error, Result};
@@ -137,15 +140,14 @@ pub struct BoState {
     pub bounds_used: Vec<f64>,
 }
 
-/// A BO run (CDBO or BO-CMA-ES).
+/// BO's proposer: w₀, then the initial design, then w = argmax h from the best weights so far,
+/// each noted with the length-scale bound it was chosen under; each told lap is added to the
+/// GP (module doc).
 #[derive(Debug, Clone)]
-pub struct Bo {
+pub struct BoProposer {
     state: BoState,
     bounds: SearchBox,
     gp: GaussianProcess,
-    best: Best,
-    /// The pending suggestion and the length-scale bound it was made under.
-    pending: Option<(Vec<f64>, f64)>,
     last_fit_at: usize,
     /// The fit started at `last_fit_at`, installed when the next is due.
     fit_in_flight: Option<FitInFlight>,
@@ -170,6 +172,9 @@ fn initial_hyper(config: &BoConfig, dim: usize) -> Hyper {
 const LENGTHSCALE_MIN_FRACTION: f64 = 0.01;
 /// Largest length-scale searched at the start, relative to the box width.
 const LENGTHSCALE_MAX_FRACTION: f64 = 10.0;
+
+/// A BO run (CDBO or BO-CMA-ES).
+pub type Bo = AskTell<BoProposer>;
 
 impl Bo {
     /// A new run from the demonstration's weights.
@@ -207,6 +212,19 @@ impl Bo {
     /// Rebuilds a run from its state by replaying its observations and hyperparameter fits,
     /// so that it continues exactly as the uninterrupted run would.
     pub fn resume(saved: BoState) -> Result<Bo> {
+        let proposer = BoProposer::resume(saved)?;
+        let told = Told::of(proposer.state.observations.iter().map(|(w, r)| (w, *r)));
+        Ok(AskTell::resumed(proposer, told))
+    }
+
+    /// Fits the GP's hyperparameters by maximum likelihood within the current bounds now.
+    pub fn fit_hyperparameters(&mut self) -> Result<()> {
+        self.proposer_mut().fit_hyperparameters()
+    }
+}
+
+impl BoProposer {
+    fn resume(saved: BoState) -> Result<BoProposer> {
         if saved.bounds_used.len() != saved.observations.len() {
             return Err(Error::CorruptState {
                 method: "BO",
@@ -227,12 +245,10 @@ impl Bo {
         state.lengthscale_max = LENGTHSCALE_MAX_FRACTION * 2.0 * saved.config.box_radius;
         let bounds = SearchBox::around(&state.w0, state.config.box_radius)?;
         let gp = GaussianProcess::new(dim, state.hyper.clone())?;
-        let mut run = Bo {
+        let mut run = BoProposer {
             state,
             bounds,
             gp,
-            best: Best::default(),
-            pending: None,
             last_fit_at: 0,
             fit_in_flight: None,
             last_af_evaluations: 0,
@@ -243,8 +259,7 @@ impl Bo {
             if run.gp.len() > run.state.config.initial_samples {
                 run.prepare_gp()?;
             }
-            run.pending = Some((w.clone(), *bound));
-            run.tell(w, *r)?;
+            run.add(w, *r, *bound)?;
         }
         run.state.lengthscale_max = saved.lengthscale_max;
         Ok(run)
@@ -315,7 +330,7 @@ impl Bo {
     }
 
     /// Fits the GP's hyperparameters by maximum likelihood within the current bounds now.
-    pub fn fit_hyperparameters(&mut self) -> Result<()> {
+    fn fit_hyperparameters(&mut self) -> Result<()> {
         let start = std::time::Instant::now();
         let bounds = self.hyper_bounds();
         fit(&mut self.gp, &bounds, self.state.config.fit_iterations)?;
@@ -358,14 +373,16 @@ impl Bo {
         points[i * d..(i + 1) * d].to_vec()
     }
 
-    /// The next point and the length-scale bound in force when it was chosen.
-    fn suggest(&mut self) -> Result<(Vec<f64>, f64)> {
-        let bound = self.state.lengthscale_max;
-        let w = self.choose()?;
-        Ok((w, bound))
+    /// Adds a told lap to the GP, with the length-scale bound in force when it was chosen.
+    fn add(&mut self, weights: &[f64], reward: f64, bound: f64) -> Result<()> {
+        self.gp.add(weights, reward)?;
+        self.state.observations.push((weights.to_vec(), reward));
+        self.state.bounds_used.push(bound);
+        self.state.hyper = self.gp.hyper().clone();
+        Ok(())
     }
 
-    fn choose(&mut self) -> Result<Vec<f64>> {
+    fn choose(&mut self, told: &Told) -> Result<Vec<f64>> {
         let n = self.state.observations.len();
         let mut rng = rng_for(self.state.config.seed, n as u64);
         if n == 0 {
@@ -389,7 +406,7 @@ impl Bo {
             return Ok(w);
         }
         self.prepare_gp()?;
-        let start = self.best.get().map_or(&self.state.w0[..], |b| b.0).to_vec();
+        let start = told.best_or(&self.state.w0).to_vec();
         let acquisition = self.state.config.acquisition;
         let ascent = match &self.state.config.maximiser {
             Maximiser::CoordinateAscent(search) => {
@@ -439,7 +456,11 @@ impl Bo {
     }
 }
 
-impl Optimizer for Bo {
+impl Proposer for BoProposer {
+    type Note = f64;
+    type State = BoState;
+    const SAVED_AS: SavedAs = SavedAs::Laps(SAVED_KIND);
+
     fn name(&self) -> &'static str {
         match self.state.config.maximiser {
             Maximiser::CoordinateAscent(_) => CDBO,
@@ -447,42 +468,22 @@ impl Optimizer for Bo {
         }
     }
 
+    fn propose(&mut self, told: &Told) -> Result<Proposal<f64>> {
+        let note = self.state.lengthscale_max;
+        let weights = self.choose(told)?;
+        Ok(Proposal { weights, note })
+    }
+
+    fn observe(&mut self, lap: &Lap<'_>, asked: Option<&Proposal<f64>>, _: &Told) -> Result<()> {
+        let bound = asked.map_or(self.state.lengthscale_max, |p| p.note);
+        self.add(lap.weights, lap.reward, bound)
+    }
+
     fn dim(&self) -> usize {
         self.state.w0.len()
     }
 
-    fn ask(&mut self) -> Result<Vec<f64>> {
-        if let Some((w, _)) = &self.pending {
-            return Ok(w.clone());
-        }
-        let (w, bound) = self.suggest()?;
-        self.pending = Some((w.clone(), bound));
-        Ok(w)
-    }
-
-    fn tell(&mut self, weights: &[f64], reward: f64) -> Result<()> {
-        check_tell(self.dim(), weights, reward)?;
-        self.gp.add(weights, reward)?;
-        self.state.observations.push((weights.to_vec(), reward));
-        let bound = self
-            .pending
-            .take()
-            .map_or(self.state.lengthscale_max, |(_, b)| b);
-        self.state.bounds_used.push(bound);
-        self.state.hyper = self.gp.hyper().clone();
-        self.best.offer(weights, reward);
-        Ok(())
-    }
-
-    fn best(&self) -> Option<(&[f64], f64)> {
-        self.best.get()
-    }
-
-    fn evaluations(&self) -> usize {
-        self.state.observations.len()
-    }
-
-    fn save(&self) -> Saved {
-        Saved::new(SAVED_KIND, &self.state)
+    fn state(&self) -> Cow<'_, BoState> {
+        Cow::Borrowed(&self.state)
     }
 }

@@ -21,12 +21,14 @@ use faer::{Mat, Side};
 use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
 
-use super::{Best, FailedLap, Optimizer, Saved, SearchBox, check_tell, check_tell_lap, rng_for};
+use std::borrow::Cow;
+
+use super::ask_tell::{AskTell, Lap, Proposal, Proposer, Recorded, SavedAs, Told};
+use super::{SearchBox, rng_for};
 use crate::error::{Error, Result};
 
 /// The method's name, and the kind of its saved state.
 pub const NAME: &str = "cmaes";
-const SAVED_KIND: &str = NAME;
 
 /// Settings of a CMA-ES run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -128,9 +130,9 @@ impl Params {
     }
 }
 
-/// Everything needed to resume a run.
+/// The search distribution and the current generation.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct CmaesState {
+pub struct CmaesProgress {
     /// Settings.
     pub config: CmaesConfig,
     /// The start point.
@@ -151,24 +153,27 @@ pub struct CmaesState {
     pub population: Vec<Vec<f64>>,
     /// Fitness (−reward) told for the current generation, in order.
     pub fitness: Vec<f64>,
-    /// Rewards told in total.
-    pub evaluations: usize,
-    /// The best (weights, reward) told.
-    pub(crate) best: Best,
     /// IPOP restarts so far (the population is λ·2^restarts).
     pub restarts: u32,
 }
 
-/// Active CMA-ES.
+/// Everything needed to resume a run: its distribution and the laps' record.
+pub type CmaesState = Recorded<CmaesProgress>;
+
+/// Active CMA-ES's proposer: the current generation's next individual m + σyₖ, updated as the
+/// module says once all λ are told.
 #[derive(Debug, Clone)]
-pub struct Cmaes {
-    state: CmaesState,
+pub struct CmaesProposer {
+    state: CmaesProgress,
     params: Params,
     bounds: SearchBox,
     /// Eigenvectors B (columns) and square roots of the eigenvalues D of C.
     b: Mat<f64>,
     d: Vec<f64>,
 }
+
+/// Active CMA-ES.
+pub type Cmaes = AskTell<CmaesProposer>;
 
 impl Cmaes {
     /// A run from `start` with step size σ₀.
@@ -188,7 +193,7 @@ impl Cmaes {
         for i in 0..n {
             cov[i * n + i] = 1.0;
         }
-        let state = CmaesState {
+        let state = CmaesProgress {
             mean: start.clone(),
             sigma: config.sigma0,
             cov,
@@ -197,17 +202,25 @@ impl Cmaes {
             generation: 0,
             population: Vec::new(),
             fitness: Vec::new(),
-            evaluations: 0,
-            best: Best::default(),
             restarts: 0,
             start,
             config,
         };
-        Cmaes::resume(state)
+        Ok(AskTell::resumed(
+            CmaesProposer::resume(state)?,
+            Told::default(),
+        ))
     }
 
     /// Rebuilds a run from its state.
     pub fn resume(state: CmaesState) -> Result<Cmaes> {
+        let (state, told) = state.into_parts();
+        Ok(AskTell::resumed(CmaesProposer::resume(state)?, told))
+    }
+}
+
+impl CmaesProposer {
+    fn resume(state: CmaesProgress) -> Result<CmaesProposer> {
         let n = state.start.len();
         if state.cov.len() != n * n || state.mean.len() != n {
             return Err(Error::CorruptState {
@@ -234,7 +247,7 @@ impl Cmaes {
                 upper: vec![f64::INFINITY; n],
             },
         };
-        let mut run = Cmaes {
+        let mut run = CmaesProposer {
             params: Params::new(n, lambda.max(2)),
             bounds,
             b: Mat::identity(n, n),
@@ -246,11 +259,6 @@ impl Cmaes {
             run.sample();
         }
         Ok(run)
-    }
-
-    /// The state to save.
-    pub fn state(&self) -> &CmaesState {
-        &self.state
     }
 
     /// Current step size σ.
@@ -341,7 +349,7 @@ impl Cmaes {
 
     /// Records a told individual with its fitness (minimised) and updates the generation
     /// once all λ are told.
-    fn tell_ranked(&mut self, weights: &[f64], reward: f64, fitness: f64) -> Result<()> {
+    fn tell_ranked(&mut self, weights: &[f64], fitness: f64, told: &Told) -> Result<()> {
         let k = self.state.fitness.len();
         let mut w = weights.to_vec();
         self.bounds.clamp(&mut w);
@@ -352,16 +360,14 @@ impl Cmaes {
             .collect();
         self.state.population[k] = y;
         self.state.fitness.push(fitness);
-        self.state.evaluations += 1;
-        self.state.best.offer(weights, reward);
         if self.state.fitness.len() == self.params.lambda {
-            self.update()?;
+            self.update(told)?;
         }
         Ok(())
     }
 
     /// The generation's update, once all λ individuals are told.
-    fn update(&mut self) -> Result<()> {
+    fn update(&mut self, told: &Told) -> Result<()> {
         let n = self.state.mean.len();
         let nf = n as f64;
         let p = self.params.clone();
@@ -439,18 +445,18 @@ impl Cmaes {
             || self.state.sigma * dmax < 1e-12 * self.state.config.sigma0
             || dmax * dmax > 1e14 * dmin * dmin;
         if collapsed {
-            self.restart()?;
+            self.restart(told)?;
         }
         self.sample();
         Ok(())
     }
 
     /// IPOP restart from the best point with σ₀ and a doubled population.
-    fn restart(&mut self) -> Result<()> {
+    fn restart(&mut self, told: &Told) -> Result<()> {
         let n = self.state.mean.len();
         let s = &mut self.state;
         s.restarts += 1;
-        s.mean = s.best.get().map_or(&s.start[..], |b| b.0).to_vec();
+        s.mean = told.best_or(&s.start).to_vec();
         s.sigma = s.config.sigma0;
         s.cov = (0..n * n)
             .map(|k| if k % (n + 1) == 0 { 1.0 } else { 0.0 })
@@ -467,44 +473,30 @@ impl Cmaes {
     }
 }
 
-impl Optimizer for Cmaes {
-    fn name(&self) -> &'static str {
-        NAME
+impl Proposer for CmaesProposer {
+    type Note = ();
+    type State = CmaesProgress;
+    const SAVED_AS: SavedAs = SavedAs::WithRecord(NAME);
+
+    fn propose(&mut self, _: &Told) -> Result<Proposal<()>> {
+        Ok(Proposal::plain(self.point(self.state.fitness.len())))
+    }
+
+    /// Told weights other than the asked ones are injected: their step (w − m)/σ replaces the
+    /// pending individual's. A lap that failed at x ranks by how far it got, f = 1 − x (behind
+    /// every completed lap, f = −reward < 0): when a whole generation fails, a fitness of zeros
+    /// everywhere steers nothing, while the failure places still point the mean towards laps
+    /// that got further.
+    fn observe(&mut self, lap: &Lap<'_>, _: Option<&Proposal<()>>, told: &Told) -> Result<()> {
+        let fitness = lap.failure.map_or(-lap.reward, |f| 1.0 - f.at);
+        self.tell_ranked(lap.weights, fitness, told)
     }
 
     fn dim(&self) -> usize {
         self.state.mean.len()
     }
 
-    fn ask(&mut self) -> Result<Vec<f64>> {
-        Ok(self.point(self.state.fitness.len()))
-    }
-
-    /// Told weights other than the asked ones are injected: their step (w − m)/σ replaces the
-    /// pending individual's.
-    fn tell(&mut self, weights: &[f64], reward: f64) -> Result<()> {
-        check_tell(self.dim(), weights, reward)?;
-        self.tell_ranked(weights, reward, -reward)
-    }
-
-    /// A lap that failed at x ranks by how far it got, f = 1 − x (behind every completed lap,
-    /// f = −reward < 0): when a whole generation fails, a fitness of zeros everywhere steers
-    /// nothing, while the failure places still point the mean towards laps that got further.
-    fn tell_lap(&mut self, weights: &[f64], reward: f64, failure: Option<FailedLap>) -> Result<()> {
-        check_tell_lap(self.dim(), weights, reward, failure)?;
-        let fitness = failure.map_or(-reward, |f| 1.0 - f.at);
-        self.tell_ranked(weights, reward, fitness)
-    }
-
-    fn best(&self) -> Option<(&[f64], f64)> {
-        self.state.best.get()
-    }
-
-    fn evaluations(&self) -> usize {
-        self.state.evaluations
-    }
-
-    fn save(&self) -> Saved {
-        Saved::new(SAVED_KIND, &self.state)
+    fn state(&self) -> Cow<'_, CmaesProgress> {
+        Cow::Borrowed(&self.state)
     }
 }

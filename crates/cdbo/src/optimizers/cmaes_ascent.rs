@@ -10,10 +10,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::Optimizer;
-use super::SearchBox;
 use super::cmaes::{Cmaes, CmaesConfig};
 use super::coordinate_ascent::Ascent;
+use super::{Optimizer, SearchBox};
 use crate::acquisition::Acquisition;
 use crate::error::Result;
 use crate::gp::GaussianProcess;

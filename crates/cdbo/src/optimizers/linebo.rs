@@ -16,8 +16,10 @@
 use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
+use std::borrow::Cow;
 
-use super::{Best, Optimizer, Saved, SearchBox, check_tell, rng_for};
+use super::ask_tell::{AskTell, Lap, Proposal, Proposer, SavedAs, Told};
+use super::{SearchBox, rng_for};
 use crate::acquisition::ucb::{DEFAULT_BETA, ucb};
 use crate::error::{Error, Result};
 use crate::gp::likelihood::{Bounds, fit};
@@ -25,7 +27,6 @@ use crate::gp::{GaussianProcess, Hyper, Kernel, Mean};
 
 /// The method's name, and the kind of its saved state.
 pub const NAME: &str = "linebo";
-const SAVED_KIND: &str = NAME;
 
 /// Settings of a LineBO run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -85,16 +86,19 @@ struct Line {
     laps: usize,
 }
 
-/// A LineBO run.
+/// LineBO's proposer: w₀, then the UCB maximiser on the current line's grid;
+/// each told lap is added to the GP, and after `laps_per_line` laps the next line begins through
+/// the best weights (module doc).
 #[derive(Debug, Clone)]
-pub struct LineBo {
+pub struct LineBoProposer {
     state: LineBoState,
     bounds: SearchBox,
     gp: GaussianProcess,
     line: Line,
-    best: Best,
-    pending: Option<Vec<f64>>,
 }
+
+/// A LineBO run.
+pub type LineBo = AskTell<LineBoProposer>;
 
 impl LineBo {
     /// A new run from the demonstration's weights.
@@ -138,7 +142,7 @@ impl LineBo {
             noise_var: 0.0,
             mean: Mean::Constant,
         };
-        let mut run = LineBo {
+        let mut run = LineBoProposer {
             bounds: SearchBox::around(&saved.w0, r)?,
             gp: GaussianProcess::new(dim, hyper)?,
             line: Line {
@@ -147,20 +151,17 @@ impl LineBo {
                 index: 0,
                 laps: 0,
             },
-            best: Best::default(),
-            pending: None,
             state: LineBoState {
                 observations: Vec::new(),
                 ..saved.clone()
             },
         };
         run.line = run.line_through(saved.w0.clone(), 0);
-        for (w, r) in &saved.observations {
-            run.tell(w, *r)?;
-        }
-        Ok(run)
+        AskTell::replayed(run, &saved.observations)
     }
+}
 
+impl LineBoProposer {
     /// The state to save.
     pub fn state(&self) -> &LineBoState {
         &self.state
@@ -242,64 +243,51 @@ impl LineBo {
     }
 }
 
-impl Optimizer for LineBo {
-    fn name(&self) -> &'static str {
-        NAME
+impl Proposer for LineBoProposer {
+    type Note = ();
+    type State = LineBoState;
+    const SAVED_AS: SavedAs = SavedAs::Laps(NAME);
+
+    fn propose(&mut self, _: &Told) -> Result<Proposal<()>> {
+        if self.state.observations.is_empty() {
+            return Ok(Proposal::plain(self.state.w0.clone()));
+        }
+        let (lo, hi) = self.t_range();
+        let grid = self.state.config.grid;
+        let ts: Vec<f64> = (0..grid)
+            .map(|k| lo + (hi - lo) * k as f64 / (grid - 1) as f64)
+            .collect();
+        let points: Vec<f64> = ts.iter().flat_map(|&t| self.on_line(t)).collect();
+        let beta = self.state.config.beta;
+        let scores: Vec<f64> = self
+            .gp
+            .predict_batch(&points)
+            .into_iter()
+            .map(|(m, v)| ucb(m, v, beta))
+            .collect();
+        Ok(Proposal::plain(
+            self.on_line(ts[crate::acquisition::argmax(&scores)]),
+        ))
+    }
+
+    fn observe(&mut self, lap: &Lap<'_>, _: Option<&Proposal<()>>, told: &Told) -> Result<()> {
+        self.gp.add(lap.weights, lap.reward)?;
+        self.state
+            .observations
+            .push((lap.weights.to_vec(), lap.reward));
+        self.line.laps += 1;
+        if self.line.laps >= self.state.config.laps_per_line || self.state.observations.len() == 1 {
+            let origin = told.best_or(&self.state.w0).to_vec();
+            self.line = self.line_through(origin, self.line.index + 1);
+        }
+        self.maybe_refit()
     }
 
     fn dim(&self) -> usize {
         self.state.w0.len()
     }
 
-    fn ask(&mut self) -> Result<Vec<f64>> {
-        if let Some(w) = &self.pending {
-            return Ok(w.clone());
-        }
-        let w = if self.state.observations.is_empty() {
-            self.state.w0.clone()
-        } else {
-            let (lo, hi) = self.t_range();
-            let grid = self.state.config.grid;
-            let ts: Vec<f64> = (0..grid)
-                .map(|k| lo + (hi - lo) * k as f64 / (grid - 1) as f64)
-                .collect();
-            let points: Vec<f64> = ts.iter().flat_map(|&t| self.on_line(t)).collect();
-            let beta = self.state.config.beta;
-            let scores: Vec<f64> = self
-                .gp
-                .predict_batch(&points)
-                .into_iter()
-                .map(|(m, v)| ucb(m, v, beta))
-                .collect();
-            self.on_line(ts[crate::acquisition::argmax(&scores)])
-        };
-        self.pending = Some(w.clone());
-        Ok(w)
-    }
-
-    fn tell(&mut self, weights: &[f64], reward: f64) -> Result<()> {
-        check_tell(self.dim(), weights, reward)?;
-        self.gp.add(weights, reward)?;
-        self.state.observations.push((weights.to_vec(), reward));
-        self.best.offer(weights, reward);
-        self.pending = None;
-        self.line.laps += 1;
-        if self.line.laps >= self.state.config.laps_per_line || self.state.observations.len() == 1 {
-            let origin = self.best.get().map_or(&self.state.w0[..], |b| b.0).to_vec();
-            self.line = self.line_through(origin, self.line.index + 1);
-        }
-        self.maybe_refit()
-    }
-
-    fn best(&self) -> Option<(&[f64], f64)> {
-        self.best.get()
-    }
-
-    fn evaluations(&self) -> usize {
-        self.state.observations.len()
-    }
-
-    fn save(&self) -> Saved {
-        Saved::new(SAVED_KIND, &self.state)
+    fn state(&self) -> Cow<'_, LineBoState> {
+        Cow::Borrowed(&self.state)
     }
 }

@@ -4,6 +4,7 @@
 //! informed with this initial solution"), counts one lap per evaluation, takes every random
 //! choice from its seed, and treats a failed lap (reward 0) as an ordinary observation.
 
+pub mod ask_tell;
 pub mod bo;
 pub mod cmaes;
 pub mod cmaes_ascent;

@@ -4,12 +4,14 @@
 use rand_distr::{Distribution, Normal};
 use serde::{Deserialize, Serialize};
 
-use super::{Best, Optimizer, Saved, SearchBox, check_tell, rng_for};
+use std::borrow::Cow;
+
+use super::ask_tell::{AskTell, Lap, Proposal, Proposer, Recorded, SavedAs, Told};
+use super::{SearchBox, rng_for};
 use crate::error::{Error, Result};
 
 /// The method's name, and the kind of its saved state.
 pub const NAME: &str = "random";
-const SAVED_KIND: &str = NAME;
 
 /// Settings of a random search.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -32,25 +34,36 @@ impl Default for RandomConfig {
     }
 }
 
-/// Everything needed to resume a search.
+/// The search's own state: its settings and start.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct RandomState {
+pub struct RandomProgress {
     /// Settings.
     pub config: RandomConfig,
     /// The start point.
     pub start: Vec<f64>,
-    /// Rewards told.
-    pub evaluations: usize,
-    /// The best (weights, reward) told.
-    pub(crate) best: Best,
+}
+
+/// Everything needed to resume a search: its state and the laps' record.
+pub type RandomState = Recorded<RandomProgress>;
+
+/// Random search's proposer: the start first, then w ~ N(w*, σ²I) clamped to the box, w* the
+/// best weights told, drawn from stream n (n laps told) of the seed.
+#[derive(Debug, Clone)]
+pub struct RandomProposer {
+    state: RandomProgress,
+    bounds: SearchBox,
 }
 
 /// Random search.
-#[derive(Debug, Clone)]
-pub struct RandomSearch {
-    state: RandomState,
-    bounds: SearchBox,
-    pending: Option<Vec<f64>>,
+pub type RandomSearch = AskTell<RandomProposer>;
+
+impl RandomProposer {
+    fn resume(state: RandomProgress) -> Result<RandomProposer> {
+        Ok(RandomProposer {
+            bounds: SearchBox::around(&state.start, state.config.box_radius)?,
+            state,
+        })
+    }
 }
 
 impl RandomSearch {
@@ -66,75 +79,45 @@ impl RandomSearch {
         if !(config.sigma.is_finite() && config.sigma > 0.0) {
             return Err(Error::invalid_value("σ", config.sigma, "positive"));
         }
-        RandomSearch::resume(RandomState {
-            config,
-            start,
-            evaluations: 0,
-            best: Best::default(),
-        })
+        let proposer = RandomProposer::resume(RandomProgress { config, start })?;
+        Ok(AskTell::resumed(proposer, Told::default()))
     }
 
     /// Rebuilds a search from its state.
     pub fn resume(state: RandomState) -> Result<RandomSearch> {
-        Ok(RandomSearch {
-            bounds: SearchBox::around(&state.start, state.config.box_radius)?,
-            state,
-            pending: None,
-        })
-    }
-
-    /// The state to save.
-    pub fn state(&self) -> &RandomState {
-        &self.state
+        let (state, told) = state.into_parts();
+        Ok(AskTell::resumed(RandomProposer::resume(state)?, told))
     }
 }
 
-impl Optimizer for RandomSearch {
-    fn name(&self) -> &'static str {
-        NAME
+impl Proposer for RandomProposer {
+    type Note = ();
+    type State = RandomProgress;
+    const SAVED_AS: SavedAs = SavedAs::WithRecord(NAME);
+
+    fn propose(&mut self, told: &Told) -> Result<Proposal<()>> {
+        let s = &self.state;
+        if told.evaluations() == 0 {
+            return Ok(Proposal::plain(s.start.clone()));
+        }
+        let normal = Normal::new(0.0, s.config.sigma)
+            .map_err(|_| Error::invalid_value("σ", s.config.sigma, "positive"))?;
+        let mut rng = rng_for(s.config.seed, told.evaluations() as u64);
+        let centre = told.best_or(&s.start);
+        let mut w: Vec<f64> = centre.iter().map(|c| c + normal.sample(&mut rng)).collect();
+        self.bounds.clamp(&mut w);
+        Ok(Proposal::plain(w))
+    }
+
+    fn observe(&mut self, _: &Lap<'_>, _: Option<&Proposal<()>>, _: &Told) -> Result<()> {
+        Ok(())
     }
 
     fn dim(&self) -> usize {
         self.state.start.len()
     }
 
-    fn ask(&mut self) -> Result<Vec<f64>> {
-        if let Some(p) = &self.pending {
-            return Ok(p.clone());
-        }
-        let s = &self.state;
-        let centre = s.best.get().map_or(&s.start[..], |b| b.0);
-        let w = if s.evaluations == 0 {
-            s.start.clone()
-        } else {
-            let normal = Normal::new(0.0, s.config.sigma)
-                .map_err(|_| Error::invalid_value("σ", s.config.sigma, "positive"))?;
-            let mut rng = rng_for(s.config.seed, s.evaluations as u64);
-            let mut w: Vec<f64> = centre.iter().map(|c| c + normal.sample(&mut rng)).collect();
-            self.bounds.clamp(&mut w);
-            w
-        };
-        self.pending = Some(w.clone());
-        Ok(w)
-    }
-
-    fn tell(&mut self, weights: &[f64], reward: f64) -> Result<()> {
-        check_tell(self.dim(), weights, reward)?;
-        self.state.evaluations += 1;
-        self.state.best.offer(weights, reward);
-        self.pending = None;
-        Ok(())
-    }
-
-    fn best(&self) -> Option<(&[f64], f64)> {
-        self.state.best.get()
-    }
-
-    fn evaluations(&self) -> usize {
-        self.state.evaluations
-    }
-
-    fn save(&self) -> Saved {
-        Saved::new(SAVED_KIND, &self.state)
+    fn state(&self) -> Cow<'_, RandomProgress> {
+        Cow::Borrowed(&self.state)
     }
 }

@@ -10,12 +10,15 @@
 //! the best of the best observation and 1,000 uniform points of Y (REMBO maximises EI
 //! globally).
 
+use std::borrow::Cow;
+
 use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
 
+use super::ask_tell::{AskTell, Lap, Proposal, Proposer, SavedAs, Told};
 use super::bo::{Bo, BoConfig, BoState, Maximiser};
 use super::coordinate_ascent::AxisSearch;
-use super::{Best, Optimizer, Saved, check_tell, rng_for};
+use super::{Optimizer, rng_for};
 use crate::acquisition::Acquisition;
 use crate::error::{Error, Result};
 use crate::gp::Kernel;
@@ -56,18 +59,19 @@ pub struct RemboState {
     pub inner: BoState,
 }
 
-/// A REMBO run.
+/// REMBO's proposer: w(y) for the y the BO run in the embedding asks, noted with that y; a
+/// told lap tells its y to the BO run.
 #[derive(Debug, Clone)]
-pub struct Rembo {
+pub struct RemboProposer {
     config: RemboConfig,
     w0: Vec<f64>,
     /// A, row-major D × d.
     embedding: Vec<f64>,
     inner: Bo,
-    /// The embedded point of the pending suggestion and its weights.
-    pending: Option<(Vec<f64>, Vec<f64>)>,
-    best: Best,
 }
+
+/// A REMBO run.
+pub type Rembo = AskTell<RemboProposer>;
 
 /// Uniform points of Y scored before each ascent of the expected improvement: REMBO
 /// maximises it globally (with DIRECT in the paper), and its maxima often lie far from the
@@ -139,30 +143,19 @@ impl Rembo {
             .map(|_| StandardNormal.sample(&mut rng))
             .collect();
         let inner = Bo::resume(state.inner)?;
-        let mut run = Rembo {
+        let proposer = RemboProposer {
             config: state.config,
             w0: state.w0,
             embedding,
             inner,
-            pending: None,
-            best: Best::default(),
         };
-        let told: Vec<(Vec<f64>, f64)> = run.inner.state().observations.clone();
-        for (y, r) in told {
-            run.best.offer(&run.weights(&y), r);
-        }
-        Ok(run)
+        let laps = proposer.inner.state().observations.iter();
+        let told = Told::of(laps.map(|(y, r)| (proposer.weights(y), *r)));
+        Ok(AskTell::resumed(proposer, told))
     }
+}
 
-    /// The state to save.
-    pub fn state(&self) -> RemboState {
-        RemboState {
-            config: self.config.clone(),
-            w0: self.w0.clone(),
-            inner: self.inner.state().clone(),
-        }
-    }
-
+impl RemboProposer {
     /// w(y) = w₀ + r·P(Ay).
     pub fn weights(&self, y: &[f64]) -> Vec<f64> {
         let d = y.len();
@@ -182,7 +175,11 @@ impl Rembo {
     }
 }
 
-impl Optimizer for Rembo {
+impl Proposer for RemboProposer {
+    type Note = Vec<f64>;
+    type State = RemboState;
+    const SAVED_AS: SavedAs = SavedAs::Laps(SAVED_KIND);
+
     fn name(&self) -> &'static str {
         match self.config.embedding_dim {
             5 => NAME_5D,
@@ -191,50 +188,42 @@ impl Optimizer for Rembo {
         }
     }
 
-    fn dim(&self) -> usize {
-        self.w0.len()
-    }
-
-    fn ask(&mut self) -> Result<Vec<f64>> {
-        if let Some((_, w)) = &self.pending {
-            return Ok(w.clone());
-        }
+    fn propose(&mut self, _: &Told) -> Result<Proposal<Vec<f64>>> {
         let y = self.inner.ask()?;
-        let w = self.weights(&y);
-        self.pending = Some((y, w.clone()));
-        Ok(w)
+        Ok(Proposal {
+            weights: self.weights(&y),
+            note: y,
+        })
     }
 
     /// Only the asked weights can be told: the GP lives in the embedding, and weights outside
     /// its image have no point there.
-    fn tell(&mut self, weights: &[f64], reward: f64) -> Result<()> {
-        check_tell(self.dim(), weights, reward)?;
-        let y = match &self.pending {
-            Some((y, w)) if w.as_slice() == weights => y.clone(),
-            _ => {
-                return Err(Error::NotAsked { method: "REMBO" });
-            }
-        };
-        self.inner.tell(&y, reward)?;
-        self.best.offer(weights, reward);
-        self.pending = None;
-        Ok(())
+    fn observe(
+        &mut self,
+        lap: &Lap<'_>,
+        asked: Option<&Proposal<Vec<f64>>>,
+        _: &Told,
+    ) -> Result<()> {
+        match asked {
+            Some(p) if p.weights.as_slice() == lap.weights => self.inner.tell(&p.note, lap.reward),
+            _ => Err(Error::NotAsked { method: "REMBO" }),
+        }
     }
 
     /// Its tell needs the embedded point of its last ask.
-    fn tells_any_weights(&self) -> bool {
+    fn takes_any_weights(&self) -> bool {
         false
     }
 
-    fn best(&self) -> Option<(&[f64], f64)> {
-        self.best.get()
+    fn dim(&self) -> usize {
+        self.w0.len()
     }
 
-    fn evaluations(&self) -> usize {
-        self.inner.evaluations()
-    }
-
-    fn save(&self) -> Saved {
-        Saved::new(SAVED_KIND, &self.state())
+    fn state(&self) -> Cow<'_, RemboState> {
+        Cow::Owned(RemboState {
+            config: self.config.clone(),
+            w0: self.w0.clone(),
+            inner: self.inner.state().clone(),
+        })
     }
 }

@@ -22,8 +22,10 @@
 use rand::Rng;
 use rand::seq::SliceRandom;
 use serde::{Deserialize, Serialize};
+use std::borrow::Cow;
 
-use super::{Best, Optimizer, Saved, SearchBox, check_tell, rng_for};
+use super::ask_tell::{AskTell, Lap, Proposal, Proposer, SavedAs, Told};
+use super::{SearchBox, rng_for};
 use crate::acquisition::thompson;
 use crate::error::{Error, Result};
 use crate::gp::likelihood::{Bounds, fit};
@@ -31,7 +33,6 @@ use crate::gp::{GaussianProcess, Hyper, Kernel, Mean};
 
 /// The method's name, and the kind of its saved state.
 pub const NAME: &str = "turbo";
-const SAVED_KIND: &str = NAME;
 
 /// TuRBO's initial base side of the trust region (the default L_init).
 pub const LENGTH_INIT: f64 = 0.8;
@@ -119,15 +120,15 @@ impl Region {
     }
 }
 
-/// A TuRBO-1 run.
+/// TuRBO's proposer: w₀, then each restart's Latin-hypercube design, then
+/// the maximiser of a Thompson sample in the trust region; each told lap is added to the GP
+/// and resizes or restarts the region (module doc).
 #[derive(Debug, Clone)]
-pub struct Turbo {
+pub struct TurboProposer {
     state: TurboState,
     bounds: SearchBox,
     gp: GaussianProcess,
     region: Region,
-    best: Best,
-    pending: Option<Vec<f64>>,
 }
 
 fn initial_hyper(dim: usize) -> Hyper {
@@ -139,6 +140,9 @@ fn initial_hyper(dim: usize) -> Hyper {
         mean: Mean::Constant,
     }
 }
+
+/// A TuRBO-1 run.
+pub type Turbo = AskTell<TurboProposer>;
 
 impl Turbo {
     /// A new run from the demonstration's weights.
@@ -171,23 +175,20 @@ impl Turbo {
                 format!("in (0, {LENGTH_MAX}]"),
             ));
         }
-        let mut run = Turbo {
+        let run = TurboProposer {
             bounds: SearchBox::around(&saved.w0, saved.config.box_radius)?,
             gp: GaussianProcess::new(dim, initial_hyper(dim))?,
             region: Region::fresh(0, length_init),
-            best: Best::default(),
-            pending: None,
             state: TurboState {
                 observations: Vec::new(),
                 ..saved.clone()
             },
         };
-        for (w, r) in &saved.observations {
-            run.tell(w, *r)?;
-        }
-        Ok(run)
+        AskTell::replayed(run, &saved.observations)
     }
+}
 
+impl TurboProposer {
     /// The state to save.
     pub fn state(&self) -> &TurboState {
         &self.state
@@ -340,19 +341,12 @@ impl Turbo {
     }
 }
 
-impl Optimizer for Turbo {
-    fn name(&self) -> &'static str {
-        NAME
-    }
+impl Proposer for TurboProposer {
+    type Note = ();
+    type State = TurboState;
+    const SAVED_AS: SavedAs = SavedAs::Laps(NAME);
 
-    fn dim(&self) -> usize {
-        self.state.w0.len()
-    }
-
-    fn ask(&mut self) -> Result<Vec<f64>> {
-        if let Some(w) = &self.pending {
-            return Ok(w.clone());
-        }
+    fn propose(&mut self, _: &Told) -> Result<Proposal<()>> {
         let w = if self.state.observations.is_empty() {
             self.state.w0.clone()
         } else if self.region.told < self.state.config.initial_samples {
@@ -360,30 +354,24 @@ impl Optimizer for Turbo {
         } else {
             self.thompson_point()?
         };
-        self.pending = Some(w.clone());
-        Ok(w)
+        Ok(Proposal::plain(w))
     }
 
-    fn tell(&mut self, weights: &[f64], reward: f64) -> Result<()> {
-        check_tell(self.dim(), weights, reward)?;
-        let u = self.unit_point(weights);
-        self.gp.add(&u, reward)?;
-        self.state.observations.push((weights.to_vec(), reward));
-        self.best.offer(weights, reward);
-        self.pending = None;
-        self.update_region(u, reward)?;
+    fn observe(&mut self, lap: &Lap<'_>, _: Option<&Proposal<()>>, _: &Told) -> Result<()> {
+        let u = self.unit_point(lap.weights);
+        self.gp.add(&u, lap.reward)?;
+        self.state
+            .observations
+            .push((lap.weights.to_vec(), lap.reward));
+        self.update_region(u, lap.reward)?;
         self.maybe_refit()
     }
 
-    fn best(&self) -> Option<(&[f64], f64)> {
-        self.best.get()
+    fn dim(&self) -> usize {
+        self.state.w0.len()
     }
 
-    fn evaluations(&self) -> usize {
-        self.state.observations.len()
-    }
-
-    fn save(&self) -> Saved {
-        Saved::new(SAVED_KIND, &self.state)
+    fn state(&self) -> Cow<'_, TurboState> {
+        Cow::Borrowed(&self.state)
     }
 }

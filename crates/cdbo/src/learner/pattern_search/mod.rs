@@ -51,18 +51,18 @@
 
 pub mod push;
 
+use std::borrow::Cow;
+
 use rand::seq::SliceRandom;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-use crate::optimizers::{
-    Best, DEFAULT_BOX_RADIUS, FailedLap, Optimizer, Saved, SearchBox, check_tell_lap, rng_for,
-};
+use crate::optimizers::ask_tell::{AskTell, Lap, Proposal, Proposer, Recorded, SavedAs, Told};
+use crate::optimizers::{DEFAULT_BOX_RADIUS, SearchBox, rng_for};
 use push::Push;
 
 /// The method's name, and the kind of its saved state.
 pub const NAME: &str = "pattern-search";
-const SAVED_KIND: &str = NAME;
 
 /// Settings of a pattern search.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -177,9 +177,9 @@ impl Rest {
     }
 }
 
-/// Everything needed to resume a search.
+/// The search's steps, sweeps and pushes.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct PatternSearchState {
+pub struct PatternSearchProgress {
     /// Settings.
     pub config: PatternSearchConfig,
     /// The start point.
@@ -212,18 +212,22 @@ pub struct PatternSearchState {
     pub pushed: bool,
     /// The next trial.
     pub next: Trial,
-    /// Rewards told.
-    pub evaluations: usize,
-    /// The best (weights, reward) told.
-    pub(crate) best: Best,
+}
+
+/// Everything needed to resume a search: its steps and the laps' record.
+pub type PatternSearchState = Recorded<PatternSearchProgress>;
+
+/// The pattern search's proposer: the next trial moves one block (or sharpening direction)
+/// from the best point, repairs it or pushes, and each told lap grows, repairs, or reverses
+/// and halves the step, as the module says.
+#[derive(Debug, Clone)]
+pub struct PatternSearchProposer {
+    state: PatternSearchProgress,
+    bounds: SearchBox,
 }
 
 /// Pattern search with failure repair.
-#[derive(Debug, Clone)]
-pub struct PatternSearch {
-    state: PatternSearchState,
-    bounds: SearchBox,
-}
+pub type PatternSearch = AskTell<PatternSearchProposer>;
 
 impl PatternSearch {
     /// A search from `start` (driven first, unmoved).
@@ -236,7 +240,7 @@ impl PatternSearch {
             ));
         }
         let n = start.len();
-        PatternSearch::resume(PatternSearchState {
+        let proposer = PatternSearchProposer::resume(PatternSearchProgress {
             steps: vec![config.sigma0; n],
             sharp_steps: vec![config.sigma0; n],
             rests: vec![Rest::default(); n],
@@ -248,15 +252,24 @@ impl PatternSearch {
             push: None,
             pushed: false,
             next: Trial::Start,
-            evaluations: 0,
-            best: Best::default(),
             config,
             start,
-        })
+        })?;
+        Ok(AskTell::resumed(proposer, Told::default()))
     }
 
     /// Rebuilds a search from its state.
-    pub fn resume(mut state: PatternSearchState) -> Result<PatternSearch> {
+    pub fn resume(state: PatternSearchState) -> Result<PatternSearch> {
+        let (state, told) = state.into_parts();
+        Ok(AskTell::resumed(
+            PatternSearchProposer::resume(state)?,
+            told,
+        ))
+    }
+}
+
+impl PatternSearchProposer {
+    fn resume(mut state: PatternSearchProgress) -> Result<PatternSearchProposer> {
         if !(state.config.sigma0.is_finite() && state.config.sigma0 > 0.0) {
             return Err(Error::invalid_value("σ₀", state.config.sigma0, "positive"));
         }
@@ -323,7 +336,7 @@ impl PatternSearch {
                 ),
             });
         }
-        Ok(PatternSearch {
+        Ok(PatternSearchProposer {
             bounds: SearchBox::around(&state.start, state.config.box_radius)?,
             state,
         })
@@ -335,17 +348,17 @@ impl PatternSearch {
         (self.state.config.block >> shift).max(1)
     }
 
-    /// The centre of the trials: the best point, or the start before any lap.
-    fn centre(&self) -> &[f64] {
-        self.state.best.get().map_or(&self.state.start[..], |b| b.0)
-    }
-
     /// Push `number` from the best lap after the kept push `previous`, if this search pushes
     /// and has not pushed that often.
-    fn begin_push(&self, number: u32, previous: Option<&Push>) -> Result<Option<Push>> {
+    fn begin_push(
+        &self,
+        number: u32,
+        previous: Option<&Push>,
+        told: &Told,
+    ) -> Result<Option<Push>> {
         let c = &self.state.config;
         let n = self.state.start.len();
-        match (c.lengthscale, self.state.best.get()) {
+        match (c.lengthscale, told.best()) {
             (Some(l), Some((best, _)))
                 if c.push > 0.0
                     && number <= push::PUSHES
@@ -360,8 +373,8 @@ impl PatternSearch {
     /// The next push (number `number`, after the kept push `previous`), or the sweeps once the
     /// pushes are done: from single weights after a kept push, from the widest blocks
     /// otherwise.
-    fn push_or_sweep(&mut self, number: u32, previous: Option<&Push>) -> Result<()> {
-        self.state.push = self.begin_push(number, previous)?;
+    fn push_or_sweep(&mut self, number: u32, previous: Option<&Push>, told: &Told) -> Result<()> {
+        self.state.push = self.begin_push(number, previous, told)?;
         if self.state.push.is_some() {
             self.state.next = Trial::Push;
         } else {
@@ -512,21 +525,17 @@ impl PatternSearch {
     }
 }
 
-impl Optimizer for PatternSearch {
-    fn name(&self) -> &'static str {
-        NAME
-    }
+impl Proposer for PatternSearchProposer {
+    type Note = ();
+    type State = PatternSearchProgress;
+    const SAVED_AS: SavedAs = SavedAs::WithRecord(NAME);
 
-    fn dim(&self) -> usize {
-        self.state.start.len()
-    }
-
-    fn ask(&mut self) -> Result<Vec<f64>> {
+    fn propose(&mut self, told: &Told) -> Result<Proposal<()>> {
         let (weight, before) = match &self.state.next {
-            Trial::Start => return Ok(self.state.start.clone()),
+            Trial::Start => return Ok(Proposal::plain(self.state.start.clone())),
             Trial::Push => {
                 return match (&self.state.push, self.state.config.lengthscale) {
-                    (Some(push), Some(l)) => push.weights(l, &self.bounds),
+                    (Some(push), Some(l)) => push.weights(l, &self.bounds).map(Proposal::plain),
                     _ => Err(Error::CorruptState {
                         method: "pattern search",
                         reason: "a push trial without its push".into(),
@@ -537,7 +546,7 @@ impl Optimizer for PatternSearch {
             Trial::Repair { weight, before } => (*weight, &before[..]),
         };
         let step = self.steps()[weight];
-        let mut w = self.centre().to_vec();
+        let mut w = told.best_or(&self.state.start).to_vec();
         for (k, coefficient) in self.direction(weight) {
             w[k] += coefficient * step;
         }
@@ -545,28 +554,22 @@ impl Optimizer for PatternSearch {
             w[j] -= self.state.config.give_back * step;
         }
         self.bounds.clamp(&mut w);
-        Ok(w)
-    }
-
-    fn tell(&mut self, weights: &[f64], reward: f64) -> Result<()> {
-        self.tell_lap(weights, reward, None)
+        Ok(Proposal::plain(w))
     }
 
     /// Its tell reads the reward as the outcome of its last step.
-    fn tells_any_weights(&self) -> bool {
+    fn takes_any_weights(&self) -> bool {
         false
     }
 
-    fn tell_lap(&mut self, weights: &[f64], reward: f64, failure: Option<FailedLap>) -> Result<()> {
-        check_tell_lap(self.dim(), weights, reward, failure)?;
-        self.state.evaluations += 1;
-        let better = self.state.best.offer(weights, reward);
+    fn observe(&mut self, lap: &Lap<'_>, _: Option<&Proposal<()>>, told: &Told) -> Result<()> {
+        let (reward, failure, better) = (lap.reward, lap.failure, lap.improved);
         // A failed lap: where it failed is told, or its reward is a failure's 0.
         let failed = failure.is_some() || reward == 0.0;
         let failed_at = failure.map(|f| f.at);
         let repair = self.state.config.repair;
         match self.state.next.clone() {
-            Trial::Start => self.push_or_sweep(1, None)?,
+            Trial::Start => self.push_or_sweep(1, None, told)?,
             Trial::Push => {
                 let Some(mut push) = self.state.push.take() else {
                     return Err(Error::CorruptState {
@@ -577,11 +580,11 @@ impl Optimizer for PatternSearch {
                 push.laps += 1;
                 if better {
                     self.state.pushed = true;
-                    self.push_or_sweep(push.number + 1, Some(&push))?;
+                    self.push_or_sweep(push.number + 1, Some(&push), told)?;
                 } else if failure.is_some_and(|f| push.repair(f)) {
                     self.state.push = Some(push);
                 } else {
-                    self.push_or_sweep(push::PUSHES + 1, None)?;
+                    self.push_or_sweep(push::PUSHES + 1, None, told)?;
                 }
             }
             Trial::Step { weight } | Trial::Repair { weight, .. } if better => {
@@ -622,15 +625,11 @@ impl Optimizer for PatternSearch {
         Ok(())
     }
 
-    fn best(&self) -> Option<(&[f64], f64)> {
-        self.state.best.get()
+    fn dim(&self) -> usize {
+        self.state.start.len()
     }
 
-    fn evaluations(&self) -> usize {
-        self.state.evaluations
-    }
-
-    fn save(&self) -> Saved {
-        Saved::new(SAVED_KIND, &self.state)
+    fn state(&self) -> Cow<'_, PatternSearchProgress> {
+        Cow::Borrowed(&self.state)
     }
 }
