@@ -3,7 +3,7 @@
 //! saved by the code of that time with the weights it asked next.
 
 use cdbo::benchmarks::Problem;
-use cdbo::method::{Settings, by_name, resume};
+use cdbo::method::{Method, Spec, resume};
 use cdbo::optimizers::{FailedLap, Optimizer, Saved};
 
 /// (method, saved state as JSON, the weights asked next as JSON), one per method.
@@ -11,8 +11,9 @@ const FIXTURES: &str = include_str!("fixtures/saved_before_the_shell.txt");
 
 /// The fixtures' run: 12 laps of `method` from Ackley-4's start with seed 5.
 fn driven(method: &str, problem: &Problem) -> Box<dyn Optimizer + Send> {
-    let settings = Settings::problem(5, problem.radius);
-    let mut opt = by_name(method, problem.start.clone(), &settings).unwrap();
+    let method: Method = method.parse().unwrap();
+    let spec = Spec::problem(method, problem.radius).unwrap().seed(5);
+    let mut opt = spec.optimizer(problem.start.clone()).unwrap();
     for k in 0..12 {
         let w = opt.ask().unwrap();
         if k % 4 == 3 {
