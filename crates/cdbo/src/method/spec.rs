@@ -83,13 +83,7 @@ impl Spec {
     /// This specification searching the box [w₀ − r, w₀ + r], refused unless r is finite and
     /// positive.
     pub fn box_radius(self, box_radius: f64) -> Result<Spec> {
-        if !(box_radius.is_finite() && box_radius > 0.0) {
-            return Err(Error::invalid_value(
-                "the search-box radius",
-                box_radius,
-                "finite and positive",
-            ));
-        }
+        let box_radius = positive("the search-box radius", box_radius)?;
         Ok(Spec { box_radius, ..self })
     }
 
@@ -97,9 +91,7 @@ impl Spec {
     /// samples, and the knob of the methods whose knob is σ₀), refused unless finite and
     /// positive.
     pub fn sigma0(self, sigma0: f64) -> Result<Spec> {
-        if !(sigma0.is_finite() && sigma0 > 0.0) {
-            return Err(Error::invalid_value("σ₀", sigma0, "finite and positive"));
-        }
+        let sigma0 = positive("σ₀", sigma0)?;
         Ok(Spec { sigma0, ..self })
     }
 
@@ -129,15 +121,8 @@ impl Spec {
     /// (the pattern search then pushes that policy's pedal), refused unless ℓ is finite and
     /// positive.
     pub fn policy(self, lengthscale: f64) -> Result<Spec> {
-        if !(lengthscale.is_finite() && lengthscale > 0.0) {
-            return Err(Error::invalid_value(
-                "the policy's length-scale",
-                lengthscale,
-                "finite and positive",
-            ));
-        }
         Ok(Spec {
-            policy_lengthscale: Some(lengthscale),
+            policy_lengthscale: Some(positive("the policy's length-scale", lengthscale)?),
             ..self
         })
     }
@@ -145,15 +130,8 @@ impl Spec {
     /// This specification for a lap of `length` metres (the pattern search's push then repairs
     /// over road rather than kernels), refused unless finite and positive.
     pub fn track_length(self, length: f64) -> Result<Spec> {
-        if !(length.is_finite() && length > 0.0) {
-            return Err(Error::invalid_value(
-                "the lap's length (m)",
-                length,
-                "a positive number of metres",
-            ));
-        }
         Ok(Spec {
-            track_length: Some(length),
+            track_length: Some(positive("the lap's length (m)", length)?),
             ..self
         })
     }
@@ -263,6 +241,15 @@ impl Spec {
                 },
             )?),
         })
+    }
+}
+
+/// `value` if it is finite and positive, else an error naming `what`.
+fn positive(what: &'static str, value: f64) -> Result<f64> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(Error::invalid_value(what, value, "finite and positive"))
     }
 }
 
