@@ -181,6 +181,49 @@ fn ask_tell_workflow_and_bad_input() {
         serde_json::from_str(&ok(&dir, &["study", "status", "fast", "--json"])).unwrap();
     assert_eq!(stored["track_length_m"], 3596.0);
     assert_eq!(status["track_length_m"], serde_json::Value::Null);
+    // The method's knob: checked once at creation (nothing written when refused), stored,
+    // shown, and a resume with another refused naming the stored one.
+    let tuned = |knob: &'static str| {
+        [
+            "study",
+            "create",
+            "tuned",
+            "--kernels",
+            "5",
+            "--demo",
+            "demo.csv",
+            "--method",
+            "turbo",
+            "--knob",
+            knob,
+        ]
+    };
+    fails(&dir, &tuned("2"), "turbo's knob length");
+    assert!(
+        !dir.join("tuned.cdbo.db").exists(),
+        "a refused knob left a file"
+    );
+    ok(&dir, &tuned("0.1"));
+    let stored: serde_json::Value =
+        serde_json::from_str(&ok(&dir, &["study", "status", "tuned", "--json"])).unwrap();
+    assert_eq!(stored["knob"], 0.1);
+    assert_eq!(status["knob"], serde_json::Value::Null);
+    let resumed = [
+        "optimize",
+        "--evaluator",
+        "echo 1",
+        "--kernels",
+        "5",
+        "--laps",
+        "1",
+        "--storage",
+        "tuned.cdbo.db",
+        "--demo",
+        "demo.csv",
+        "--knob",
+        "0.3",
+    ];
+    fails(&dir, &resumed, "created with --knob 0.1");
 }
 
 #[test]

@@ -408,6 +408,7 @@ fn status(s: &Study, json: bool) -> CliResult {
         "method": c.method,
         "kernels": c.kernels,
         "track_length_m": c.track_length,
+        "knob": c.knob,
         "told": told,
         "failed": failed,
         "pending_trial": pending,
