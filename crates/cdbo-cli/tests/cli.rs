@@ -223,6 +223,42 @@ fn bad_race_knobs_are_refused_in_one_line() {
     );
 }
 
+/// `--max-failed-laps 10` caps a race's failed laps at 10 for every kind of method (a
+/// learner, the paper's GP method, a random search), where without it the same races fail
+/// more; the best lap is still a completed one.
+#[test]
+fn a_failed_lap_budget_caps_the_failed_laps() {
+    for method in ["pattern-search", "cdbo", "random"] {
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+            .join(format!("cdbo-cli-budget-{method}-{}", std::process::id()));
+        let race = |budget: Option<&str>| {
+            let mut args = vec![
+                "race", "--method", method, "--laps", "60", "--json", "--out",
+            ];
+            args.push(dir.to_str().unwrap());
+            if let Some(n) = budget {
+                args.extend(["--max-failed-laps", n]);
+            }
+            json(&args)
+        };
+        let free = race(None);
+        let capped = race(Some("10"));
+        assert!(
+            free["failed_laps"].as_u64().unwrap() > 10,
+            "{method}: {free}"
+        );
+        assert!(
+            capped["failed_laps"].as_u64().unwrap() <= 10,
+            "{method}: {capped}"
+        );
+        assert!(
+            capped["best_reward_mps"].as_f64().unwrap() > 0.0,
+            "{method}: {capped}"
+        );
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
+
 #[test]
 fn a_short_race_writes_its_results() {
     // 20 kernels: since the gearbox shifts at the current throttle, the 10-kernel fit of the

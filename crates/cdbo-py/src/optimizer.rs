@@ -16,7 +16,7 @@ use crate::convert::{IntoPy, array, lock, vector};
 /// An ask/tell optimiser of rewards over weights, started from w0.
 ///
 /// `Optimizer(method, w0, seed=0, beta=1.0, bounds=1.5, sigma0=None, knob=None,
-/// lengthscale=None, track_length=None)`: `method` is
+/// lengthscale=None, track_length=None, max_failed=None)`: `method` is
 /// one of `cdbo.METHODS`; the weights are searched in the box [w0 - bounds, w0 + bounds];
 /// `sigma0` is the exploration scale around w0 (CDBO's initial samples, the evolution
 /// strategies' step); `knob` is the method's main knob (`cdbo race --knob`: σ₀ for CMA-ES,
@@ -24,7 +24,8 @@ use crate::convert::{IntoPy, array, lock, vector};
 /// checked against its range; `lengthscale`, when w0 are a lap policy's weights, is its
 /// kernels' length-scale (`RaceEnv.lengthscale`; pattern search then pushes the policy's
 /// pedal) and `track_length` the lap's length in metres (`RaceEnv.track_length`; the push then
-/// repairs over road). With the defaults, the policy's length-scale and the lap's length, it
+/// repairs over road); `max_failed` caps the failed laps (once they have failed, only the best
+/// completed weights are asked again). With the defaults, the policy's length-scale and the lap's length, it
 /// is `cdbo race`'s optimiser (each knob at its tuned value), so the same seed asks the same
 /// weights.
 #[pyclass(name = "Optimizer", module = "cdbo")]
@@ -46,7 +47,7 @@ impl PyOptimizer {
 #[pymethods]
 impl PyOptimizer {
     #[new]
-    #[pyo3(signature = (method, w0, *, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, bounds = DEFAULT_BOX_RADIUS, sigma0 = None, knob = None, lengthscale = None, track_length = None))]
+    #[pyo3(signature = (method, w0, *, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, bounds = DEFAULT_BOX_RADIUS, sigma0 = None, knob = None, lengthscale = None, track_length = None, max_failed = None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -59,6 +60,7 @@ impl PyOptimizer {
         knob: Option<f64>,
         lengthscale: Option<f64>,
         track_length: Option<f64>,
+        max_failed: Option<usize>,
     ) -> PyResult<Self> {
         let w0 = vector(w0, "w0")?;
         let method: Method = method.parse().py()?;
@@ -75,6 +77,9 @@ impl PyOptimizer {
             }
             if let Some(lengthscale) = lengthscale {
                 spec = spec.policy(lengthscale)?;
+            }
+            if let Some(max) = max_failed {
+                spec = spec.max_failed_laps(max);
             }
             track_length.map_or(Ok(spec), |length| spec.track_length(length))
         };

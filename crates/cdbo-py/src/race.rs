@@ -88,7 +88,7 @@ impl PyRaceResult {
 /// --knob`; None: its tuned value); `progress(record)` is called after every lap with the
 /// lap's record (a dict).
 #[pyfunction]
-#[pyo3(signature = (track = None, car = None, *, method = "cdbo", kernels = 30, laps = 300, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, demo_speed = 15.0, knob = None, data_dir = None, progress = None))]
+#[pyo3(signature = (track = None, car = None, *, method = "cdbo", kernels = 30, laps = 300, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, demo_speed = 15.0, knob = None, max_failed = None, data_dir = None, progress = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn race(
     py: Python<'_>,
@@ -101,6 +101,7 @@ pub fn race(
     beta: f64,
     demo_speed: f64,
     knob: Option<f64>,
+    max_failed: Option<usize>,
     data_dir: Option<&Bound<'_, PyAny>>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<PyRaceResult> {
@@ -114,6 +115,7 @@ pub fn race(
         beta,
         demo_speed,
         knob,
+        max_failed_laps: max_failed,
     };
     let mut callback_error: Option<PyErr> = None;
     let outcome = py

@@ -44,6 +44,10 @@ pub struct RaceArgs {
     /// The knob of the methods whose knob is σ₀, by its older name (the same as `--knob`).
     #[arg(long, conflicts_with = "knob", allow_negative_numbers = true)]
     sigma0: Option<f64>,
+    /// Failed laps allowed: once they have failed, only the best completed lap is driven
+    /// again (in the simulator a hard cap; default: no budget).
+    #[arg(long, value_name = "N")]
+    max_failed_laps: Option<usize>,
     /// Output folder (default: runs/race-TRACK-METHOD-mM-sSEED).
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
@@ -93,6 +97,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         beta: args.beta,
         demo_speed: args.demo_speed,
         knob: args.knob.or(args.sigma0),
+        max_failed_laps: args.max_failed_laps,
     };
     // A knob the method cannot take is refused before any lap is driven.
     config.spec()?;

@@ -34,12 +34,19 @@ pub struct RaceConfig {
     /// box); `None`: its race value. Older configs name it `sigma0`.
     #[serde(default, alias = "sigma0", skip_serializing_if = "Option::is_none")]
     pub knob: Option<f64>,
+    /// Failed laps allowed ([`crate::learner::budget`]); `None`: no budget.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_failed_laps: Option<usize>,
 }
 
 impl RaceConfig {
     /// The race's specification of its method.
     pub fn spec(&self) -> Result<Spec> {
-        Spec::told(self.method, self.seed, self.beta, self.knob)
+        let spec = Spec::told(self.method, self.seed, self.beta, self.knob)?;
+        Ok(match self.max_failed_laps {
+            Some(max) => spec.max_failed_laps(max),
+            None => spec,
+        })
     }
 }
 
@@ -53,6 +60,7 @@ impl Default for RaceConfig {
             beta: crate::acquisition::ucb::DEFAULT_BETA,
             demo_speed: 15.0,
             knob: None,
+            max_failed_laps: None,
         }
     }
 }

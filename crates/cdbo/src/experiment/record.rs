@@ -173,6 +173,7 @@ pub fn run_at(
         beta: grid.beta,
         demo_speed: grid.demo_speed,
         knob: Some(grid.knob_of(method)),
+        max_failed_laps: None,
     };
     let (track_name, length_m) = (track.name.clone(), track.length);
     let venue = match grounds {

@@ -7,5 +7,6 @@
 //! [`FailedLap`]: crate::optimizers::FailedLap
 //! [`Optimizer`]: crate::optimizers::Optimizer
 
+pub mod budget;
 pub mod pattern_search;
 pub mod repair;

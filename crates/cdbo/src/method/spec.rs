@@ -7,6 +7,7 @@
 
 use super::{KnobKind, Method, PAPER_SIGMA0};
 use crate::error::{Error, Result};
+use crate::learner::budget::{self, FailureBudget};
 use crate::learner::pattern_search::{self, PatternSearch};
 use crate::optimizers::bo::{self, Bo};
 use crate::optimizers::cmaes::{self, Cmaes};
@@ -27,6 +28,7 @@ pub struct Spec {
     knob: Option<f64>,
     policy_lengthscale: Option<f64>,
     track_length: Option<f64>,
+    max_failed_laps: Option<usize>,
 }
 
 impl Spec {
@@ -46,6 +48,7 @@ impl Spec {
             knob: None,
             policy_lengthscale: None,
             track_length: None,
+            max_failed_laps: None,
         }
         .with_checked_knob(method.knob().value)
     }
@@ -136,6 +139,15 @@ impl Spec {
         })
     }
 
+    /// This specification within a budget of `max` failed laps ([`FailureBudget`]): once they
+    /// have failed, only the best completed lap is driven again.
+    pub fn max_failed_laps(self, max: usize) -> Spec {
+        Spec {
+            max_failed_laps: Some(max),
+            ..self
+        }
+    }
+
     /// The method.
     pub fn method(&self) -> Method {
         self.method
@@ -157,8 +169,16 @@ impl Spec {
         self.knob
     }
 
-    /// The method's optimiser, from w₀.
+    /// The method's optimiser, from w₀ (within its failed-lap budget, if it has one).
     pub fn optimizer(&self, w0: Vec<f64>) -> Result<Box<dyn Optimizer + Send>> {
+        let method = self.method_optimizer(w0)?;
+        Ok(match self.max_failed_laps {
+            Some(max) => Box::new(FailureBudget::new(method, max)),
+            None => method,
+        })
+    }
+
+    fn method_optimizer(&self, w0: Vec<f64>) -> Result<Box<dyn Optimizer + Send>> {
         let Spec {
             method,
             seed,
@@ -168,6 +188,7 @@ impl Spec {
             knob,
             policy_lengthscale,
             track_length,
+            max_failed_laps: _,
         } = *self;
         let bo = |maximiser| bo::BoConfig {
             seed,
@@ -263,11 +284,15 @@ pub fn resume(saved: Saved) -> Result<Box<dyn Optimizer + Send>> {
         turbo::NAME => Box::new(Turbo::resume(saved.state("TuRBO")?)?),
         linebo::NAME => Box::new(LineBo::resume(saved.state("LineBO")?)?),
         pattern_search::NAME => Box::new(PatternSearch::resume(saved.state("pattern search")?)?),
+        budget::SAVED_KIND => Box::new(FailureBudget::resume(
+            saved.state("failure budget")?,
+            resume,
+        )?),
         kind => {
             return Err(Error::NotFound {
                 what: "kind of saved optimiser",
                 name: format!("{kind:?}"),
-                detail: "available: bo, cmaes, random, rembo, turbo, linebo, pattern-search".into(),
+                detail: "available: bo, cmaes, random, rembo, turbo, linebo, pattern-search, failure-budget".into(),
             });
         }
     })

@@ -1,0 +1,179 @@
+//! A budget of failed laps around any method (issue 36's hard cap): the method proposes laps as
+//! usual until `max_failed` of them have failed; from then on only the best completed lap is
+//! driven again. In a deterministic simulator that lap completes again, so a run fails at most
+//! `max_failed` laps; on a real car it is the lap the learner is most certain of.
+//!
+//! A lap failed when its reward is 0 or its failure was told ([`FailedLap`]). A lap can be
+//! driven again only once one has completed: until then the method goes on proposing (where
+//! w₀'s own lap fails, the cap holds from the first completed lap on).
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::Result;
+use crate::optimizers::{FailedLap, Optimizer, Saved, check_tell_lap};
+
+/// The kind of a budgeted method's saved state.
+pub const SAVED_KIND: &str = "failure-budget";
+
+/// What a budget keeps besides its method.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BudgetState {
+    /// The method's own state.
+    pub inner: Saved,
+    /// Failed laps allowed.
+    pub max_failed: usize,
+    /// Failed laps told.
+    pub failed: usize,
+    /// Laps driven again after the budget was spent (not told to the method).
+    pub repeats: usize,
+}
+
+/// A method that fails at most `max_failed` laps.
+pub struct FailureBudget {
+    inner: Box<dyn Optimizer + Send>,
+    max_failed: usize,
+    failed: usize,
+    repeats: usize,
+}
+
+impl FailureBudget {
+    /// `inner` within a budget of `max_failed` failed laps.
+    pub fn new(inner: Box<dyn Optimizer + Send>, max_failed: usize) -> FailureBudget {
+        FailureBudget {
+            inner,
+            max_failed,
+            failed: 0,
+            repeats: 0,
+        }
+    }
+
+    /// A budget continuing exactly where `state` was saved, its method by `resume`.
+    pub fn resume(
+        state: BudgetState,
+        resume: impl FnOnce(Saved) -> Result<Box<dyn Optimizer + Send>>,
+    ) -> Result<FailureBudget> {
+        Ok(FailureBudget {
+            inner: resume(state.inner)?,
+            max_failed: state.max_failed,
+            failed: state.failed,
+            repeats: state.repeats,
+        })
+    }
+
+    /// Whether the budget is spent: only the best completed lap is driven from now on.
+    pub fn spent(&self) -> bool {
+        self.failed >= self.max_failed
+    }
+
+    /// The lap driven again once the budget is spent: the best completed one.
+    fn safest(&self) -> Option<Vec<f64>> {
+        self.inner
+            .best()
+            .filter(|(_, reward)| *reward > 0.0)
+            .map(|(w, _)| w.to_vec())
+    }
+}
+
+impl Optimizer for FailureBudget {
+    fn name(&self) -> &'static str {
+        self.inner.name()
+    }
+
+    fn dim(&self) -> usize {
+        self.inner.dim()
+    }
+
+    fn ask(&mut self) -> Result<Vec<f64>> {
+        if self.spent()
+            && let Some(w) = self.safest()
+        {
+            return Ok(w);
+        }
+        self.inner.ask()
+    }
+
+    fn tell(&mut self, weights: &[f64], reward: f64) -> Result<()> {
+        self.tell_lap(weights, reward, None)
+    }
+
+    fn tell_lap(&mut self, weights: &[f64], reward: f64, failure: Option<FailedLap>) -> Result<()> {
+        check_tell_lap(self.dim(), weights, reward, failure)?;
+        let failed = reward == 0.0 || failure.is_some();
+        if self.spent() && self.safest().is_some() {
+            self.repeats += 1;
+        } else {
+            self.inner.tell_lap(weights, reward, failure)?;
+        }
+        self.failed += usize::from(failed);
+        Ok(())
+    }
+
+    fn tells_any_weights(&self) -> bool {
+        self.inner.tells_any_weights()
+    }
+
+    fn best(&self) -> Option<(&[f64], f64)> {
+        self.inner.best()
+    }
+
+    fn evaluations(&self) -> usize {
+        self.inner.evaluations() + self.repeats
+    }
+
+    fn save(&self) -> Saved {
+        Saved::new(
+            SAVED_KIND,
+            &BudgetState {
+                inner: self.inner.save(),
+                max_failed: self.max_failed,
+                failed: self.failed,
+                repeats: self.repeats,
+            },
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::method::{Method, Spec, resume};
+
+    /// A cliff: laps fail wherever Σw > 0.5, else the reward rises towards the cliff.
+    fn lap(w: &[f64]) -> (f64, Option<crate::optimizers::FailedLap>) {
+        let s: f64 = w.iter().sum();
+        if s > 0.5 {
+            (0.0, Some(crate::optimizers::FailedLap::too_fast(0.5)))
+        } else {
+            (10.0 + s, None)
+        }
+    }
+
+    /// Within a budget of 3, at most 3 laps fail over 80, for each of 10 seeds; saved halfway
+    /// and resumed, the run asks the same weights as the uninterrupted one.
+    #[test]
+    fn a_budget_caps_failures_and_resumes_bit_for_bit() {
+        for seed in 0..10 {
+            let spec = Spec::race(Method::Random).seed(seed).max_failed_laps(3);
+            let mut a = spec.optimizer(vec![0.0; 4]).unwrap();
+            let mut failed = 0;
+            let mut resumed = None;
+            for k in 0..80 {
+                if k == 40 {
+                    resumed = Some(resume(a.save()).unwrap());
+                }
+                let w = a.ask().unwrap();
+                if let Some(b) = resumed.as_mut() {
+                    assert_eq!(b.ask().unwrap(), w, "seed {seed} lap {k}");
+                }
+                let (reward, failure) = lap(&w);
+                failed += usize::from(failure.is_some());
+                a.tell_lap(&w, reward, failure).unwrap();
+                if let Some(b) = resumed.as_mut() {
+                    b.tell_lap(&w, reward, failure).unwrap();
+                }
+            }
+            assert!(failed <= 3, "seed {seed}: {failed} failed laps");
+            assert_eq!(a.evaluations(), 80);
+            assert!(a.best().unwrap().1 > 10.0, "seed {seed}: no gain");
+        }
+    }
+}
