@@ -101,3 +101,26 @@ def test_bad_input_raises_value_error_with_the_librarys_message():
     assert opt.evaluations == 1
     with pytest.raises(ValueError, match="not a saved cdbo optimiser"):
         cdbo.Optimizer.load(b"{not json")
+
+
+@pytest.mark.parametrize("method", ["pattern-search", "random", "cmaes"])
+def test_a_failed_lap_budget_caps_the_failures(method):
+    """On a cliff (laps fail where the weights sum past 0.1), max_failed=3 keeps the failed
+    laps to 3 over 60; without it the same run fails more."""
+
+    def run(max_failed):
+        opt = cdbo.Optimizer(method, np.zeros(4), seed=1, max_failed=max_failed)
+        failed = 0
+        for _ in range(60):
+            w = opt.ask()
+            if w.sum() > 0.1:
+                failed += 1
+                opt.tell(w, 0.0, failed_at=0.5)
+            else:
+                opt.tell(w, 10.0 + w.sum())
+        return failed, opt.best[1]
+
+    free, _ = run(None)
+    capped, best = run(3)
+    assert free > 3, free
+    assert capped <= 3 and best > 10.0, (capped, best)
