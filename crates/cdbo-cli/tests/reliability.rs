@@ -336,14 +336,20 @@ fn a_single_worker_is_unchanged_by_claims() {
             &["lap", "--policy", policy.to_str().unwrap(), "--json"],
         ))
         .unwrap();
-        let reward = lap["reward_mps"].as_f64().unwrap().to_string();
         let trial = asked["trial"].to_string();
-        ok(
-            &dir,
-            &[
-                "study", "tell", "s", "--db", "b.db", "--trial", &trial, "--reward", &reward,
-            ],
-        );
+        let mut tell = vec!["study", "tell", "s", "--db", "b.db", "--trial", &trial];
+        // A failed lap is told with its place and reason, as the evaluator reads them from
+        // `cdbo lap --json`.
+        let (reward, at, reason);
+        if lap["completed"].as_bool().unwrap() {
+            reward = lap["reward_mps"].as_f64().unwrap().to_string();
+            tell.extend(["--reward", &reward]);
+        } else {
+            at = lap["failure"]["x"].as_f64().unwrap().to_string();
+            reason = lap["failure"]["reason"].as_str().unwrap().to_owned();
+            tell.extend(["--failed", "--at", &at, "--reason", &reason]);
+        }
+        ok(&dir, &tell);
     }
     let (a, b) = (history(&dir, "s", "a.db"), history(&dir, "s", "b.db"));
     assert_eq!(a, b);

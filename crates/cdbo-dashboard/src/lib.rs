@@ -136,7 +136,10 @@ impl Dashboard {
         match source.kind {
             Kind::Study => {
                 let (config, trials) = self.store.study(source)?;
-                Ok(view::study(&config, &trials)?)
+                let mut view = view::study(&config, &trials)?;
+                // The track the map drives on: the study's own, else the dashboard's --track.
+                view.track = view.track.or_else(|| self.study_track.clone());
+                Ok(view)
             }
             Kind::Experiment => Ok(view::experiment(&self.store.runs(source)?, run)?),
         }

@@ -12,6 +12,7 @@ use cdbo::method::{Method, Spec};
 use cdbo::optimizers::{DEFAULT_BOX_RADIUS, FailedLap, Optimizer, Saved};
 
 use crate::convert::{IntoPy, array, lock, vector};
+use crate::sim::PyLapResult;
 
 /// An ask/tell optimiser of rewards over weights, started from w0.
 ///
@@ -108,21 +109,40 @@ impl PyOptimizer {
         f64::from_bits(self.last_ask_s.load(Ordering::Relaxed))
     }
 
-    /// Tells the reward of `w` (0 for a failed lap) and, for a failed lap whose place is
-    /// known, where it failed (`failed_at`, a lap fraction) and whether the car was too slow
-    /// there (`too_slow`: it stalled or ran out of time, rather than leaving the road or
-    /// spinning); methods that use them, such as pattern-search, repair the policy there.
-    #[pyo3(signature = (w, reward, failed_at = None, too_slow = false))]
+    /// Tells what the lap driven with `w` gave: a `LapResult` (`env.lap(w)`,
+    /// `Simulator.lap(...)`), which carries its failure's place and reason, or its reward as a
+    /// number (0 for a failed lap) with, for a failed lap whose place is known, where it failed
+    /// (`failed_at`, a lap fraction) and whether the car was too slow there (`too_slow`: it
+    /// stalled or ran out of time, rather than leaving the road or spinning). Methods that use
+    /// the failure, such as pattern-search, repair the policy there.
+    #[pyo3(signature = (w, lap, failed_at = None, too_slow = false))]
     fn tell(
         &self,
         py: Python<'_>,
         w: &Bound<'_, PyAny>,
-        reward: f64,
+        lap: &Bound<'_, PyAny>,
         failed_at: Option<f64>,
         too_slow: bool,
     ) -> PyResult<()> {
         let w = vector(w, "w")?;
-        let failure = failed_at.map(|at| FailedLap { at, too_slow });
+        let (reward, failure) = match lap.cast::<PyLapResult>() {
+            Ok(_) if failed_at.is_some() || too_slow => {
+                return Err(pyo3::exceptions::PyValueError::new_err(
+                    "tell: the LapResult already says where and why it failed; \
+                     failed_at= and too_slow= go with a reward given as a number",
+                ));
+            }
+            Ok(result) => result.borrow().told(),
+            Err(_) => {
+                let reward: f64 = lap.extract().map_err(|_| {
+                    pyo3::exceptions::PyTypeError::new_err(format!(
+                        "tell: the lap is a LapResult or a reward (a number), not {}",
+                        lap.get_type()
+                    ))
+                })?;
+                (reward, failed_at.map(|at| FailedLap { at, too_slow }))
+            }
+        };
         py.detach(|| lock(&self.inner)?.tell_lap(&w, reward, failure).py())
     }
 

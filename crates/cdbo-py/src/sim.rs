@@ -8,6 +8,7 @@ use pyo3::types::{PyDict, PyType};
 
 use cdbo::car::Car;
 use cdbo::limit::{Limit, limit_lap};
+use cdbo::optimizers::FailedLap;
 use cdbo::policy::RkhsPolicy;
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 use cdbo::sim::{LapResult, Simulator};
@@ -268,7 +269,8 @@ impl PyPolicy {
 /// failure), `failure` (`off_track`, `spun`, `backwards`, `stalled`, `time_limit` or None) and
 /// where (`x_fail`, lap fraction), and the `trace` when asked for: a dict of NumPy arrays, one
 /// entry per driver step (t, distance_m, x, speed, pedal, steer, lateral, heading_error,
-/// slip_angle, gear, rpm, pos_x, pos_y).
+/// slip_angle, gear, rpm, pos_x, pos_y). `Optimizer.tell(w, lap)` takes it whole, failure
+/// and all; `float(lap)` is its reward.
 #[pyclass(name = "LapResult", module = "cdbo", frozen)]
 pub struct PyLapResult {
     lap: LapResult,
@@ -276,6 +278,16 @@ pub struct PyLapResult {
 }
 
 impl PyLapResult {
+    /// The reward and, for a failed lap, where it failed and whether it was too slow there:
+    /// everything an optimiser is told of a lap.
+    pub fn told(&self) -> (f64, Option<FailedLap>) {
+        let failure = self.lap.failure.map(|f| FailedLap {
+            at: f.x,
+            too_slow: f.reason.too_slow(),
+        });
+        (self.lap.reward_mps, failure)
+    }
+
     pub fn new(py: Python<'_>, lap: LapResult, with_trace: bool) -> PyResult<Self> {
         let trace = if with_trace {
             let cols: [Column<cdbo::sim::TracePoint>; 13] = [
@@ -326,6 +338,18 @@ impl PyLapResult {
     #[getter]
     fn x_fail(&self) -> Option<f64> {
         self.lap.failure.map(|f| f.x)
+    }
+
+    /// Whether the lap failed for being too slow (it stalled or ran out of time) rather than
+    /// too fast (it left the road, spun or turned round); False for a completed lap.
+    #[getter]
+    fn too_slow(&self) -> bool {
+        self.lap.failure.is_some_and(|f| f.reason.too_slow())
+    }
+
+    /// The reward, so that a lap reads as its number: `float(lap)`.
+    fn __float__(&self) -> f64 {
+        self.lap.reward_mps
     }
 
     /// Simulated time (s).

@@ -62,6 +62,41 @@ def test_a_python_loop_over_optimizer_and_env_is_the_librarys_race(method, knob)
     assert cdbo.Simulator("ridgeway").lap(result.best).reward == result.best_reward
 
 
+def test_the_readmes_loop_tells_the_whole_lap_and_is_the_librarys_race():
+    """`opt.tell(w, env.lap(w))`, as the README writes it, passes each failure's place and
+    reason: the pattern search, which repairs there, asks what `cdbo.race` asks."""
+    laps = 60
+    result = cdbo.race("ridgeway", method="pattern-search", kernels=20, laps=laps, seed=2)
+    env = cdbo.RaceEnv("ridgeway", kernels=20)
+    opt = env.optimizer("pattern-search", seed=2)
+    told = []
+    for _ in range(laps):
+        w = opt.ask()
+        lap = env.lap(w)
+        opt.tell(w, lap)
+        told.append(lap)
+    assert [float(lap) for lap in told] == [r["reward"] for r in result.laps]
+    assert opt.best[1] == result.best_reward
+    failed = [lap for lap in told if not lap.completed]
+    assert failed, "a pattern search of 60 laps fails some: the failures are what is tested"
+    assert all(lap.x_fail is not None and lap.reward == 0.0 for lap in failed)
+    assert any(lap.too_slow == (lap.failure in ("stalled", "time_limit")) for lap in failed)
+
+
+def test_tell_takes_a_lap_or_a_number_not_both_kinds_of_failure():
+    env = cdbo.RaceEnv("ridgeway", kernels=10)
+    opt = cdbo.Optimizer("random", env.w0, seed=0)
+    w = opt.ask()
+    lap = env.lap(w + 5.0)  # full throttle everywhere: the car leaves the road
+    assert not lap.completed and lap.x_fail is not None
+    with pytest.raises(ValueError, match="already says where and why it failed"):
+        opt.tell(w, lap, failed_at=0.5)
+    with pytest.raises(TypeError, match="a LapResult or a reward"):
+        opt.tell(w, "fast")
+    opt.tell(w, lap)
+    assert opt.evaluations == 1
+
+
 def test_progress_is_called_after_every_lap_and_its_errors_propagate():
     seen = []
     result = cdbo.race(laps=5, kernels=10, progress=seen.append)

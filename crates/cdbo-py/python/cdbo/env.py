@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._cdbo import DEFAULT_BOX_RADIUS, Policy, Simulator
+from ._cdbo import DEFAULT_BOX_RADIUS, Optimizer, Policy, Simulator
 
 try:
     import gymnasium as _gym
@@ -81,9 +81,20 @@ class RaceEnv(_Base):
         self.w0 = self.initial.weights
         self.lengthscale = self.initial.lengthscale
         self.track_length = self.simulator.track.length
+        self.bounds = bounds
         self.action_space = _box(self.w0 - bounds, self.w0 + bounds)
         self.observation_space = _box(np.zeros(1), np.ones(1))
         self.last = None
+
+    def optimizer(self, method="cdbo", **options):
+        """``cdbo.Optimizer(method, w0, ...)`` told what this race is: its start ``w0``, its
+        box, the policy's length-scale and the lap's length, as ``cdbo race`` tells it (the
+        pattern search pushes the policy's pedal and repairs it over road with them).
+        ``options`` are the Optimizer's own (``seed=``, ``knob=``, ``max_failed=``, ...)."""
+        options.setdefault("bounds", self.bounds)
+        options.setdefault("lengthscale", self.lengthscale)
+        options.setdefault("track_length", self.track_length)
+        return Optimizer(method, self.w0, **options)
 
     def reset(self, *, seed=None, options=None):
         if _gym is not None:
@@ -103,9 +114,14 @@ class RaceEnv(_Base):
         }
         return np.zeros(1), lap.reward, True, False, info
 
-    def lap(self, w) -> float:
-        """The reward of one lap with weights ``w`` (``step`` without the episode)."""
-        return self.step(w)[1]
+    def lap(self, w):
+        """One lap with weights ``w`` (``step`` without the episode): its ``LapResult``.
+
+        ``opt.tell(w, env.lap(w))`` tells the optimiser the reward and, for a failed lap,
+        where and why it failed; ``float(env.lap(w))`` is the reward alone.
+        """
+        self.step(w)
+        return self.last
 
 
 def register():

@@ -3,7 +3,10 @@
 //! For each lap the policy is written as JSON — `{"weights": […], "lengthscale": l,
 //! "table": [[x, a], …]}` — to a file, and the command runs through `sh -c` with `{policy}`
 //! replaced by that file's (quoted) path. Its standard output gives the reward: a number, or a
-//! JSON object with `reward` (or `reward_mps`), or `{"failed": true, "at": x, "reason": …}`.
+//! JSON object with `reward` (or `reward_mps`), or a failure with its place and reason —
+//! `{"failed": true, "at": x, "reason": …}`, or as `cdbo lap --json` reports one,
+//! `{"completed": false, "failure": {"reason": …, "x": x}}` — which learners that repair
+//! where a lap failed (the pattern search) are told.
 //! A non-zero exit, a timeout, output that parses as neither or an output past its bound
 //! ([`bounded::LAP_COMMAND_OUTPUT`], the command then stopped) is a failed lap with the reason.
 
@@ -81,6 +84,19 @@ pub fn parse_output(stdout: &str) -> Outcome {
     let Ok(serde_json::Value::Object(v)) = serde_json::from_str::<serde_json::Value>(text) else {
         return unparsable();
     };
+    if v.get("completed").and_then(|c| c.as_bool()) == Some(false) {
+        let failure = v.get("failure");
+        return Outcome::Failed {
+            at: failure.and_then(|f| f.get("x")).and_then(|x| x.as_f64()),
+            reason: Some(
+                failure
+                    .and_then(|f| f.get("reason"))
+                    .and_then(|r| r.as_str())
+                    .unwrap_or("reported not completed")
+                    .to_owned(),
+            ),
+        };
+    }
     if v.get("failed").and_then(|f| f.as_bool()) == Some(true) {
         return Outcome::Failed {
             at: v.get("at").and_then(|x| x.as_f64()),
@@ -272,6 +288,16 @@ mod tests {
         );
         assert_eq!(
             parse_output(r#"{"failed": true, "at": 0.4, "reason": "spun"}"#),
+            Outcome::Failed {
+                at: Some(0.4),
+                reason: Some("spun".into())
+            }
+        );
+        // `cdbo lap --json`'s own report of a failed lap.
+        assert_eq!(
+            parse_output(
+                r#"{"completed": false, "reward_mps": 0.0, "failure": {"reason": "spun", "x": 0.4}}"#
+            ),
             Outcome::Failed {
                 at: Some(0.4),
                 reason: Some("spun".into())
