@@ -98,7 +98,7 @@ impl Lap {
                 self.distance_fail_m.unwrap_or(0.0),
                 self.x_fail.unwrap_or(0.0)
             ),
-            _ => "-".into(),
+            _ => "–".into(),
         }
     }
 }
@@ -146,7 +146,7 @@ pub fn run(args: &CompareArgs, data: &DataPath) -> CliResult {
     for track in &args.tracks {
         let r = compare_track(&game, track, args, &pool, data)?;
         eprintln!(
-            "{}: demo {}; policies agree {}/{}, lap-time error {:.2} %",
+            "{}: demo {}; policies agree {}/{}, lap-time error {}",
             r.track,
             r.demos
                 .iter()
@@ -155,7 +155,7 @@ pub fn run(args: &CompareArgs, data: &DataPath) -> CliResult {
                 .join(", "),
             r.policies.agree,
             r.policies.drawn,
-            100.0 * r.policies.lap_time_error_mean.unwrap_or(f64::NAN)
+            percent(r.policies.lap_time_error_mean)
         );
         reports.push(r);
     }
@@ -299,7 +299,7 @@ fn compare_track(
 fn pct(a: Option<f64>, b: Option<f64>) -> String {
     match (a, b) {
         (Some(a), Some(b)) => format!("{:+.2} %", 100.0 * (a - b) / b),
-        _ => "-".into(),
+        _ => "–".into(),
     }
 }
 
@@ -344,10 +344,9 @@ fn markdown(reports: &[TrackReport], args: &CompareArgs) -> String {
     );
     for r in reports {
         let p = &r.policies;
-        let opt = |v: Option<f64>| v.map_or("-".into(), |v| format!("{:.2} %", 100.0 * v));
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} / {} | {} / {} ({:.0} %) | {} | {} / {} | {} | {:.1} s |",
+            "| {} | {} | {} | {} / {} | {} / {} ({}) | {} | {} / {} | {} | {:.1} s |",
             r.track,
             r.learned.cdbo.cell(),
             r.learned.torcs.cell(),
@@ -355,12 +354,14 @@ fn markdown(reports: &[TrackReport], args: &CompareArgs) -> String {
             p.completed_torcs,
             p.agree,
             p.drawn,
-            100.0 * p.agree as f64 / p.drawn as f64,
+            (p.drawn > 0)
+                .then(|| p.agree as f64 / p.drawn as f64)
+                .map_or("–".into(), |f| format!("{:.0} %", 100.0 * f)),
             p.both_completed,
-            opt(p.lap_time_error_mean),
-            opt(p.lap_time_error_max),
+            percent(p.lap_time_error_mean),
+            percent(p.lap_time_error_max),
             p.lap_time_bias
-                .map_or("-".into(), |v| format!("{:+.2} %", 100.0 * v)),
+                .map_or("–".into(), |v| format!("{:+.2} %", 100.0 * v)),
             p.torcs_wall_s
         );
     }
@@ -370,7 +371,7 @@ fn markdown(reports: &[TrackReport], args: &CompareArgs) -> String {
         args.robot, args.robot, args.robot
     );
     for r in reports {
-        let t = |v: Option<f64>| v.map_or("-".into(), |v| format!("{v:.2} s"));
+        let t = |v: Option<f64>| v.map_or("–".into(), |v| format!("{v:.2} s"));
         let _ = writeln!(
             s,
             "| {} | {:.2} s | {} | {} | {} |",
@@ -382,4 +383,24 @@ fn markdown(reports: &[TrackReport], args: &CompareArgs) -> String {
         );
     }
     s
+}
+
+/// A fraction as a percentage with two decimals, or "–" where nothing could be computed (no
+/// policy completed in both simulators): never "NaN".
+fn percent(fraction: Option<f64>) -> String {
+    fraction
+        .filter(|f| f.is_finite())
+        .map_or("–".into(), |f| format!("{:.2} %", 100.0 * f))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::percent;
+
+    #[test]
+    fn a_percentage_that_cannot_be_computed_is_a_dash_not_nan() {
+        assert_eq!(percent(Some(0.0123)), "1.23 %");
+        assert_eq!(percent(None), "–");
+        assert_eq!(percent(Some(f64::NAN)), "–");
+    }
 }
