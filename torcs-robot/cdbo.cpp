@@ -343,18 +343,27 @@ void new_track(int, tTrack *track, void *, void **settings, tSituation *) {
     if (lap.cfg.time_limit <= 0.0) lap.cfg.time_limit = 30.0 + track->length / 4.0;
 }
 
-void new_race(int, tCarElt *car, tSituation *) {
+// Where the car stands on the grid, as a distance along the lap: a grid behind the start line
+// (a station short of the length, as on corkscrew) is a negative distance, so that the lap is
+// the grid's distance to the line plus one length, and never read as driving backwards.
+void place_on_grid(tCarElt *car) {
     lap.last_station = car->_distFromStartLine;
-    // The grid puts the car on the start line: a station just short of the length is -epsilon.
     if (lap.last_station > 0.5 * lap.track->length) lap.last_station -= lap.track->length;
     lap.distance = lap.last_station;
     lap.farthest = lap.distance;
 }
 
+void new_race(int, tCarElt *car, tSituation *) { place_on_grid(car); }
+
 void drive(int, tCarElt *car, tSituation *s) {
     memset((void *)&car->ctrl, 0, sizeof(tCarCtrl));
     double now = s->currentTime;
     if (!lap.error.empty()) finish(0.0, now, nullptr, 0.0);
+    if (now < 0.0 || lap.start_time < 0.0) {
+        // Before the first step of the race the car's station may not be set yet at new_race:
+        // place it again where the game has put it.
+        place_on_grid(car);
+    }
     if (now < 0.0) {
         // The count-down before the start: stand on the brake, as the car does at t < 0 in cdbo.
         car->_brakeCmd = 1.0;
