@@ -34,6 +34,20 @@ pub enum TorcsCommand {
     /// cdbo's simulator against the game: demonstrations, full throttle, policies drawn
     /// around a learned one, speed along the lap, the limit against a built-in robot.
     Compare(super::torcs_compare::CompareArgs),
+    /// Time every shipped TORCS robot that can drive the car: its standing first lap and its
+    /// best (flying) lap of two, alone, from a clean start, headless — the table cdbo's
+    /// learned laps are judged against — beside cdbo's QSS limit on the centre line.
+    Robots {
+        /// TORCS track name.
+        #[arg(long, default_value = "forza")]
+        track: String,
+        /// TORCS car name.
+        #[arg(long, default_value = torcs::DEFAULT_CAR)]
+        car: String,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 #[derive(Debug, Serialize)]
@@ -58,6 +72,7 @@ fn report(game: &Game) -> SetupReport {
 pub fn run(cmd: &TorcsCommand, data: &cdbo::data_path::DataPath) -> CliResult {
     match cmd {
         TorcsCommand::Compare(args) => super::torcs_compare::run(args, data),
+        TorcsCommand::Robots { track, car, json } => robots(track, car, *json),
         TorcsCommand::Setup { json } => {
             let install = Install::find()?;
             let game = torcs::setup(&install, &torcs::sdk_dir()?, &torcs::cache_dir()?)?;
@@ -123,4 +138,97 @@ pub fn run(cmd: &TorcsCommand, data: &cdbo::data_path::DataPath) -> CliResult {
             Ok(())
         }
     }
+}
+
+/// One shipped robot's laps, or why it drove none.
+#[derive(Debug, Serialize)]
+struct RobotLaps {
+    robot: String,
+    /// The first lap from the standing start (s).
+    first_lap_s: Option<f64>,
+    /// The best of its two laps, the second a flying one (s).
+    best_lap_s: Option<f64>,
+    /// Why it drove no lap.
+    error: Option<String>,
+}
+
+/// `cdbo torcs robots`: every robot of the installed game but the human driver and cdbo's own
+/// (those with a `drivers/NAME/NAME.xml`), one at a time, fastest standing first lap first.
+fn robots(track: &str, car: &str, json: bool) -> CliResult {
+    let game = Game::ready()?;
+    let req = game.request(track, car, GamePedal::Demo(15.0))?;
+    let data = cdbo::data_path::DataPath::new(std::slice::from_ref(&game.install.data_dir));
+    let limit = cdbo::limit::limit_lap(&cdbo::track::catalog::find(track, &data)?, &req.car);
+    let drivers = game.install.data_dir.join("drivers");
+    let mut names: Vec<String> = std::fs::read_dir(&drivers)
+        .map_err(|e| format!("{}: {e}", drivers.display()))?
+        .filter_map(|d| Some(d.ok()?.file_name().to_string_lossy().into_owned()))
+        .filter(|n| n != "human" && n != torcs::ROBOT)
+        .filter(|n| drivers.join(n).join(format!("{n}.xml")).is_file())
+        .collect();
+    names.sort();
+    let mut laps: Vec<RobotLaps> = names
+        .into_iter()
+        .map(|robot| {
+            let laps = game.robot_laps(&robot, track, car);
+            if !json {
+                eprintln!(
+                    "{robot}: {}",
+                    laps.as_ref().map_or_else(
+                        |e| e.to_string(),
+                        |l| format!("first lap {:.2} s, best {:?} s", l.0, l.1)
+                    )
+                );
+            }
+            RobotLaps {
+                first_lap_s: laps.as_ref().ok().map(|l| l.0),
+                best_lap_s: laps.as_ref().ok().and_then(|l| l.1),
+                error: laps.err().map(|e| e.to_string()),
+                robot,
+            }
+        })
+        .collect();
+    laps.sort_by(|a, b| {
+        let key = |r: &RobotLaps| r.first_lap_s.unwrap_or(f64::INFINITY);
+        key(a).total_cmp(&key(b))
+    });
+    #[derive(Serialize)]
+    struct Table {
+        track: String,
+        car: String,
+        limit_lap_time_s: f64,
+        robots: Vec<RobotLaps>,
+    }
+    let table = Table {
+        track: track.to_owned(),
+        car: car.to_owned(),
+        limit_lap_time_s: limit.lap_time_s,
+        robots: laps,
+    };
+    if json {
+        return print_json(&table);
+    }
+    println!(
+        "{} on {}, each robot alone from a standing start; cdbo's QSS limit on the centre line {:.2} s",
+        table.car, table.track, table.limit_lap_time_s
+    );
+    println!("| robot | standing first lap | best (flying) lap | first lap / limit |");
+    println!("| --- | --- | --- | --- |");
+    for r in &table.robots {
+        let s = |v: Option<f64>| v.map_or("–".into(), |v| format!("{v:.2} s"));
+        println!(
+            "| {} | {} | {} | {} |",
+            r.robot,
+            r.first_lap_s.map_or_else(
+                || format!("– ({})", r.error.as_deref().unwrap_or("no lap")),
+                |v| format!("{v:.2} s")
+            ),
+            s(r.best_lap_s),
+            r.first_lap_s.map_or("–".into(), |v| format!(
+                "{:.1} %",
+                100.0 * table.limit_lap_time_s / v
+            )),
+        );
+    }
+    Ok(())
 }

@@ -119,9 +119,9 @@ pub fn robot_xml(car: &str, settings: &str) -> String {
     )
 }
 
-/// A one-car quick race of `laps` laps on `track` (in `category`): driver 0 of `robot` on
+/// A one-car quick race of `laps` laps on `track` (in `category`): driver `idx` of `robot` on
 /// the start line.
-fn race_xml(track: &str, category: &str, robot: &str, laps: usize) -> String {
+fn race_xml(track: &str, category: &str, robot: &str, idx: usize, laps: usize) -> String {
     format!(
         r#"<?xml version="1.0" encoding="UTF-8"?>
 <!DOCTYPE params SYSTEM "params.dtd">
@@ -158,13 +158,26 @@ fn race_xml(track: &str, category: &str, robot: &str, laps: usize) -> String {
   <section name="Drivers">
     <attnum name="maximum number" val="1"/>
     <section name="1">
-      <attnum name="idx" val="0"/>
+      <attnum name="idx" val="{idx}"/>
       <attstr name="module" val="{robot}"/>
     </section>
   </section>
 </params>
 "#
     )
+}
+
+/// The index of a robot's first driver in its `drivers/NAME/NAME.xml`: the first numbered
+/// section of its `Robots/index` (0 for most, 1 for the berniw family); 0 if none is found.
+fn first_driver(robot_xml: &str) -> usize {
+    let Some(index) = robot_xml.find("name=\"index\"") else {
+        return 0;
+    };
+    robot_xml[index..]
+        .split("<section name=\"")
+        .skip(1)
+        .find_map(|rest| rest.split('"').next()?.parse().ok())
+        .unwrap_or(0)
 }
 
 /// The robot's settings file (format in `torcs-robot/cdbo.cpp`).
@@ -291,7 +304,7 @@ impl Game {
             ),
             (
                 dir.0.join("race.xml"),
-                race_xml(&req.track, &category, ROBOT, 2),
+                race_xml(&req.track, &category, ROBOT, 0, 2),
             ),
         ];
         for (path, text) in &files {
@@ -404,8 +417,9 @@ impl Game {
     }
 
     /// A built-in robot (`bt`, `berniw`, ...) driving `car` on `track` for two laps from the
-    /// same standing start: (the first lap's time, the best lap's time) in seconds.
-    pub fn robot_laps(&self, robot: &str, track: &str, car: &str) -> Result<(f64, f64)> {
+    /// same standing start: (the first lap's time, the best lap's time) in seconds; no best
+    /// lap where the game records none (0: the robot did not finish its second lap).
+    pub fn robot_laps(&self, robot: &str, track: &str, car: &str) -> Result<(f64, Option<f64>)> {
         let category = self.install.track_category(track)?;
         self.install.check_car(car)?;
         let xml = self
@@ -442,7 +456,7 @@ impl Game {
             })
             .collect::<Vec<_>>()
             .join("\n");
-        let race = race_xml(track, &category, robot, 2);
+        let race = race_xml(track, &category, robot, first_driver(&original), 2);
         let files = [
             (robot_dir.join(format!("{robot}.xml")), ours),
             (dir.0.join("race.xml"), race),
@@ -474,7 +488,7 @@ impl Game {
             .and_then(|t| t.parse::<f64>().ok());
         let best = find_number(&dir.0.join("results"), "best lap time")?;
         match (first, best) {
-            (Some(first), Some(best)) => Ok((first, best)),
+            (Some(first), Some(best)) => Ok((first, (best > 0.0).then_some(best))),
             _ => Err(Error::External {
                 program: format!("the TORCS robot {robot} on {track} in {car}"),
                 message: format!(
@@ -602,4 +616,20 @@ fn tail(path: &Path) -> String {
         .unwrap_or("no output")
         .trim()
         .to_owned()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::first_driver;
+
+    #[test]
+    fn a_robots_first_driver_is_its_first_numbered_index_section() {
+        let berniw = r#"<section name="Robots"><section name="index">
+            <section name="1"><attstr name="name" val="berniw 1"/></section>
+            <section name="2"></section></section></section>"#;
+        assert_eq!(first_driver(berniw), 1);
+        let bt = r#"<section name="Robots"><section name="index"><section name="0">"#;
+        assert_eq!(first_driver(bt), 0);
+        assert_eq!(first_driver("<params/>"), 0);
+    }
 }
