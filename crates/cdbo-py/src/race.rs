@@ -42,14 +42,14 @@ impl PyRaceResult {
     #[getter]
     fn best(&self) -> PyPolicy {
         PyPolicy {
-            policy: self.outcome.best.clone(),
+            policy: self.outcome.best.pedal.clone(),
         }
     }
 
     #[getter]
     fn initial(&self) -> PyPolicy {
         PyPolicy {
-            policy: self.outcome.initial.clone(),
+            policy: self.outcome.initial.pedal.clone(),
         }
     }
 

@@ -9,7 +9,7 @@
 //! - [`sim`]: the vehicle model and the lap evaluator.
 //! - [`drive`]: the environment's controllers (steering, demonstrator).
 //! - [`limit`]: the quasi-steady-state minimum lap time.
-//! - [`policy`]: policies π(x), the paper's RKHS policy and (x, a) tables.
+//! - [`policy`]: policies π(x), the paper's RKHS policy, policies with a line, (x, a) tables.
 //! - [`gp`], [`acquisition`], [`optimizers`]: the Gaussian process, UCB / EI and the generic
 //!   ask/tell optimisers of weights in Rᵈ, CDBO first.
 //! - [`learner`]: learners that know they learn laps (the pattern search and its repairs).
@@ -44,7 +44,8 @@
 //!     .policy(w0.lengthscale)?
 //!     .track_length(sim.track.length)?
 //!     .optimizer(w0.weights.clone())?;
-//! let mut laps = SimEvaluator { sim, lengthscale: w0.lengthscale };
+//! let shape = PolicyShape::pedal(Block::new(kernels, w0.lengthscale)?);
+//! let mut laps = SimEvaluator { sim, shape };
 //! for trial in 1..=20 {
 //!     let weights = optimizer.ask()?;
 //!     let outcome = laps.evaluate(trial, &weights)?;

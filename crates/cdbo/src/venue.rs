@@ -4,10 +4,10 @@
 //! evaluator of a race's laps, so that no caller branches on which venue it is.
 
 use crate::car::Car;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::evaluator::Evaluator;
 use crate::evaluator::simulator::SimEvaluator;
-use crate::policy::RkhsPolicy;
+use crate::policy::{Policy, PolicyShape};
 use crate::sim::{LapResult, Simulator};
 use crate::torcs::evaluator::{TorcsEvaluator, drive};
 use crate::torcs::{Game, GamePedal, LapRequest};
@@ -65,29 +65,46 @@ impl Venue {
     }
 
     /// One lap of `policy`, traced.
-    pub fn drive(&self, policy: &RkhsPolicy) -> Result<LapResult> {
+    pub fn drive(&self, policy: &Policy) -> Result<LapResult> {
         match self {
-            Venue::Simulator(sim) => Ok(traced(sim).lap(&mut policy.pedal())),
-            Venue::Game { game, request } => {
-                drive(game, &recorded(request), GamePedal::Rkhs(policy.clone()))
-            }
+            Venue::Simulator(sim) => Ok(traced(sim).lap(&mut policy.driver())),
+            Venue::Game { game, request } => drive(
+                game,
+                &recorded(request),
+                GamePedal::Rkhs(policy.pedal_only().ok_or_else(line_in_game)?.clone()),
+            ),
         }
     }
 
-    /// The evaluator of policy weights of length-scale `lengthscale` here.
-    pub fn evaluator(&self, lengthscale: f64) -> Box<dyn Evaluator + Send> {
-        match self {
+    /// The evaluator of policy weights of shape `shape` here; the game's robot drives the
+    /// pedal only, on its centre line, so a shape with a line is refused there.
+    pub fn evaluator(&self, shape: PolicyShape) -> Result<Box<dyn Evaluator + Send>> {
+        Ok(match self {
             Venue::Simulator(sim) => Box::new(SimEvaluator {
                 sim: sim.as_ref().clone(),
-                lengthscale,
+                shape,
             }),
-            Venue::Game { game, request } => Box::new(TorcsEvaluator {
-                game: game.clone(),
-                request: request.as_ref().clone(),
-                lengthscale,
-            }),
-        }
+            Venue::Game { game, request } => {
+                if shape.line.is_some() {
+                    return Err(line_in_game());
+                }
+                Box::new(TorcsEvaluator {
+                    game: game.clone(),
+                    request: request.as_ref().clone(),
+                    lengthscale: shape.pedal.lengthscale,
+                })
+            }
+        })
     }
+}
+
+/// The game's robot drives the pedal only, on the centre line.
+fn line_in_game() -> Error {
+    Error::invalid_value(
+        "a policy's line in the game TORCS",
+        "a line d(x)",
+        "none: cdbo's robot steers the centre line (drive the line in cdbo's simulator)",
+    )
 }
 
 /// The simulator, recording a trace of its laps.

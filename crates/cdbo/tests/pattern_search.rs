@@ -660,10 +660,10 @@ fn a_study_told_the_laps_length_drives_the_races_laps() {
             StudyConfig {
                 method: config.method,
                 kernels: config.kernels,
-                lengthscale: raced.initial.lengthscale,
+                lengthscale: raced.initial.pedal.lengthscale,
                 seed: config.seed,
                 beta: config.beta,
-                w0: raced.initial.weights.clone(),
+                w0: raced.initial.weights(),
                 track: None,
                 track_length,
                 knob: None,
@@ -673,7 +673,8 @@ fn a_study_told_the_laps_length_drives_the_races_laps() {
         let rewards: Vec<f64> = (0..config.laps)
             .map(|_| {
                 let trial = study.ask().unwrap();
-                let policy = RkhsPolicy::new(trial.weights, raced.initial.lengthscale).unwrap();
+                let policy =
+                    RkhsPolicy::new(trial.weights, raced.initial.pedal.lengthscale).unwrap();
                 let lap = sim.lap(&mut policy.pedal());
                 study
                     .tell(trial.id, &Outcome::of_lap(&lap, length))

@@ -219,3 +219,34 @@ fn standing_start_acceleration_is_that_of_a_290_kw_car() {
         .expect("reaches 100 km/h");
     assert!((3.5..7.0).contains(&t100), "0-100 km/h in {t100} s");
 }
+
+/// A policy's line moves the car: the demonstration's fitted pedal with a line d(x) = 2 m runs
+/// Ridgeway's lap 2 m left of the centre line (the median offset within 0.3 m; the PI
+/// look-ahead cuts corners), and a line beyond the road (d = ±50 m) is held at its bound,
+/// the road's half-width less half the car's width.
+#[test]
+fn a_policys_line_moves_the_car_within_the_road() {
+    use cdbo::policy::{Policy, RkhsPolicy};
+    let mut sim = Simulator::new(builtin("ridgeway"), &Car::spirit_300());
+    let (_, pairs) = sim.demonstrate(15.0);
+    let pedal = RkhsPolicy::fit(&pairs, 30, 1.0 / 29.0, 1e-3).unwrap();
+    sim.config.trace = true;
+    let half_width = sim.track.samples[0].width / 2.0;
+    let bound = half_width - Car::spirit_300().width / 2.0;
+    for (d, expected) in [(2.0, 2.0), (50.0, bound), (-50.0, -bound)] {
+        let flat: Vec<(f64, f64)> = (0..=100).map(|i| (i as f64 / 100.0, d)).collect();
+        let policy = Policy {
+            pedal: pedal.clone(),
+            line: Some(RkhsPolicy::fit(&flat, 10, 1.0 / 9.0, 1e-9).unwrap()),
+        };
+        let lap = sim.lap(&mut policy.driver());
+        assert!(lap.completed, "d = {d}: {:?}", lap.failure);
+        let mut lateral: Vec<f64> = lap.trace.iter().map(|p| p.lateral).collect();
+        lateral.sort_by(f64::total_cmp);
+        let median = lateral[lateral.len() / 2];
+        assert!(
+            (median - expected).abs() < 0.3,
+            "d = {d}: median offset {median} m, expected {expected} m"
+        );
+    }
+}

@@ -96,7 +96,7 @@ pub fn run(args: &LapArgs, data: &DataPath, simulator: Simulator) -> CliResult {
             Box::new(ConstantPedal(a))
         }
         (_, _, Some(path)) if path.extension().is_some_and(|e| e == "json") => {
-            Box::new(super::policy::read_policy(path)?.pedal())
+            Box::new(super::policy::read_policy(path)?.driver())
         }
         (_, _, Some(path)) => Box::new(PolicyTable::read_csv(path)?),
         (speed, _, _) => {
@@ -151,7 +151,7 @@ fn run_torcs(args: &LapArgs, data: &DataPath) -> CliResult {
             GamePedal::Constant(a)
         }
         (_, _, Some(path)) if path.extension().is_some_and(|e| e == "json") => {
-            GamePedal::Rkhs(super::policy::read_policy(path)?)
+            GamePedal::Rkhs(super::policy::read_pedal_policy(path, "the game's robot")?)
         }
         (_, _, Some(path)) => GamePedal::Table(PolicyTable::read_csv(path)?.points().to_vec()),
         (speed, _, _) => {

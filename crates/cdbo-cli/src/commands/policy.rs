@@ -6,8 +6,8 @@ use clap::Subcommand;
 
 use super::CliResult;
 use cdbo::bounded;
-use cdbo::policy::RkhsPolicy;
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
+use cdbo::policy::{Policy, RkhsPolicy};
 
 #[derive(Debug, Subcommand)]
 pub enum PolicyCommand {
@@ -29,7 +29,7 @@ pub enum PolicyCommand {
         #[arg(short, long, value_name = "FILE.json")]
         output: PathBuf,
     },
-    /// Print a policy's (x, a) table as CSV.
+    /// Print a policy's (x, a) table as CSV (x, a, d with a line: its offset d(x) in metres).
     Table {
         /// Weights written by `cdbo policy fit` (JSON).
         weights: PathBuf,
@@ -69,24 +69,43 @@ pub fn run(cmd: &PolicyCommand) -> CliResult {
         }
         PolicyCommand::Table { weights, points } => {
             let policy = read_policy(weights)?;
-            println!("x,a");
-            for (x, a) in policy.table(*points) {
-                println!("{x:.6},{a:.6}");
+            if policy.line.is_some() {
+                println!("x,a,d");
+                for (x, a, d) in policy.table(*points) {
+                    println!("{x:.6},{a:.6},{d:.6}");
+                }
+            } else {
+                println!("x,a");
+                for (x, a, _) in policy.table(*points) {
+                    println!("{x:.6},{a:.6}");
+                }
             }
             Ok(())
         }
     }
 }
 
-/// Reads policy weights written by `cdbo policy fit`.
-pub fn read_policy(path: &Path) -> Result<RkhsPolicy, Box<dyn std::error::Error>> {
+/// Reads a policy written by `cdbo policy fit` or `cdbo race` (a one-action policy is the
+/// paper's file; a line adds its own block).
+pub fn read_policy(path: &Path) -> Result<Policy, Box<dyn std::error::Error>> {
     let text = bounded::read_text(path, &bounded::POLICY_FILE)?;
-    let p: RkhsPolicy = serde_json::from_str(&text)
-        .map_err(|e| format!("{}: not policy weights: {e}", path.display()))?;
-    Ok(
-        RkhsPolicy::new(p.weights, p.lengthscale)
-            .map_err(|e| format!("{}: {e}", path.display()))?,
-    )
+    Ok(Policy::from_json(&text, &path.display().to_string())?)
+}
+
+/// Reads a pedal-only policy for `user`, which drives the centre line.
+pub fn read_pedal_policy(
+    path: &Path,
+    user: &str,
+) -> Result<RkhsPolicy, Box<dyn std::error::Error>> {
+    let policy = read_policy(path)?;
+    match policy.pedal_only() {
+        Some(pedal) => Ok(pedal.clone()),
+        None => Err(format!(
+            "{}: a policy with a line d(x); {user} drives the pedal only, on the centre line",
+            path.display()
+        )
+        .into()),
+    }
 }
 
 /// Reads a demonstration's (x, a) pairs ([`cdbo::policy::demo`]).

@@ -11,7 +11,7 @@ use super::{CliResult, Setup, Simulator, from_flag, print_json};
 use cdbo::data_path::DataPath;
 use cdbo::experiment::race::{RaceConfig, RaceOutcome, race};
 use cdbo::method::{KnobKind, Method};
-use cdbo::policy::RkhsPolicy;
+use cdbo::policy::Policy;
 
 #[derive(Debug, Args)]
 pub struct RaceArgs {
@@ -146,7 +146,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     let (_, ceiling_mps) = cdbo::ceiling::tracked_profile(&ceiling_sim, &outcome.limit)?;
     write_outputs(&out, &outcome)?;
     // The speed plots re-drive the initial and best policies where the race was driven.
-    let drive = |p: &RkhsPolicy| venue.drive(p);
+    let drive = |p: &Policy| venue.drive(p);
     write_plots(&out, &track, &outcome, &drive)?;
     let best_lap = outcome
         .laps
@@ -267,7 +267,7 @@ fn write_plots(
     out: &Path,
     track: &cdbo::track::Track,
     o: &RaceOutcome,
-    drive: &dyn Fn(&RkhsPolicy) -> Result<cdbo::sim::LapResult, cdbo::Error>,
+    drive: &dyn Fn(&Policy) -> Result<cdbo::sim::LapResult, cdbo::Error>,
 ) -> CliResult {
     use crate::figures::{LineChart, draw, speed_chart, speed_map};
     use plotters::style::{BLACK, BLUE, GREEN, RED};
@@ -303,12 +303,12 @@ fn write_plots(
             (
                 "initial π(w₀)".into(),
                 GREEN,
-                xs.clone().map(|x| (x, o.initial.action(x))).collect(),
+                xs.clone().map(|x| (x, o.initial.pedal.action(x))).collect(),
             ),
             (
                 "best".into(),
                 BLUE,
-                xs.map(|x| (x, o.best.action(x))).collect(),
+                xs.map(|x| (x, o.best.pedal.action(x))).collect(),
             ),
         ],
     };
@@ -329,14 +329,20 @@ fn write_plots(
     Ok(())
 }
 
-fn write_policy(out: &Path, name: &str, p: &RkhsPolicy) -> CliResult {
+/// The policy as JSON and as its (x, a) table, with the line's offset d (m) when it has one.
+fn write_policy(out: &Path, name: &str, p: &Policy) -> CliResult {
     std::fs::write(
         out.join(format!("{name}.json")),
         serde_json::to_string_pretty(p)?,
     )?;
-    let mut csv = String::from("x,a\n");
-    for (x, a) in p.table(1001) {
-        csv += &format!("{x:.6},{a:.6}\n");
+    let line = p.line.is_some();
+    let mut csv = String::from(if line { "x,a,d\n" } else { "x,a\n" });
+    for (x, a, d) in p.table(1001) {
+        csv += &if line {
+            format!("{x:.6},{a:.6},{d:.6}\n")
+        } else {
+            format!("{x:.6},{a:.6}\n")
+        };
     }
     std::fs::write(out.join(format!("{name}.csv")), csv)?;
     Ok(())

@@ -9,8 +9,8 @@ use super::{CliResult, Setup, Simulator};
 use cdbo::data_path::DataPath;
 use cdbo::evaluator::Evaluator;
 use cdbo::optimizers::{DEFAULT_BOX_RADIUS, SearchBox};
-use cdbo::policy::RkhsPolicy;
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
+use cdbo::policy::{Block, PolicyShape, RkhsPolicy};
 use cdbo::serve::{Info, Server};
 use cdbo::track::Track;
 
@@ -32,7 +32,7 @@ pub fn run(args: &ServeSimArgs, data: &DataPath, simulator: Simulator) -> CliRes
     let (venue, track, car) = super::venue(&args.setup, data, simulator)?;
     let limit = cdbo::limit::limit_lap(&track, &car);
     let (_, demo) = venue.demonstrate(args.demo_speed)?;
-    let evaluator = venue.evaluator(default_lengthscale(args.kernels));
+    let evaluator = venue.evaluator(PolicyShape::pedal(Block::paper(args.kernels)?))?;
     serve(args, &track, &limit, &demo, evaluator)
 }
 

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use clap::{Args, Subcommand, ValueEnum};
 
-use super::policy::{read_demo, read_policy};
+use super::policy::{read_demo, read_pedal_policy};
 use super::{CliResult, from_flag, print_json};
 use cdbo::method::Method;
 use cdbo::policy::RkhsPolicy;
@@ -91,7 +91,7 @@ impl InitialPolicy {
                 RkhsPolicy::fit(&read_demo(demo)?, self.kernels, lengthscale, DEFAULT_RIDGE)
                     .map_err(|e| format!("{}: {e}", demo.display()))?
             }
-            (None, Some(w)) => read_policy(w)?,
+            (None, Some(w)) => read_pedal_policy(w, "a study")?,
             (None, None) => {
                 return Err("give the initial policy: --demo demo.csv or --weights w0.json".into());
             }

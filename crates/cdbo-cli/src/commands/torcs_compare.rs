@@ -214,7 +214,7 @@ fn compare_track(
         &config,
         |_| {},
     )?;
-    let best = learned.best.clone();
+    let best = learned.best.pedal.clone();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(args.seed);
     let drawn: Vec<RkhsPolicy> = (0..args.policies)
         .map(|_| {

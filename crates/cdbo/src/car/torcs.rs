@@ -81,6 +81,7 @@ pub fn from_params(p: &Params) -> Result<Car> {
 
     let mass = positive(car, "mass", car.require_num("mass")?)?;
     let cg_height = positive(car, "GC height", car.num_or("GC height", 0.3)?)?;
+    let width = positive(car, "body width", car.num_or("body width", 1.9)?)?;
     let front_weight = fraction(
         car,
         "front-rear weight repartition",
@@ -229,6 +230,7 @@ pub fn from_params(p: &Params) -> Result<Car> {
         cg_height,
         front_weight,
         wheelbase,
+        width,
         yaw_inertia_factor,
         cx,
         front_area,

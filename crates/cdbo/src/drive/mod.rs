@@ -2,7 +2,8 @@
 //!
 //! A lap is driven by a [`Pedal`] (the optimised policy, the demonstrator or a constant), which
 //! maps the observation — chiefly x, the fraction of the lap — to a ∈ [−1, 1] (throttle > 0,
-//! brake < 0). Steering is the environment's [`steering::Steering`] controller, never optimised.
+//! brake < 0), and may name a line d(x) to hold (the centre line unless it does). Steering is
+//! the environment's [`steering::Steering`] controller, which holds that line.
 
 pub mod demo;
 pub mod steering;
@@ -18,10 +19,17 @@ pub struct Observation {
     pub time: f64,
 }
 
-/// A throttle/brake command source.
+/// What drives a lap: the throttle/brake command, and the line to hold.
 pub trait Pedal {
     /// The command a ∈ [−1, 1] for this observation.
     fn pedal(&mut self, obs: &Observation) -> f64;
+
+    /// The line d(x) at lap fraction x: the offset (m, positive left) from the centre line
+    /// the steering holds, before the lap bounds it to the road; 0, the centre line, unless
+    /// the driver has a line of its own (a [`crate::policy::Policy`] with a line).
+    fn line(&self, _x: f64) -> f64 {
+        0.0
+    }
 }
 
 /// The same command everywhere (`cdbo lap --throttle A`).

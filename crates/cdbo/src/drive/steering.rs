@@ -1,7 +1,9 @@
 //! The steering controller: a PI controller on the heading error towards a look-ahead point
 //! of the centre line (the paper's PI steering, with look-ahead).
 //!
-//! The target is the centre-line point d = max(d_min, t_la·v) ahead of the car's station.
+//! The target is the point of the line the driver holds (the centre line unless its
+//! [`Pedal::line`](super::Pedal::line) names another, [`Track::point_off`]) d = max(d_min,
+//! t_la·v) ahead of the car's station.
 //! With e the angle between the car's heading and the line to the target,
 //! δ = clamp(K_p·e + K_i·∫e dt, −δ_max, δ_max), with K_p = 2L/d (the small-angle gain of
 //! pure pursuit for wheelbase L, so the loop's bandwidth is independent of speed) and
@@ -13,7 +15,7 @@
 //! checked against them (`tests/robot_drive.rs`).
 
 use super::pi_control;
-use crate::sim::vehicle::State;
+use crate::sim::vehicle::{State, Vehicle};
 use crate::track::{Projection, Track};
 
 /// Look-ahead time (s).
@@ -53,21 +55,31 @@ impl Steering {
     }
 
     /// The road-wheel angle (rad) for the car in `state` at `proj`, after `dt` seconds: the
-    /// [`steering_law`] on the [`bearing`] of the centre-line point [`Self::lookahead`]
-    /// metres ahead of the car's station.
+    /// [`steering_law`] on the [`bearing`] of the line's point [`Self::lookahead`] metres ahead
+    /// of the car's station, the line `line(s)` metres left of the centre line at station s.
     pub fn update(
         &mut self,
         track: &Track,
-        wheelbase: f64,
-        steer_lock: f64,
+        vehicle: &Vehicle,
         state: &State,
         proj: &Projection,
+        line: &dyn Fn(f64) -> f64,
         dt: f64,
     ) -> f64 {
         let d = self.lookahead(state.speed());
-        let (tx, ty) = track.point_at(proj.s + d);
+        let s = proj.s + d;
+        let (tx, ty) = track.point_off(s, line(track.wrap(s)));
         let e = bearing(tx - state.x, ty - state.y, state.yaw_sin_cos);
-        steering_law(e, d, wheelbase, self.ki, steer_lock, &mut self.integral, dt)
+        let car = &vehicle.car;
+        steering_law(
+            e,
+            d,
+            car.wheelbase,
+            self.ki,
+            car.steer_lock,
+            &mut self.integral,
+            dt,
+        )
     }
 
     /// The look-ahead distance d = max(d_min, t_la·v) (m) at speed v (m/s).

@@ -1,23 +1,23 @@
-//! The simulator as an evaluator: one lap of the RKHS policy with the given weights.
+//! The simulator as an evaluator: one lap of the policy with the given weights.
 
 use super::{Evaluator, Outcome};
 use crate::error::Result;
-use crate::policy::RkhsPolicy;
+use crate::policy::PolicyShape;
 use crate::sim::Simulator;
 
-/// Laps of the simulator with RKHS policies of a fixed length-scale.
+/// Laps of the simulator with policies of one shape (each action's kernels and length-scale).
 #[derive(Debug, Clone)]
 pub struct SimEvaluator {
     /// The simulator.
     pub sim: Simulator,
-    /// The policy kernels' length-scale.
-    pub lengthscale: f64,
+    /// The shape of the policies' weights.
+    pub shape: PolicyShape,
 }
 
 impl Evaluator for SimEvaluator {
     fn evaluate(&mut self, _trial: i64, weights: &[f64]) -> Result<Outcome> {
-        let policy = RkhsPolicy::new(weights.to_vec(), self.lengthscale)?;
-        let lap = self.sim.lap(&mut policy.pedal());
+        let policy = self.shape.policy(weights)?;
+        let lap = self.sim.lap(&mut policy.driver());
         Ok(Outcome::of_lap(&lap, self.sim.track.length))
     }
 }
@@ -26,6 +26,7 @@ impl Evaluator for SimEvaluator {
 mod tests {
     use super::*;
     use crate::car::Car;
+    use crate::policy::{Block, RkhsPolicy};
 
     /// The evaluator reports the simulator's own lap: the time of a completed lap over the
     /// track's length, and where and why a failed lap failed.
@@ -39,7 +40,7 @@ mod tests {
         let policy = RkhsPolicy::fit(&steady, 8, 1.0 / 7.0, 1e-3).unwrap();
         let mut e = SimEvaluator {
             sim: sim.clone(),
-            lengthscale: policy.lengthscale,
+            shape: PolicyShape::pedal(Block::new(8, policy.lengthscale).unwrap()),
         };
         let lap = sim.lap(&mut policy.pedal());
         let outcome = e.evaluate(1, &policy.weights).unwrap();

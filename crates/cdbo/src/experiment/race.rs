@@ -8,8 +8,8 @@ use crate::error::{Error, Result};
 use crate::evaluator::{Evaluator, Outcome};
 use crate::limit::{Limit, limit_lap};
 use crate::method::{Method, Spec};
-use crate::policy::RkhsPolicy;
 use crate::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
+use crate::policy::{Block, Policy, PolicyShape, RkhsPolicy};
 use crate::sim::{FailureReason, LapResult};
 use crate::study::run::{Event, InMemory, run};
 use crate::track::Track;
@@ -94,9 +94,9 @@ pub struct RaceOutcome {
     /// The demonstration's (x, a) pairs.
     pub demo_pairs: Vec<(f64, f64)>,
     /// The fitted initial policy.
-    pub initial: RkhsPolicy,
+    pub initial: Policy,
     /// The best policy found.
-    pub best: RkhsPolicy,
+    pub best: Policy,
     /// Its reward.
     pub best_reward_mps: f64,
     /// Every optimisation lap.
@@ -116,7 +116,8 @@ pub fn race(
 ) -> Result<RaceOutcome> {
     let limit = limit_lap(track, car);
     let demo = venue.demonstrate(config.demo_speed)?;
-    let mut evaluator = venue.evaluator(default_lengthscale(config.kernels));
+    let shape = PolicyShape::pedal(Block::paper(config.kernels)?);
+    let mut evaluator = venue.evaluator(shape)?;
     race_with(
         &track.name,
         demo,
@@ -159,14 +160,20 @@ fn race_with(
         });
     }
     let lengthscale = default_lengthscale(config.kernels);
-    let initial = RkhsPolicy::fit(&demo_pairs, config.kernels, lengthscale, DEFAULT_RIDGE)?;
+    let initial = Policy::from(RkhsPolicy::fit(
+        &demo_pairs,
+        config.kernels,
+        lengthscale,
+        DEFAULT_RIDGE,
+    )?);
+    let shape = initial.shape();
     let optimizer = config
         .spec()?
         .policy(lengthscale)?
         .track_length(limit.track_length)?
-        .optimizer(initial.weights.clone())?;
+        .optimizer(initial.weights())?;
     let mut laps = Vec::with_capacity(config.laps);
-    let mut best = (initial.weights.clone(), 0.0);
+    let mut best = (initial.weights(), 0.0);
     let mut source = InMemory::new(optimizer, config.laps);
     run(&mut source, evaluator, &mut |event| {
         let Event::Told {
@@ -204,7 +211,7 @@ fn race_with(
         demo,
         demo_pairs,
         initial,
-        best: RkhsPolicy::new(best.0, lengthscale)?,
+        best: shape.policy(&best.0)?,
         best_reward_mps: best.1,
         laps,
         limit,

@@ -196,8 +196,8 @@ pub fn run_at(
         ceiling_reward_mps,
         initial_reward_mps: outcome.laps.first().map_or(0.0, |l| l.reward_mps),
         best_reward_mps: outcome.best_reward_mps,
-        best_weights: outcome.best.weights.clone(),
-        lengthscale: outcome.best.lengthscale,
+        best_weights: outcome.best.weights(),
+        lengthscale: outcome.best.pedal.lengthscale,
         laps: outcome.laps,
         wall_s: start.elapsed().as_secs_f64(),
     })

@@ -1,8 +1,11 @@
-//! Driving policies π(x): the pedal command as a function of the lap fraction x ∈ [0, 1].
+//! Driving policies: the pedal command as a function of the lap fraction x ∈ [0, 1] and,
+//! optionally, the line to hold ([`actions`]: one RKHS block per action).
 
+pub mod actions;
 pub mod demo;
 pub mod rkhs;
 pub mod table;
 
+pub use actions::{Block, Policy, PolicyShape};
 pub use rkhs::RkhsPolicy;
 pub use table::PolicyTable;

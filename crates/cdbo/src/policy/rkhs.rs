@@ -4,6 +4,8 @@
 //!
 //! The initial weights fit a demonstration's (xⱼ, aⱼ) by ridge regression (eq. 8–9):
 //! w₀ = [ΦᵀΦ + λI]⁻¹Φᵀa, Φⱼᵢ = φᵢ(xⱼ).
+//!
+//! The same block wᵀφ(x), unclamped, is a policy's line d(x) ([`super::actions`]).
 
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
@@ -221,7 +223,9 @@ pub fn features_into(x: f64, lengthscale: f64, out: &mut [f64]) {
     }
 }
 
-fn check_shape(kernels: usize, lengthscale: f64) -> Result<()> {
+/// Refuses fewer than 2 kernels (or more than the size bound) and a length-scale that is not
+/// finite and positive.
+pub(crate) fn check_shape(kernels: usize, lengthscale: f64) -> Result<()> {
     if kernels < 2 {
         return Err(Error::too_small("policy kernels", kernels, 2));
     }

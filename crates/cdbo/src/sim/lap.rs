@@ -2,7 +2,10 @@
 //!
 //! The car starts standing on the start line, on the centre line, facing along it. Every
 //! physics step (4 ms) the car is projected on the centre line; every driver step (20 ms) the
-//! pedal and the steering controller update their commands, which are held in between. The lap
+//! pedal and the steering controller update their commands, which are held in between. The
+//! steering holds the driver's line ([`Pedal::line`]: the centre line unless the driver names
+//! another), bounded to the road: at station s the offset d(s/L) is clamped to
+//! ±max(0, w(s)/2 − w_car/2), the road's half-width less half the car's width. The lap
 //! ends when the car has covered the track's length, or fails when:
 //! - **off track**: the car's centre is more than width/2 + 1 m from the centre line;
 //! - **spun**: the car faces more than 90° away from the track, or slides with a body slip
@@ -220,7 +223,7 @@ impl Simulator {
     pub fn lap(&self, pedal: &mut dyn Pedal) -> LapResult {
         let track = &self.track;
         let cfg = &self.config;
-        let car = &self.vehicle.car;
+        let half_car = 0.5 * self.vehicle.car.width;
         let start = track.sample(0);
         let mut state: State = self.vehicle.at_rest(start.x, start.y, start.heading);
         let mut steering = cfg.steering.clone();
@@ -256,14 +259,11 @@ impl Simulator {
                     speed: state.speed(),
                     time: t,
                 }));
-                let steer = steering.update(
-                    track,
-                    car.wheelbase,
-                    car.steer_lock,
-                    &state,
-                    &proj,
-                    driver_dt,
-                );
+                let line = |s: f64| {
+                    let bound = (track.frame(track.index_at(s)).half_width - half_car).max(0.0);
+                    pedal.line(s / track.length).clamp(-bound, bound)
+                };
+                let steer = steering.update(track, &self.vehicle, &state, &proj, &line, driver_dt);
                 controls = Controls::new(steer, a.max(0.0), (-a).max(0.0));
                 self.vehicle.shift(&mut state, controls.throttle());
                 if cfg.trace {

@@ -233,6 +233,25 @@ impl Track {
         )
     }
 
+    /// The point `d` metres left of the centre line (right if negative) at station `s`:
+    /// c(s) + d·n(s), n = (−sin θ, cos θ) the left normal at the heading θ = θᵢ + κᵢ·(s − sᵢ)
+    /// along the arc from the sample before it; the centre-line point itself when d = 0.
+    #[inline]
+    pub fn point_off(&self, s: f64, d: f64) -> (f64, f64) {
+        let (x, y) = self.point_at(s);
+        if d == 0.0 {
+            return (x, y);
+        }
+        let s = self.wrap(s);
+        let f = &self.frames[self.index_at(s)];
+        let (sin, cos) = (f.curvature * (s - f.s)).sin_cos();
+        let (sin_heading, cos_heading) = (
+            f.sin_heading * cos + f.cos_heading * sin,
+            f.cos_heading * cos - f.sin_heading * sin,
+        );
+        (x - d * sin_heading, y + d * cos_heading)
+    }
+
     /// Projects (x, y) on the centre line, searching from `hint` (the last known index).
     ///
     /// Walks sample to sample while the point's tangential offset d = (p − cᵢ)·tᵢ lies outside
