@@ -138,6 +138,9 @@ pub struct Car {
     pub rear_brake: Brake,
     /// Largest road-wheel steering angle (rad).
     pub steer_lock: f64,
+    /// Overall width of the body (m), TORCS `Car/overall width` (else `body width`): how
+    /// much of the road a racing line leaves between the car's centre and the edge.
+    pub width: f64,
 }
 
 impl Car {
@@ -211,6 +214,7 @@ impl Car {
                 pad_mu: 0.25,
             },
             steer_lock: 45f64.to_radians(),
+            width: 1.90,
         }
     }
 

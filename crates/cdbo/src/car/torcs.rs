@@ -59,6 +59,13 @@ fn find_category(car: &Path, cat: &str) -> Option<PathBuf> {
 /// Rolling resistance of TORCS's asphalt surfaces (`data/tracks/surfaces.xml`).
 const ASPHALT_ROLLING_RESISTANCE: f64 = 0.001;
 
+/// The car's overall width (m): `overall width`, else `body width` (the names of TORCS's
+/// `car.h`), else 1.9 m.
+fn car_width(car: &Section) -> Result<f64> {
+    let body = car.num_or("body width", 1.9)?;
+    car.num_or("overall width", body)
+}
+
 /// Builds a car from (merged) parameters.
 pub fn from_params(p: &Params) -> Result<Car> {
     let empty = Section::default();
@@ -263,6 +270,7 @@ pub fn from_params(p: &Params) -> Result<Car> {
             "steer lock",
             sec("Steer").num_or("steer lock", 0.43)?,
         )?,
+        width: positive(car, "overall width", car_width(car)?)?,
     })
 }
 
