@@ -2,7 +2,7 @@
 //! arc length.
 //!
 //! Periodic cubic splines x(u), y(u) run through the line's points pⱼ, u the chord length
-//! from p₀ (within a part in 10⁴ of the arc length at 3 m spacing and 50 m radius); the track
+//! from p₀ (within 2 parts in 10⁴ of the arc length at 3 m spacing and 50 m radius); the track
 //! samples them every ≈ [`TARGET_DS`] m of u, with heading atan2(y′, x′) and curvature
 //! κ = (x′y″ − y′x″)/(x′² + y′²)^{3/2}. Each sample takes the road of the centre-line station
 //! it lies across (linear in u between stations): its banking β, width, friction and rolling
