@@ -289,6 +289,21 @@ mod tests {
     }
 
     #[test]
+    fn a_road_narrower_than_the_car_and_its_margins_is_refused_naming_where() {
+        let options = LineOptions {
+            margin_m: 1.45,
+            spacing_m: crate::line::SPACING,
+        };
+        let e = RacingLine::minimum_curvature(&circle(100.0, 2.5), &options)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("the road of circle at 0 m") && e.contains("2.50 m wide"),
+            "{e}"
+        );
+    }
+
+    #[test]
     fn a_circles_line_is_the_circle_along_its_outer_edge() {
         let (r, width) = (100.0, 12.0);
         let options = LineOptions {
