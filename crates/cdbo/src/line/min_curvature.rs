@@ -20,8 +20,8 @@
 //!
 //! **Quadratic programme.** Each step minimises ‖S·(J·d + κ(dᵏ) − J·dᵏ)‖², i.e.
 //! ½dᵀPd + qᵀd with P = 2S²JᵀJ (five non-zeros a row) and q = 2S²Jᵀ(κ(dᵏ) − J·dᵏ), over the
-//! box of the road (and of a trust radius, halved whenever a step raised Σκ² instead of
-//! lowering it), S = [`SCALE`]. Clarabel, a sparse interior-point solver, solves it; the
+//! box of the road (and of a trust radius, none at first, half the rejected step's largest
+//! move whenever a step raised Σκ² instead of lowering it), S = [`SCALE`]. Clarabel, a sparse interior-point solver, solves it; the
 //! iteration re-linearises at the new offsets until they move by less than [`TOLERANCE`]
 //! (as TUMFTM's iterative variant re-linearises around each solution). The centre line is
 //! resampled every ≈ [`super::SPACING`] m, so Forza's 5.8 km make about 1,900 unknowns.
