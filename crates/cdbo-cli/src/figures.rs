@@ -34,6 +34,8 @@ pub struct TrackMap<'a> {
     pub track: &'a Track,
     /// (distance, speed) along a lap to colour by, or `None` for the curvature.
     pub speeds: Option<&'a [(f64, f64)]>,
+    /// A racing line's points to draw beside the centre line, with its name.
+    pub line: Option<(&'a str, &'a [[f64; 2]])>,
 }
 
 impl Figure for TrackMap<'_> {
@@ -41,7 +43,7 @@ impl Figure for TrackMap<'_> {
     where
         DB::ErrorType: 'static,
     {
-        track_map(root, self.track, self.speeds)
+        track_map(root, self)
     }
 }
 
@@ -228,18 +230,16 @@ pub fn speed_map(path: &Path, track: &Track, lap: &LapResult) -> CliResult {
         &TrackMap {
             track,
             speeds: Some(&speeds),
+            line: None,
         },
     )
 }
 
-fn track_map<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
-    t: &Track,
-    speeds: Option<&[(f64, f64)]>,
-) -> CliResult
+fn track_map<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, map: &TrackMap) -> CliResult
 where
     DB::ErrorType: 'static,
 {
+    let (t, speeds) = (map.track, map.speeds);
     let edge = |side: f64| -> Vec<(f64, f64)> {
         t.samples
             .iter()
@@ -302,12 +302,25 @@ where
             BLACK.stroke_width(1),
         )))?;
     }
+    if let Some((_, points)) = map.line {
+        chart.draw_series(std::iter::once(PathElement::new(
+            points
+                .iter()
+                .chain(points.first())
+                .map(|p| (p[0], p[1]))
+                .collect::<Vec<_>>(),
+            MAGENTA.stroke_width(1),
+        )))?;
+    }
     let s0 = &t.samples[0];
     chart.draw_series(std::iter::once(Circle::new((s0.x, s0.y), 6, RED.filled())))?;
-    let label = match speeds {
+    let mut label = match speeds {
         Some(_) => format!("speed 0 .. {vmax:.1} m/s (dark → bright); red dot: start"),
         None => format!("|curvature| 0 .. {vmax:.3} 1/m (dark → bright); red dot: start"),
     };
+    if let Some((name, _)) = map.line {
+        label += &format!("; magenta: the {name}");
+    }
     root.draw(&Text::new(
         label,
         (80, (SIZE.1 - 30) as i32),

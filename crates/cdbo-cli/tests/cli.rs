@@ -97,6 +97,21 @@ fn full_throttle_on_forza_names_where_it_failed() {
 fn limit_and_bench_print_their_keys() {
     let v = json(&["limit", "--json"]);
     assert!(v["lap_time_s"].as_f64().unwrap() > 0.0 && v["reward_mps"].as_f64().unwrap() > 0.0);
+    // The minimum-curvature line's limit beside it, its speed the centre line's length over
+    // its lap time.
+    let line = &v["min_curvature_line"];
+    let (t, r) = (
+        line["lap_time_s"].as_f64().unwrap(),
+        line["reward_mps"].as_f64().unwrap(),
+    );
+    assert!(t < v["lap_time_s"].as_f64().unwrap(), "{line}");
+    assert!(
+        (r * t - v["track_length_m"].as_f64().unwrap()).abs() < 1e-6,
+        "{line}"
+    );
+    for key in ["line_length_m", "max_offset_m", "margin_m", "iterations"] {
+        assert!(line[key].as_f64().unwrap() > 0.0, "{key}");
+    }
     let v = json(&["bench", "sim", "--laps", "1", "--json"]);
     for key in ["laps", "simulated_s", "wall_s", "realtime_factor"] {
         assert!(v[key].as_f64().unwrap() > 0.0, "{key}");
@@ -128,6 +143,21 @@ fn traces_and_plots_are_written() {
         trace.to_str().unwrap(),
     ]);
     assert!(std::fs::read_to_string(&svg).unwrap().contains("<svg"));
+    let lined = scratch("line.svg", "");
+    succeed(&[
+        "plot",
+        "track",
+        "ridgeway",
+        "-o",
+        lined.to_str().unwrap(),
+        "--line",
+        "min-curvature",
+    ]);
+    let text = std::fs::read_to_string(&lined).unwrap();
+    assert!(
+        text.contains("magenta: the minimum-curvature line"),
+        "{text}"
+    );
 }
 
 const TRACK: &str = r#"<?xml version="1.0"?>

@@ -71,6 +71,7 @@ pub mod gp;
 pub mod interp;
 pub mod learner;
 pub mod limit;
+pub mod line;
 pub mod method;
 pub mod optimizers;
 pub mod params;

@@ -17,10 +17,15 @@
 //!
 //! It ignores rotating inertia, gear-shift time and the driver's reaction, and grants both
 //! axles their full grip at once, so no lap of the simulator can beat it.
+//!
+//! [`line_limit`] drives the same QSS lap along a racing line ([`crate::line`]), on the line's
+//! own curvature and arc length; its speed is the *centre line's* length over its lap time, so
+//! that it compares with [`limit_lap`]'s, the reference every "% of the limit" uses.
 
 use serde::Serialize;
 
 use crate::car::{Car, Drive};
+use crate::line::RacingLine;
 use crate::sim::tyre::TyreModel;
 use crate::sim::vehicle::G;
 use crate::track::Track;
@@ -38,6 +43,40 @@ pub struct Limit {
     /// The lap's length L (m), R = L/T.
     #[serde(skip)]
     pub track_length: f64,
+}
+
+/// The limit lap along a racing line.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LineLimit {
+    /// The lap on the line: its time T (s); its `reward_mps` is L/T with L the *centre
+    /// line's* length, comparable with the centre line's limit; its `speed` is along the
+    /// line's own samples ([`RacingLine::path`]).
+    #[serde(flatten)]
+    pub limit: Limit,
+    /// The line's length (m).
+    pub line_length_m: f64,
+    /// The largest lateral offset of the line from the centre line (m).
+    pub max_offset_m: f64,
+    /// Distance kept from the car's centre to the road's edge (m).
+    pub margin_m: f64,
+    /// Quadratic programmes solved for the line.
+    pub iterations: usize,
+}
+
+/// The QSS limit lap of `car` along `line`, a racing line on `track`: [`limit_lap`] on
+/// [`RacingLine::path`], its reward the centre line's length over the lap time.
+pub fn line_limit(track: &Track, line: &RacingLine, car: &Car) -> LineLimit {
+    let path = line.path(track);
+    let mut limit = limit_lap(&path, car);
+    limit.reward_mps = track.length / limit.lap_time_s;
+    limit.track_length = track.length;
+    LineLimit {
+        limit,
+        line_length_m: path.length,
+        max_offset_m: line.max_offset(),
+        margin_m: line.margin_m,
+        iterations: line.iterations,
+    }
 }
 
 /// Computes the QSS limit lap of `car` on `track`.

@@ -40,7 +40,7 @@ pub fn run(args: &CeilingArgs, data: &DataPath) -> CliResult {
         format!("none completes within {} laps", cdbo::ceiling::REPAIR_LAPS)
     };
     println!(
-        "{} on {}: limit {:.2} m/s; tracking {:.3} x the limit's speed profile {:.2} m/s ({:.1} % of the limit); {}-kernel policy fitted to its pedal, repaired where it fails: {}",
+        "{} on {}: centre-line limit {:.2} m/s; tracking {:.3} x the limit's speed profile {:.2} m/s ({:.1} % of the centre-line limit); {}-kernel policy fitted to its pedal, repaired where it fails: {}",
         car.name,
         name,
         c.limit_mps,

@@ -253,7 +253,7 @@ pub fn run_grid(args: &ExperimentArgs, data: &DataPath, simulator: Simulator) ->
             let k = done.fetch_add(1, Ordering::Relaxed) + 1;
             bar.set_message(format!("{k}/{} runs", runs.len()));
             let line = format!(
-                "{k}/{}: {}: best {:.2} m/s ({:.0} % of the limit) in {:.1} s",
+                "{k}/{}: {}: best {:.2} m/s ({:.0} % of the centre-line limit) in {:.1} s",
                 runs.len(),
                 spec.id(),
                 record.best_reward_mps,
@@ -351,7 +351,7 @@ fn shared_grid(
                         Progress::Ran(r) => {
                             let k = ran.fetch_add(1, Ordering::Relaxed) + 1;
                             say(format!(
-                                "ran {}: best {:.2} m/s ({:.0} % of the limit) in {:.1} s ({k} by this worker)",
+                                "ran {}: best {:.2} m/s ({:.0} % of the centre-line limit) in {:.1} s ({k} by this worker)",
                                 r.spec.id(),
                                 r.best_reward_mps,
                                 100.0 * r.best_reward_mps / r.limit_reward_mps,

@@ -205,7 +205,7 @@ fn print_report(report: LapReport, json: bool) -> CliResult {
     }
     match (report.lap_time_s, report.failure) {
         (Some(t), _) => println!(
-            "{} on {}: lap {:.2} s, reward {:.2} m/s ({:.1} % of the limit {:.2} s, {:.2} m/s; {:.1} % of the ceiling {:.2} m/s)",
+            "{} on {}: lap {:.2} s, reward {:.2} m/s ({:.1} % of the centre-line limit {:.2} s, {:.2} m/s; {:.1} % of the ceiling {:.2} m/s)",
             report.car,
             report.track,
             t,

@@ -131,7 +131,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     let progress = |r: &cdbo::experiment::race::LapRecord| {
         bar.set_position(r.lap as u64);
         bar.set_message(format!(
-            "best {:.2} m/s ({:.0}% of the limit)",
+            "best {:.2} m/s ({:.0}% of the centre-line limit)",
             r.best_mps,
             100.0 * r.best_mps / limit_reward
         ));
@@ -181,7 +181,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         return print_json(&summary);
     }
     println!(
-        "{} on {}, {} kernels, {} laps: best lap {} at {:.2} m/s, {:.1} % of the limit ({:.2} m/s), {:.1} % of the ceiling ({:.2} m/s), {:.2}x the demonstration ({:.2} m/s); {} laps failed",
+        "{} on {}, {} kernels, {} laps: best lap {} at {:.2} m/s, {:.1} % of the centre-line limit ({:.2} m/s), {:.1} % of the ceiling ({:.2} m/s), {:.2}x the demonstration ({:.2} m/s); {} laps failed",
         summary.method,
         summary.track,
         summary.kernels,

@@ -397,7 +397,7 @@ fn results_md(
         };
         let _ = writeln!(s, "- {}: {verdict}. {}", c.statement, c.evidence);
     }
-    s += "\n## Final best reward (m/s), mean ± standard error\n\n% of the ceiling: of the tracked limit profile's lap (`cdbo ceiling`), where the runs recorded it; failed laps: mean per run.\n\n| track | kernels | method | runs | best | × demonstration | % of limit | % of ceiling | failed laps |\n|---|---:|---|---:|---:|---:|---:|---:|---:|\n";
+    s += "\n## Final best reward (m/s), mean ± standard error\n\n% of limit: of the quasi-steady-state limit on the centre line (`cdbo limit`, which gives the minimum-curvature line's beside it); % of the ceiling: of the tracked limit profile's lap (`cdbo ceiling`), where the runs recorded it; failed laps: mean per run.\n\n| track | kernels | method | runs | best | × demonstration | % of limit | % of ceiling | failed laps |\n|---|---:|---|---:|---:|---:|---:|---:|---:|\n";
     let demos = cell_means(records, |r| r.demo_reward_mps);
     let limits = cell_means(records, |r| r.limit_reward_mps);
     let ceilings = cell_means(records, |r| r.ceiling_reward_mps.unwrap_or(f64::NAN));

@@ -91,9 +91,6 @@ pub struct Car {
     pub front_weight: f64,
     /// Distance between the axles (m).
     pub wheelbase: f64,
-    /// Width of the body (m), TORCS `body width`: a line keeps the car's centre half of it
-    /// inside the road's edge.
-    pub width: f64,
     /// Yaw inertia factor k: I_z = k·m·a·b (TORCS `mass repartition coefficient`).
     pub yaw_inertia_factor: f64,
     /// Drag coefficient Cx.
@@ -141,6 +138,9 @@ pub struct Car {
     pub rear_brake: Brake,
     /// Largest road-wheel steering angle (rad).
     pub steer_lock: f64,
+    /// Overall width of the body (m), TORCS `Car/overall width` (else `body width`): how
+    /// much of the road a racing line leaves between the car's centre and the edge.
+    pub width: f64,
 }
 
 impl Car {
@@ -184,7 +184,6 @@ impl Car {
             cg_height: 0.285,
             front_weight: 0.44,
             wheelbase: 1.235 + 1.5,
-            width: 1.90,
             yaw_inertia_factor: 0.62,
             cx: 0.32,
             front_area: 1.85,
@@ -215,6 +214,7 @@ impl Car {
                 pad_mu: 0.25,
             },
             steer_lock: 45f64.to_radians(),
+            width: 1.90,
         }
     }
 

@@ -59,6 +59,13 @@ fn find_category(car: &Path, cat: &str) -> Option<PathBuf> {
 /// Rolling resistance of TORCS's asphalt surfaces (`data/tracks/surfaces.xml`).
 const ASPHALT_ROLLING_RESISTANCE: f64 = 0.001;
 
+/// The car's overall width (m): `overall width`, else `body width` (the names of TORCS's
+/// `car.h`), else 1.9 m.
+fn car_width(car: &Section) -> Result<f64> {
+    let body = car.num_or("body width", 1.9)?;
+    car.num_or("overall width", body)
+}
+
 /// Builds a car from (merged) parameters.
 pub fn from_params(p: &Params) -> Result<Car> {
     let empty = Section::default();
@@ -81,7 +88,6 @@ pub fn from_params(p: &Params) -> Result<Car> {
 
     let mass = positive(car, "mass", car.require_num("mass")?)?;
     let cg_height = positive(car, "GC height", car.num_or("GC height", 0.3)?)?;
-    let width = positive(car, "body width", car.num_or("body width", 1.9)?)?;
     let front_weight = fraction(
         car,
         "front-rear weight repartition",
@@ -230,7 +236,6 @@ pub fn from_params(p: &Params) -> Result<Car> {
         cg_height,
         front_weight,
         wheelbase,
-        width,
         yaw_inertia_factor,
         cx,
         front_area,
@@ -265,6 +270,7 @@ pub fn from_params(p: &Params) -> Result<Car> {
             "steer lock",
             sec("Steer").num_or("steer lock", 0.43)?,
         )?,
+        width: positive(car, "overall width", car_width(car)?)?,
     })
 }
 
