@@ -84,6 +84,20 @@ fn a_demo_lap_reports_reward_and_limit() {
 }
 
 #[test]
+fn the_path_tracker_drives_a_lap_and_lifts_the_ceiling() {
+    let pi = json(&["lap", "--json"]);
+    let tracker = json(&["lap", "--steering", "tracker", "--json"]);
+    assert_eq!(tracker["completed"], true);
+    let ceiling = |v: &serde_json::Value| v["ceiling_reward_mps"].as_f64().unwrap();
+    assert!(
+        ceiling(&tracker) > ceiling(&pi) + 5.0,
+        "{} against {}",
+        ceiling(&tracker),
+        ceiling(&pi)
+    );
+}
+
+#[test]
 fn full_throttle_on_forza_names_where_it_failed() {
     let v = json(&["lap", "--track", "forza", "--throttle", "1", "--json"]);
     assert_eq!(v["completed"], false);
@@ -526,6 +540,10 @@ fn simulator_torcs_is_refused_where_it_is_not_supported() {
     let works = "--simulator torcs works with `lap`, `race`, `experiment`, `serve-sim` and `optimize --track T`";
     fails_with(&["--simulator", "torcs", "limit"], &[works]);
     fails_with(&["--simulator", "torcs", "ceiling"], &[works]);
+    fails_with(
+        &["--simulator", "torcs", "lap", "--steering", "tracker"],
+        &["--steering", "PI law only"],
+    );
     // A grid in the game runs in a folder; workers over storage drive cdbo's simulator only.
     let grid_db = scratch("torcs-grid.db", "");
     std::fs::remove_file(&grid_db).unwrap();

@@ -4,6 +4,7 @@
 //! evaluator of a race's laps, so that no caller branches on which venue it is.
 
 use crate::car::Car;
+use crate::drive::steering::Steering;
 use crate::error::{Error, Result};
 use crate::evaluator::Evaluator;
 use crate::evaluator::simulator::SimEvaluator;
@@ -41,6 +42,23 @@ impl Venue {
             game: game.clone(),
             request: Box::new(request),
         })
+    }
+
+    /// This venue with the car steered by `steering`; the game's robot steers with the PI law
+    /// only, so the path tracker is refused there.
+    pub fn steered(self, steering: Steering) -> Result<Venue> {
+        match self {
+            Venue::Simulator(mut sim) => {
+                sim.config.steering = steering;
+                Ok(Venue::Simulator(sim))
+            }
+            Venue::Game { .. } if matches!(steering, Steering::Pi(_)) => Ok(self),
+            Venue::Game { .. } => Err(Error::invalid_value(
+                "the steering in the game TORCS",
+                "the path tracker",
+                "the PI steering: cdbo's robot steers with the PI law only",
+            )),
+        }
     }
 
     /// The car as cdbo reads it (for the limit and the plots).

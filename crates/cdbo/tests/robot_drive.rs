@@ -22,7 +22,7 @@ use std::sync::OnceLock;
 
 use cdbo::car::Car;
 use cdbo::drive::demo::{self, SpeedHold};
-use cdbo::drive::steering::{self, Steering};
+use cdbo::drive::steering::{self, PiSteering};
 use cdbo::drive::{Observation, Pedal, pedal_command, pi_control};
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 use cdbo::policy::{PolicyTable, RkhsPolicy};
@@ -216,7 +216,7 @@ fn the_robots_decisions_are_the_rust_ones_on_recorded_laps() {
         .chain(map.upshift.iter().flatten().copied())
         .chain([DOWNSHIFT_MARGIN, car.shift_time])
         .collect::<Vec<f64>>();
-    let steer = Steering::new();
+    let steer = PiSteering::new();
     let dt = sim.config.dt * sim.config.driver_every as f64;
     let (mut upshifts, mut downshifts, mut top_gear, mut slipping) = (0, 0, 0, 0);
     for (lap, trace) in [("demonstration", &demo), ("learned policy", &fast)] {

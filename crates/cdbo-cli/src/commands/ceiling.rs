@@ -3,7 +3,7 @@
 use clap::Args;
 
 use super::{CliResult, Setup, print_json};
-use cdbo::ceiling::ceiling;
+use cdbo::ceiling::ceiling_with;
 use cdbo::data_path::DataPath;
 
 #[derive(Debug, Args)]
@@ -13,6 +13,9 @@ pub struct CeilingArgs {
     /// Policy kernels M of the fitted policy.
     #[arg(long, default_value_t = 30)]
     kernels: usize,
+    /// How the car steers.
+    #[arg(long, value_enum, default_value_t)]
+    steering: super::SteeringChoice,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -24,7 +27,10 @@ pub fn run(args: &CeilingArgs, data: &DataPath) -> CliResult {
     }
     let (track, car) = args.setup.load(data)?;
     let name = track.name.clone();
-    let c = ceiling(track, &car, args.kernels)?;
+    let limit = cdbo::limit::limit_lap(&track, &car);
+    let mut sim = cdbo::sim::Simulator::new(track, &car);
+    sim.config.steering = args.steering.steering();
+    let c = ceiling_with(&sim, &limit, args.kernels)?;
     if args.json {
         return print_json(&c);
     }

@@ -29,6 +29,9 @@ pub struct LapArgs {
     /// `cdbo race`, `cdbo policy fit` and `cdbo optimize`).
     #[arg(long, value_name = "FILE")]
     policy: Option<PathBuf>,
+    /// How the car steers.
+    #[arg(long, value_enum, default_value_t)]
+    steering: super::SteeringChoice,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -111,6 +114,7 @@ pub fn run(args: &LapArgs, data: &DataPath, simulator: Simulator) -> CliResult {
     };
     let limit = limit_lap(&track, &car);
     let mut sim = cdbo::sim::Simulator::new(track, &car);
+    sim.config.steering = args.steering.steering();
     sim.config.trace = args.trace.is_some() || args.plot.is_some();
     let lap = sim.lap(pedal.as_mut());
     if let Some(path) = &args.trace {
@@ -137,6 +141,7 @@ pub fn run(args: &LapArgs, data: &DataPath, simulator: Simulator) -> CliResult {
 /// A lap in the game TORCS, driven by cdbo's robot; the limit is cdbo's, on the game's track
 /// and car files.
 fn run_torcs(args: &LapArgs, data: &DataPath) -> CliResult {
+    super::check_game_steering(Simulator::Torcs, args.steering)?;
     if args.plot.is_some() {
         return Err(
             "--plot needs cdbo's simulator; with --simulator torcs write --trace and plot it"

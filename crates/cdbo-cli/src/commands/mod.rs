@@ -22,6 +22,8 @@ use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 
 use cdbo::car::{Car, catalog as cars};
 use cdbo::data_path::DataPath;
+use cdbo::drive::steering::Steering;
+use cdbo::drive::tracker::PathTracker;
 use cdbo::method::Method;
 use cdbo::track::{Ends, Track, builtin, catalog as tracks};
 use cdbo::venue::Venue;
@@ -54,6 +56,36 @@ impl Simulator {
             _ => spec,
         }
     }
+}
+
+/// How the car steers (`--steering`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum SteeringChoice {
+    /// The paper's PI steering on a look-ahead point of the line (the default).
+    #[default]
+    Pi,
+    /// The path tracker: feed-forward from the path's curvature and the car's understeer
+    /// gradient, feedback on the previewed lateral error, yaw-rate damping (cdbo's simulator
+    /// only).
+    Tracker,
+}
+
+impl SteeringChoice {
+    /// The steering controller, with its documented gains.
+    pub fn steering(self) -> Steering {
+        match self {
+            SteeringChoice::Pi => Steering::default(),
+            SteeringChoice::Tracker => Steering::Tracker(PathTracker::new()),
+        }
+    }
+}
+
+/// Refuses a steering other than the PI in the game, whose robot steers with the PI law only.
+pub fn check_game_steering(simulator: Simulator, steering: SteeringChoice) -> CliResult {
+    if simulator == Simulator::Torcs && steering != SteeringChoice::Pi {
+        return Err("--steering: cdbo's robot in the game steers with the PI law only".into());
+    }
+    Ok(())
 }
 
 /// Where `--simulator` drives the laps of `setup`'s track and car, and cdbo's reading of them

@@ -48,6 +48,9 @@ pub struct RaceArgs {
     /// again (in the simulator a hard cap; default: no budget).
     #[arg(long, value_name = "N")]
     max_failed_laps: Option<usize>,
+    /// How the car steers.
+    #[arg(long, value_enum, default_value_t)]
+    steering: super::SteeringChoice,
     /// Output folder (default: runs/race-TRACK-METHOD-mM-sSEED).
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
@@ -104,7 +107,11 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     if let Some(w) = cdbo::method::cost::slow_race_warning(args.method, args.kernels, args.laps) {
         eprintln!("warning: {w}");
     }
+    super::check_game_steering(simulator, args.steering)?;
     let (venue, track, car) = super::venue(&args.setup, data, simulator)?;
+    let venue = venue
+        .steered(args.steering.steering())
+        .map_err(from_flag("--steering"))?;
     let track_name = track.name.clone();
     let out = args.out.clone().unwrap_or_else(|| {
         PathBuf::from("runs").join(format!(
@@ -142,7 +149,8 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     })?;
     bar.finish_and_clear();
     let wall_s = start.elapsed().as_secs_f64();
-    let ceiling_sim = cdbo::sim::Simulator::new(track.clone(), &car);
+    let mut ceiling_sim = cdbo::sim::Simulator::new(track.clone(), &car);
+    ceiling_sim.config.steering = args.steering.steering();
     let (_, ceiling_mps) = cdbo::ceiling::tracked_profile(&ceiling_sim, &outcome.limit)?;
     write_outputs(&out, &outcome)?;
     // The speed plots re-drive the initial and best policies where the race was driven.

@@ -7,6 +7,7 @@
 
 pub mod demo;
 pub mod steering;
+pub mod tracker;
 
 /// What the driver sees at each driver step.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -1,6 +1,8 @@
-//! The steering controller: a PI controller on the heading error towards a look-ahead point
-//! of the centre line (the paper's PI steering, with look-ahead).
+//! The steering controllers: [`Steering`] is the one a lap drives with — the paper's PI
+//! steering with look-ahead ([`PiSteering`], the default, below) or the path tracker
+//! ([`super::tracker::PathTracker`]: feed-forward, previewed feedback, yaw-rate damping).
 //!
+//! The PI steering is a PI controller on the heading error towards a look-ahead point.
 //! The target is the point of the line the driver holds (the centre line unless its
 //! [`Pedal::line`](super::Pedal::line) names another, [`Track::point_off`]) d = max(d_min,
 //! t_la·v) ahead of the car's station.
@@ -15,6 +17,7 @@
 //! checked against them (`tests/robot_drive.rs`).
 
 use super::pi_control;
+use super::tracker::PathTracker;
 use crate::sim::vehicle::{State, Vehicle};
 use crate::track::{Projection, Track};
 
@@ -25,9 +28,43 @@ pub const LOOKAHEAD_MIN: f64 = 12.0;
 /// Integral gain (1/s).
 pub const KI: f64 = 0.1;
 
-/// The steering controller: its gains and its memory.
+/// The steering a lap drives with.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Steering {
+pub enum Steering {
+    /// The paper's PI steering with look-ahead (the default).
+    Pi(PiSteering),
+    /// The path tracker.
+    Tracker(PathTracker),
+}
+
+impl Default for Steering {
+    fn default() -> Self {
+        Steering::Pi(PiSteering::new())
+    }
+}
+
+impl Steering {
+    /// The road-wheel angle (rad) for the car in `state` at `proj` holding the line `line(s)`
+    /// metres left of the centre line at station s, after `dt` seconds.
+    pub fn update(
+        &mut self,
+        track: &Track,
+        vehicle: &Vehicle,
+        state: &State,
+        proj: &Projection,
+        line: &dyn Fn(f64) -> f64,
+        dt: f64,
+    ) -> f64 {
+        match self {
+            Steering::Pi(pi) => pi.update(track, vehicle, state, proj, line, dt),
+            Steering::Tracker(tracker) => tracker.update(track, vehicle, state, proj, line),
+        }
+    }
+}
+
+/// The PI steering controller: its gains and its memory.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PiSteering {
     /// Look-ahead time t_la (s).
     pub lookahead_time: f64,
     /// Shortest look-ahead distance d_min (m).
@@ -37,9 +74,9 @@ pub struct Steering {
     integral: f64,
 }
 
-impl Default for Steering {
+impl Default for PiSteering {
     fn default() -> Self {
-        Steering {
+        PiSteering {
             lookahead_time: LOOKAHEAD_TIME,
             lookahead_min: LOOKAHEAD_MIN,
             ki: KI,
@@ -48,10 +85,10 @@ impl Default for Steering {
     }
 }
 
-impl Steering {
+impl PiSteering {
     /// A fresh controller with the documented gains.
-    pub fn new() -> Steering {
-        Steering::default()
+    pub fn new() -> PiSteering {
+        PiSteering::default()
     }
 
     /// The road-wheel angle (rad) for the car in `state` at `proj`, after `dt` seconds: the

@@ -150,7 +150,8 @@ pub struct LapConfig {
     pub time_limit: Option<f64>,
     /// Record a trace of every driver step.
     pub trace: bool,
-    /// The steering controller (its gains; its memory starts empty each lap).
+    /// The steering controller (its gains; its memory starts empty each lap): the PI by
+    /// default.
     pub steering: Steering,
 }
 
@@ -162,7 +163,7 @@ impl Default for LapConfig {
             off_track_margin: 1.0,
             time_limit: None,
             trace: false,
-            steering: Steering::new(),
+            steering: Steering::default(),
         }
     }
 }

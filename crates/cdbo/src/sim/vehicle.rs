@@ -186,6 +186,18 @@ impl Vehicle {
         &self.tyres
     }
 
+    /// The cornering stiffness C_α (N/rad) of the front and rear axles at speed v on level road
+    /// of friction μ_r: the slope of the lateral force at zero slip, F_max·B·C, with the
+    /// axle's budget F_max = F_z·μ·μ_r·λ(F_z/2) under its static load and its downforce at v.
+    pub fn cornering_stiffness(&self, speed: f64, friction: f64) -> [f64; 2] {
+        let v2 = speed * speed;
+        [0, 1].map(|k| {
+            let fz = self.static_load[k] + self.downforce_per_v2[k] * v2;
+            let tyre = &self.tyres[k];
+            tyre.axle_max_force(fz, friction) * tyre.b * tyre.c
+        })
+    }
+
     /// The weights of the front and rear axles' spin in the drive speed the gearbox reads.
     pub fn driven(&self) -> [f64; 2] {
         self.driven

@@ -20,6 +20,7 @@ use serde::Deserialize;
 use super::{Game, ROBOT};
 use crate::bounded;
 use crate::car::Car;
+use crate::drive::steering::Steering;
 use crate::error::{Error, Result};
 use crate::policy::RkhsPolicy;
 use crate::sim::lap::{Failure, LapConfig, LapResult, TracePoint};
@@ -181,7 +182,13 @@ fn first_driver(robot_xml: &str) -> usize {
 }
 
 /// The robot's settings file (format in `torcs-robot/cdbo.cpp`).
-fn settings(req: &LapRequest, output: &Path, trace: Option<&Path>, time_limit: f64) -> String {
+/// Refused for the path tracker: the robot steers with the PI law only.
+fn settings(
+    req: &LapRequest,
+    output: &Path,
+    trace: Option<&Path>,
+    time_limit: f64,
+) -> Result<String> {
     let car = &req.car;
     let vehicle = Vehicle::new(car);
     let list = |v: &mut dyn Iterator<Item = f64>| {
@@ -207,7 +214,13 @@ fn settings(req: &LapRequest, output: &Path, trace: Option<&Path>, time_limit: f
     };
     let _ = writeln!(s, "pedal {pedal}");
     let _ = writeln!(s, "wheelbase {:e}", car.wheelbase);
-    let st = &req.config.steering;
+    let Steering::Pi(st) = &req.config.steering else {
+        return Err(Error::invalid_value(
+            "the steering of a lap in the game TORCS",
+            "the path tracker",
+            "the PI steering: cdbo's robot steers with the PI law only",
+        ));
+    };
     let _ = writeln!(
         s,
         "steering {:e} {:e} {:e}",
@@ -229,7 +242,7 @@ fn settings(req: &LapRequest, output: &Path, trace: Option<&Path>, time_limit: f
     let _ = writeln!(s, "aid_slip {f:e} {r:e}");
     let _ = writeln!(s, "off_track_margin {:e}", req.config.off_track_margin);
     let _ = writeln!(s, "time_limit {time_limit:e}");
-    s
+    Ok(s)
 }
 
 impl Game {
@@ -300,7 +313,7 @@ impl Game {
             ),
             (
                 dir.0.join("lap.txt"),
-                settings(req, &output, trace.as_deref(), time_limit),
+                settings(req, &output, trace.as_deref(), time_limit)?,
             ),
             (
                 dir.0.join("race.xml"),

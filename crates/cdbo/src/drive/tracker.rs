@@ -1,0 +1,232 @@
+//! The path tracker: steering that holds any line d(x) at racing speed — feed-forward from
+//! the path's curvature and the car's understeer gradient, feedback on the lateral error
+//! previewed ahead, and yaw-rate feedback (the feed-forward and the previewed error after
+//! Kapania & Gerdes, *Design of a feedback-feedforward steering controller for accurate path
+//! tracking and stability at the limits of handling*, 2015).
+//!
+//! The path is the line P(s) = c(s) + d(s)·n(s), d metres left of the centre line at station
+//! s. With v the speed, e the car's lateral offset from the path, Δψ = ψ − θ_P its heading
+//! error and r its yaw rate, the tracker demands the curvature
+//!
+//! κ_d = κ_f − (2/x_p²)·(e + x_p·(Δψ − Δψ_ss))
+//!
+//! and steers δ = G·(κ_d + c·(κ_d − r/v)), clamped to ±δ_max, where
+//! - κ_f is the path's curvature t_f·v ahead (the car's yaw lags its steering);
+//! - x_p = max(x_min, t_p·v) is the preview distance: e + x_p·Δψ is the lateral error x_p
+//!   ahead, and the gain 2/x_p² makes it obey ë = −(2/t_p²)·e − (2/t_p)·ė on the kinematic
+//!   car, damped at ζ = 1/√2 whatever the speed;
+//! - Δψ_ss = κ_f·(m·a·v²/(L·C_r) − b) is the linear single-track car's steady-state heading
+//!   error (minus its body slip angle) on curvature κ_f, so that a steady corner is no error
+//!   (a, b the distances of the axles from the centre of gravity, C_r the rear axle's
+//!   cornering stiffness at this speed, [`Vehicle::cornering_stiffness`]);
+//! - G = max(L + K·v², L/4), with K = (m/L)·(b/C_f − a/C_r) the understeer gradient, is the
+//!   steering per unit of curvature in a steady corner (the floor keeps the sign of an
+//!   oversteering car's gain below its critical speed √(−L/K));
+//! - c·(κ_d − r/v) is the yaw-rate feedback: the steering grows while the car yaws less than
+//!   demanded, v·κ_d, and shrinks while it yaws more (a slide), with a gain c·G/v that shrinks
+//!   with speed as the car's yaw response v/G grows.
+//!
+//! On a circle of curvature κ the linear single-track car settles with e = 0, Δψ = Δψ_ss and
+//! r = v·κ, steering δ = (L + K·v²)·κ: there κ_d = κ, the feed-forward is the whole steady
+//! steering and the feedback's error vanishes (a car held at offset e turns on curvature
+//! κ/(1 − κe) and would need e·[κ² + (2/x_p²)·(1 + x_p·κ²·(m·a·v²/(L·C_r) − b))] = 0). The test
+//! `the_tracker_holds_an_offset_on_a_circle` checks this steady state on the simulator's car.
+
+use super::steering::bearing;
+use crate::sim::vehicle::{State, Vehicle};
+use crate::track::{Projection, Track};
+
+/// Preview time t_p (s). The gains were chosen by the ceiling (`cdbo ceiling --steering
+/// tracker`) on Ridgeway, Forza, Allondaz and E-Track 2: t_p from 0.2 to 0.9 s, x_min from 3
+/// to 10 m, t_f from 0 to 0.2 s and c from 0 to 8; the ceiling lies within 1 % of its best
+/// for t_p 0.3–0.4 s, t_f 0.1–0.2 s and c 2–4.
+pub const PREVIEW_TIME: f64 = 0.4;
+/// Shortest preview distance x_min (m).
+pub const PREVIEW_MIN: f64 = 10.0;
+/// Feed-forward preview time t_f (s).
+pub const FEEDFORWARD_TIME: f64 = 0.15;
+/// Yaw-rate gain c (dimensionless: the steering per unit of curvature error in yaw).
+pub const YAW_RATE_GAIN: f64 = 4.0;
+/// Half the spacing of the path points the heading and curvature are read from (m).
+const PATH_STEP: f64 = 2.0;
+/// The speed below which the gains are those of this speed (m/s): the standing start.
+const MIN_SPEED: f64 = 1.0;
+
+/// The path tracker's gains (it keeps no memory between steps).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PathTracker {
+    /// Preview time t_p (s).
+    pub preview_time: f64,
+    /// Shortest preview distance x_min (m).
+    pub preview_min: f64,
+    /// Feed-forward preview time t_f (s).
+    pub feedforward_time: f64,
+    /// Yaw-rate gain c.
+    pub yaw_rate_gain: f64,
+}
+
+impl Default for PathTracker {
+    fn default() -> Self {
+        PathTracker {
+            preview_time: PREVIEW_TIME,
+            preview_min: PREVIEW_MIN,
+            feedforward_time: FEEDFORWARD_TIME,
+            yaw_rate_gain: YAW_RATE_GAIN,
+        }
+    }
+}
+
+impl PathTracker {
+    /// A tracker with the documented gains.
+    pub fn new() -> PathTracker {
+        PathTracker::default()
+    }
+
+    /// The road-wheel angle (rad) for the car in `state` at `proj` holding the line `line(s)`
+    /// metres left of the centre line at station s (the [module](self)'s law).
+    pub fn update(
+        &self,
+        track: &Track,
+        vehicle: &Vehicle,
+        state: &State,
+        proj: &Projection,
+        line: &dyn Fn(f64) -> f64,
+    ) -> f64 {
+        let car = &vehicle.car;
+        let (l, a, b, m) = (car.wheelbase, car.cg_to_front(), car.cg_to_rear(), car.mass);
+        let v = state.speed().max(MIN_SPEED);
+        let path = |s: f64| track.point_off(s, line(track.wrap(s)));
+        let s = proj.s;
+        let (behind, ahead) = (path(s - PATH_STEP), path(s + PATH_STEP));
+        // Δψ = ψ − θ_P: minus the bearing of the path's tangent from the car's heading.
+        let heading_error = -bearing(ahead.0 - behind.0, ahead.1 - behind.1, state.yaw_sin_cos);
+        let e = proj.lateral - line(s);
+        let sf = s + self.feedforward_time * v;
+        let kappa = curvature(path(sf - PATH_STEP), path(sf), path(sf + PATH_STEP));
+        let [cf, cr] = vehicle.cornering_stiffness(v, track.frame(proj.index).friction);
+        let understeer = m / l * (b / cf - a / cr);
+        let steady_heading_error = kappa * (m * a * v * v / (l * cr) - b);
+        let x_p = (self.preview_time * v).max(self.preview_min);
+        let kappa_d =
+            kappa - 2.0 / (x_p * x_p) * (e + x_p * (heading_error - steady_heading_error));
+        let gain = (l + understeer * v * v).max(0.25 * l);
+        let delta = gain * (kappa_d + self.yaw_rate_gain * (kappa_d - state.yaw_rate / v));
+        delta.clamp(-car.steer_lock, car.steer_lock)
+    }
+}
+
+/// The signed curvature (1/m, positive turning left) of the circle through three points:
+/// 2·((p₁ − p₀) × (p₂ − p₁)) / (|p₁ − p₀|·|p₂ − p₁|·|p₂ − p₀|).
+fn curvature(p0: (f64, f64), p1: (f64, f64), p2: (f64, f64)) -> f64 {
+    let (ax, ay) = (p1.0 - p0.0, p1.1 - p0.1);
+    let (bx, by) = (p2.0 - p1.0, p2.1 - p1.1);
+    let (cx, cy) = (p2.0 - p0.0, p2.1 - p0.1);
+    let norms = (ax.hypot(ay) * bx.hypot(by) * cx.hypot(cy)).max(f64::MIN_POSITIVE);
+    2.0 * (ax * by - ay * bx) / norms
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::car::Car;
+    use crate::drive::demo::SpeedHold;
+    use crate::drive::steering::{Steering, wrap_angle};
+    use crate::drive::{Observation, Pedal};
+    use crate::sim::Simulator;
+    use crate::track::Piece;
+    use std::f64::consts::FRAC_PI_2;
+
+    /// The demonstrator's speed hold on a line `offset` metres left of the centre line.
+    struct OnLine {
+        hold: SpeedHold,
+        offset: f64,
+    }
+
+    impl Pedal for OnLine {
+        fn pedal(&mut self, obs: &Observation) -> f64 {
+            self.hold.pedal(obs)
+        }
+
+        fn line(&self, _: f64) -> f64 {
+            self.offset
+        }
+    }
+
+    /// The closed-form steady state (see the module): on a circle of radius 100 m, with a line
+    /// 3 m inside it (and outside it) at 15 m/s (0.23 g), the car settles on the line (e = 0
+    /// within 5 mm) with the steering δ = (L + K·v²)·κ of the linear single-track car (within
+    /// 0.2 %) and its heading error Δψ_ss = κ·(m·a·v²/(L·C_r) − b) (within 2.5 % of κ·b, the
+    /// two terms nearly cancelling at this speed; the drive force on the rear tyres' budget
+    /// moves the rear slip a little), κ = 1/(R − d) the line's curvature.
+    #[test]
+    fn the_tracker_holds_an_offset_on_a_circle() {
+        let r = 100.0;
+        let track = Track::from_pieces(
+            "circle",
+            "test",
+            &[Piece::flat(std::f64::consts::TAU * r, 1.0 / r)],
+            vec![],
+        );
+        let car = Car::spirit_300();
+        let mut sim = Simulator::new(track, &car);
+        sim.config.steering = Steering::Tracker(PathTracker::new());
+        sim.config.trace = true;
+        let (l, a, b, m) = (car.wheelbase, car.cg_to_front(), car.cg_to_rear(), car.mass);
+        let start = sim.track.sample(0);
+        let centre = (
+            start.x - r * start.heading.sin(),
+            start.y + r * start.heading.cos(),
+        );
+        for offset in [3.0, -3.0] {
+            let mut driver = OnLine {
+                hold: SpeedHold::new(15.0),
+                offset,
+            };
+            let lap = sim.lap(&mut driver);
+            assert!(lap.completed, "{:?}", lap.failure);
+            // The last third of the lap, settled.
+            let settled = &lap.trace[2 * lap.trace.len() / 3..];
+            let n = settled.len() as f64;
+            let mean =
+                |f: &dyn Fn(&crate::sim::TracePoint) -> f64| settled.iter().map(f).sum::<f64>() / n;
+            let v = mean(&|p| p.speed);
+            let kappa = 1.0 / (r - offset);
+            let [cf, cr] = sim.vehicle.cornering_stiffness(v, 1.0);
+            let understeer = m / l * (b / cf - a / cr);
+            let steer = (l + understeer * v * v) * kappa;
+            let heading = kappa * (m * a * v * v / (l * cr) - b);
+            let lateral = mean(&|p| p.lateral);
+            let heading_error = mean(&|p| {
+                let proj = sim.track.project_global(p.pos_x, p.pos_y);
+                let yaw = p.heading_error + sim.track.sample(proj.index).heading;
+                let tangent = (p.pos_y - centre.1).atan2(p.pos_x - centre.0) + FRAC_PI_2;
+                wrap_angle(yaw - tangent)
+            });
+            let delta = mean(&|p| p.steer);
+            assert!((v - 15.0).abs() < 0.1, "speed {v}");
+            assert!(
+                (lateral - offset).abs() < 0.005,
+                "d {offset}: lateral {lateral}"
+            );
+            assert!(
+                (heading_error - heading).abs() < 0.025 * b * kappa,
+                "d {offset}: Δψ {heading_error} against {heading}"
+            );
+            assert!(
+                (delta / steer - 1.0).abs() < 0.002,
+                "d {offset}: δ {delta} against {steer}"
+            );
+        }
+    }
+
+    /// Three points on a circle of radius R give 1/R, signed by the turn.
+    #[test]
+    fn three_points_give_the_circles_curvature() {
+        let r = 37.0;
+        let p = |t: f64| (r * t.cos(), r * t.sin());
+        let k = curvature(p(0.1), p(0.15), p(0.2));
+        assert!((k - 1.0 / r).abs() < 1e-12, "{k}");
+        assert!((curvature(p(0.2), p(0.15), p(0.1)) + 1.0 / r).abs() < 1e-12);
+        assert_eq!(curvature((0.0, 0.0), (1.0, 0.0), (2.0, 0.0)), 0.0);
+    }
+}
