@@ -304,6 +304,43 @@ fn a_failed_lap_budget_caps_the_failed_laps() {
 }
 
 #[test]
+fn a_race_with_a_learned_line_writes_and_drives_it() {
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("cdbo-cli-race-line-{}", std::process::id()));
+    let v = json(&[
+        "race",
+        "--laps",
+        "10",
+        "--kernels",
+        "20",
+        "--line",
+        "learn",
+        "--line-kernels",
+        "6",
+        "--method",
+        "pattern-search",
+        "--json",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(v["line_kernels"].as_u64(), Some(6));
+    let csv = std::fs::read_to_string(out.join("best_policy.csv")).unwrap();
+    assert!(csv.starts_with("x,a,d\n"), "{}", &csv[..20]);
+    let policy = out.join("best_policy.json");
+    let file: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&policy).unwrap()).unwrap();
+    assert_eq!(file["line"]["weights"].as_array().map(Vec::len), Some(6));
+    let lap = json(&["lap", "--policy", policy.to_str().unwrap(), "--json"]);
+    assert_eq!(
+        lap["reward_mps"].as_f64(),
+        v["best_reward_mps"].as_f64(),
+        "the best policy drives its lap again"
+    );
+    fails_with(&["race", "--line-kernels", "6", "--laps", "2"], &["--line"]);
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
 fn a_short_race_writes_its_results() {
     // 20 kernels: since the gearbox shifts at the current throttle, the 10-kernel fit of the
     // demonstration laps Ridgeway at 8.8 m/s (its smoothed pedal climbs the gears), 20 at 15.4.

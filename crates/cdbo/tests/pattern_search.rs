@@ -688,3 +688,74 @@ fn a_study_told_the_laps_length_drives_the_races_laps() {
         );
     }
 }
+
+/// With a line ([`cdbo::policy::actions`]) the weights are two blocks [w_a, w_d]: every trial
+/// (the push, the blocks of a sweep, the sharpening directions, the repairs) moves the
+/// weights of one action only, and the push moves the pedal's.
+#[test]
+fn a_search_with_a_line_moves_one_action_at_a_time() {
+    let (pedal, line) = (12, 6);
+    let config = PatternSearchConfig {
+        lengthscale: Some(default_lengthscale(pedal)),
+        pedal_kernels: Some(pedal),
+        ..PatternSearchConfig::default()
+    };
+    let mut ps = PatternSearch::new(vec![0.1; pedal + line], config).unwrap();
+    // A lap whose pedal above 0.6 anywhere fails there; else faster the nearer the line to 1 m.
+    let lap = |w: &[f64]| {
+        let policy = RkhsPolicy::new(w[..pedal].to_vec(), default_lengthscale(pedal)).unwrap();
+        let fail = (0..=200)
+            .map(|i| i as f64 / 200.0)
+            .find(|&x| policy.action(x) > 0.6);
+        let line: f64 = w[pedal..].iter().map(|d| (d - 1.0).powi(2)).sum();
+        let pedal_sum: f64 = w[..pedal].iter().sum();
+        (fail.map_or(10.0 + pedal_sum - line, |_| 0.0), fail)
+    };
+    let mut moved_line = false;
+    for _ in 0..300 {
+        let best = ps
+            .best()
+            .map_or(vec![0.1; pedal + line], |(w, _)| w.to_vec());
+        let w = ps.ask().unwrap();
+        let changed: Vec<usize> = (0..w.len()).filter(|&k| w[k] != best[k]).collect();
+        assert!(
+            changed.iter().all(|&k| k < pedal) || changed.iter().all(|&k| k >= pedal),
+            "a trial moved both actions: {changed:?}"
+        );
+        moved_line |= changed.iter().any(|&k| k >= pedal);
+        let (reward, at) = lap(&w);
+        ps.tell_lap(&w, reward, at.map(FailedLap::too_fast))
+            .unwrap();
+    }
+    let (best, reward) = ps.best().unwrap();
+    assert!(moved_line && reward > 10.0, "{reward}");
+    assert!(
+        best[pedal..].iter().all(|d| (d - 1.0).abs() < 0.5),
+        "{best:?}"
+    );
+}
+
+/// A race with a learned line: w₀'s line is the centre (d = 0), all methods see the joint
+/// weights, and the best policy has the pedal's and the line's kernels.
+#[test]
+fn a_race_learns_a_line_from_the_centre() {
+    use cdbo::experiment::race::{RaceConfig, race};
+    let track = cdbo::track::builtin::load("ridgeway").unwrap().unwrap();
+    let car = cdbo::car::Car::spirit_300();
+    let venue = cdbo::venue::Venue::simulator(track.clone(), &car);
+    for method in [Method::PatternSearch, Method::Cdbo] {
+        let config = RaceConfig {
+            method,
+            kernels: 12,
+            laps: 30,
+            line_kernels: Some(8),
+            ..RaceConfig::default()
+        };
+        let raced = race(&venue, &track, &car, &config, |_| {}).unwrap();
+        let line = raced.initial.line.as_ref().expect("no line");
+        assert_eq!(line.weights, vec![0.0; 8]);
+        assert_eq!(raced.best.shape(), config.shape().unwrap());
+        assert_eq!(raced.best.weights().len(), 20);
+        assert!(raced.best_reward_mps > raced.demo.reward_mps, "{method}");
+    }
+}

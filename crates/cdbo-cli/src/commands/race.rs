@@ -51,6 +51,13 @@ pub struct RaceArgs {
     /// How the car steers.
     #[arg(long, value_enum, default_value_t)]
     steering: super::SteeringChoice,
+    /// The line the car holds: the centre line, or a line d(x) learned with the pedal (a
+    /// second action on its own kernels, starting at the centre line).
+    #[arg(long, value_enum, default_value_t)]
+    line: Line,
+    /// Kernels of a learned line (default: --kernels).
+    #[arg(long, value_parser = super::value::kernels, requires = "line")]
+    line_kernels: Option<usize>,
     /// Output folder (default: runs/race-TRACK-METHOD-mM-sSEED).
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
@@ -59,11 +66,23 @@ pub struct RaceArgs {
     json: bool,
 }
 
+/// The line the car holds (`--line`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+enum Line {
+    /// The centre line.
+    #[default]
+    Centre,
+    /// A line d(x) learned with the pedal.
+    Learn,
+}
+
 #[derive(Debug, Serialize)]
 struct Summary {
     method: Method,
     track: String,
     kernels: usize,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    line_kernels: Option<usize>,
     laps: usize,
     seed: u64,
     demo_reward_mps: f64,
@@ -101,6 +120,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         demo_speed: args.demo_speed,
         knob: args.knob.or(args.sigma0),
         max_failed_laps: args.max_failed_laps,
+        line_kernels: (args.line == Line::Learn).then(|| args.line_kernels.unwrap_or(args.kernels)),
     };
     // A knob the method cannot take is refused before any lap is driven.
     config.spec()?;
@@ -115,10 +135,13 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     let track_name = track.name.clone();
     let out = args.out.clone().unwrap_or_else(|| {
         PathBuf::from("runs").join(format!(
-            "race-{}-{}-m{}-s{}",
+            "race-{}-{}-m{}{}-s{}",
             slug(&track_name),
             args.method,
             args.kernels,
+            config
+                .line_kernels
+                .map_or(String::new(), |m| format!("-line{m}")),
             args.seed
         ))
     });
@@ -165,6 +188,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         method: args.method,
         track: track_name,
         kernels: args.kernels,
+        line_kernels: config.line_kernels,
         laps: args.laps,
         seed: args.seed,
         demo_reward_mps: outcome.demo.reward_mps,

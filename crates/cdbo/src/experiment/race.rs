@@ -37,15 +37,33 @@ pub struct RaceConfig {
     /// Failed laps allowed ([`crate::learner::budget`]); `None`: no budget.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_failed_laps: Option<usize>,
+    /// Kernels of a learned line d(x) ([`crate::policy::actions`]), starting at the centre line
+    /// (d = 0) and optimised with the pedal; `None`: the centre line.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub line_kernels: Option<usize>,
 }
 
 impl RaceConfig {
     /// The race's specification of its method.
     pub fn spec(&self) -> Result<Spec> {
         let spec = Spec::told(self.method, self.seed, self.beta, self.knob)?;
+        let spec = match self.line_kernels {
+            Some(_) => spec.pedal_kernels(self.kernels),
+            None => spec,
+        };
         Ok(match self.max_failed_laps {
             Some(max) => spec.max_failed_laps(max),
             None => spec,
+        })
+    }
+
+    /// The shape of the race's policies: M pedal kernels and, with a learned line, M_d line
+    /// kernels, each at the paper's length-scale 1/(M − 1).
+    pub fn shape(&self) -> Result<PolicyShape> {
+        let pedal = PolicyShape::pedal(Block::paper(self.kernels)?);
+        Ok(match self.line_kernels {
+            Some(m) => pedal.with_line(Block::paper(m)?),
+            None => pedal,
         })
     }
 }
@@ -61,6 +79,7 @@ impl Default for RaceConfig {
             demo_speed: 15.0,
             knob: None,
             max_failed_laps: None,
+            line_kernels: None,
         }
     }
 }
@@ -116,8 +135,7 @@ pub fn race(
 ) -> Result<RaceOutcome> {
     let limit = limit_lap(track, car);
     let demo = venue.demonstrate(config.demo_speed)?;
-    let shape = PolicyShape::pedal(Block::paper(config.kernels)?);
-    let mut evaluator = venue.evaluator(shape)?;
+    let mut evaluator = venue.evaluator(config.shape()?)?;
     race_with(
         &track.name,
         demo,
@@ -160,13 +178,15 @@ fn race_with(
         });
     }
     let lengthscale = default_lengthscale(config.kernels);
-    let initial = Policy::from(RkhsPolicy::fit(
-        &demo_pairs,
-        config.kernels,
-        lengthscale,
-        DEFAULT_RIDGE,
-    )?);
-    let shape = initial.shape();
+    // w₀: the pedal fitted to the demonstration, a line at the centre (d = 0).
+    let shape = config.shape()?;
+    let initial = Policy {
+        pedal: RkhsPolicy::fit(&demo_pairs, config.kernels, lengthscale, DEFAULT_RIDGE)?,
+        line: match shape.line {
+            Some(line) => Some(RkhsPolicy::new(vec![0.0; line.kernels], line.lengthscale)?),
+            None => None,
+        },
+    };
     let optimizer = config
         .spec()?
         .policy(lengthscale)?

@@ -28,6 +28,7 @@ pub struct Spec {
     knob: Option<f64>,
     policy_lengthscale: Option<f64>,
     track_length: Option<f64>,
+    pedal_kernels: Option<usize>,
     max_failed_laps: Option<usize>,
 }
 
@@ -48,6 +49,7 @@ impl Spec {
             knob: None,
             policy_lengthscale: None,
             track_length: None,
+            pedal_kernels: None,
             max_failed_laps: None,
         }
         .with_checked_knob(method.knob().value)
@@ -139,6 +141,16 @@ impl Spec {
         })
     }
 
+    /// This specification for the weights of a policy with a line ([`crate::policy::actions`]):
+    /// the first `kernels` are the pedal's (the pattern search pushes and repairs those), the
+    /// rest another action's.
+    pub fn pedal_kernels(self, kernels: usize) -> Spec {
+        Spec {
+            pedal_kernels: Some(kernels),
+            ..self
+        }
+    }
+
     /// This specification within a budget of `max` failed laps ([`FailureBudget`]): once they
     /// have failed, only the best completed lap is driven again.
     pub fn max_failed_laps(self, max: usize) -> Spec {
@@ -188,6 +200,7 @@ impl Spec {
             knob,
             policy_lengthscale,
             track_length,
+            pedal_kernels,
             max_failed_laps: _,
         } = *self;
         let bo = |maximiser| bo::BoConfig {
@@ -258,6 +271,7 @@ impl Spec {
                     repair: true,
                     lengthscale: policy_lengthscale,
                     track_length,
+                    pedal_kernels,
                     ..pattern_search::PatternSearchConfig::default()
                 },
             )?),

@@ -2,7 +2,10 @@
 //! reads where a failed lap failed, on blocks of weights that narrow sweep by sweep.
 //!
 //! The weights are a policy's kernels in lap order (weight i acts around x̂ᵢ = i/(M − 1)), and
-//! a lap is causal: the pedal at x changes nothing before x. Sweep k moves blocks of
+//! a lap is causal: the pedal at x changes nothing before x. A policy with a line
+//! ([`crate::policy::actions`]) has two such blocks, [w_a, w_d]: when the pedal's count M_a is
+//! told, blocks, sharpening directions and sweeps stay within one action's weights, and the
+//! push and the repairs, which read the pedal, act on w_a only. Sweep k moves blocks of
 //! b_k = max(1, ⌊b₀/2ᵏ⁻¹⌋) adjacent weights together (b₀ = 8: first whole stretches of the lap,
 //! then single kernels); block B starting at weight i has a signed step sᵢ, first +σ₀ (more
 //! pedal), reset to +σ₀ when the width changes. A trial moves one block from the best point
@@ -102,6 +105,10 @@ pub struct PatternSearchConfig {
     /// road before a failure (without it, over two kernel spacings).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub track_length: Option<f64>,
+    /// The pedal's kernels M_a when the weights after them are another action's (a line);
+    /// none: every weight is the pedal's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pedal_kernels: Option<usize>,
 }
 
 /// Blocks of one weight and one repair: the settings of a search saved before they existed.
@@ -129,6 +136,7 @@ impl Default for PatternSearchConfig {
             push: push::SIZE,
             lengthscale: None,
             track_length: None,
+            pedal_kernels: None,
         }
     }
 }
@@ -296,6 +304,13 @@ impl PatternSearchProposer {
             ));
         }
         let n = state.start.len();
+        if let Some(m) = state.config.pedal_kernels.filter(|&m| m == 0 || m > n) {
+            return Err(Error::invalid_value(
+                "the pedal's kernels",
+                m,
+                format!("1 to the {n} weights"),
+            ));
+        }
         if state.sharp_steps.is_empty() {
             // Saved before sharpening sweeps existed.
             state.sharp_steps = vec![state.config.sigma0; n];
@@ -316,10 +331,10 @@ impl PatternSearchProposer {
             || state.sharp_rests.len() != n
             || state.order.iter().any(|&i| i >= n)
             || (state.next == Trial::Push) != state.push.is_some()
-            || state
-                .push
-                .as_ref()
-                .is_some_and(|p| state.config.lengthscale.is_none() || !p.is_sound(n))
+            || state.push.as_ref().is_some_and(|p| {
+                let pedal = state.config.pedal_kernels.unwrap_or(n);
+                state.config.lengthscale.is_none() || !p.is_sound(pedal)
+            })
         {
             return Err(Error::CorruptState {
                 method: "pattern search",
@@ -357,14 +372,14 @@ impl PatternSearchProposer {
         told: &Told,
     ) -> Result<Option<Push>> {
         let c = &self.state.config;
-        let n = self.state.start.len();
+        let n = self.pedal_kernels();
         match (c.lengthscale, told.best()) {
             (Some(l), Some((best, _)))
                 if c.push > 0.0
                     && number <= push::PUSHES
                     && (2..=push::MAX_KERNELS).contains(&n) =>
             {
-                Push::begin(number, best, l, c, previous).map(Some)
+                Push::begin(number, &best[..n], l, c, previous).map(Some)
             }
             _ => Ok(None),
         }
@@ -400,7 +415,11 @@ impl PatternSearchProposer {
         let s = &mut self.state;
         s.sharpening =
             s.config.sharpen && width == 1 && (s.sweeps.saturating_sub(singles_from)) % 2 == 1;
-        s.order = (0..n).step_by(width).collect();
+        let pedal = s.config.pedal_kernels.unwrap_or(n);
+        s.order = (0..pedal)
+            .step_by(width)
+            .chain((pedal..n).step_by(width))
+            .collect();
         s.order.shuffle(&mut rng_for(s.config.seed, s.sweeps - 1));
         s.cursor = 0;
         if width != old_width {
@@ -432,9 +451,14 @@ impl PatternSearchProposer {
     /// The direction of the trial at `weight`, as (weight, coefficient) pairs in lap order:
     /// the block starting there, or the sharpening direction dᵢ.
     fn direction(&self, weight: usize) -> Vec<(usize, f64)> {
-        let n = self.state.start.len();
+        let pedal = self.pedal_kernels();
+        let (first, n) = if weight < pedal {
+            (0, pedal)
+        } else {
+            (pedal, self.state.start.len())
+        };
         if self.state.sharpening {
-            let before = weight.checked_sub(1).map(|k| (k, -0.5));
+            let before = (weight > first).then(|| (weight - 1, -0.5));
             let after = (weight + 1 < n).then_some((weight + 1, -0.5));
             before
                 .into_iter()
@@ -474,9 +498,16 @@ impl PatternSearchProposer {
         &mut steps[weight]
     }
 
-    /// The kernel just before a failure at lap fraction `at`, if it lies at or past `after`.
+    /// The pedal's kernels M_a: the first M_a weights.
+    fn pedal_kernels(&self) -> usize {
+        let n = self.state.start.len();
+        self.state.config.pedal_kernels.unwrap_or(n)
+    }
+
+    /// The pedal's kernel just before a failure at lap fraction `at`, if it lies at or past
+    /// `after`.
     fn before_failure(&self, after: usize, at: f64) -> Option<usize> {
-        let last = self.state.start.len() - 1;
+        let last = self.pedal_kernels() - 1;
         let at_kernel = (at.clamp(0.0, 1.0) * last as f64).floor() as usize;
         let j = at_kernel.checked_sub(1)?;
         (j >= after).then_some(j)
@@ -535,7 +566,17 @@ impl Proposer for PatternSearchProposer {
             Trial::Start => return Ok(Proposal::plain(self.state.start.clone())),
             Trial::Push => {
                 return match (&self.state.push, self.state.config.lengthscale) {
-                    (Some(push), Some(l)) => push.weights(l, &self.bounds).map(Proposal::plain),
+                    (Some(push), Some(l)) => {
+                        // The pushed pedal, the other actions' weights those of the best lap.
+                        let pedal = self.pedal_kernels();
+                        let mut w = told.best_or(&self.state.start).to_vec();
+                        let bounds = SearchBox {
+                            lower: self.bounds.lower[..pedal].to_vec(),
+                            upper: self.bounds.upper[..pedal].to_vec(),
+                        };
+                        w[..pedal].copy_from_slice(&push.weights(l, &bounds)?);
+                        Ok(Proposal::plain(w))
+                    }
                     _ => Err(Error::CorruptState {
                         method: "pattern search",
                         reason: "a push trial without its push".into(),
