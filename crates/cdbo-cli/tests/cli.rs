@@ -267,6 +267,29 @@ fn bad_race_knobs_are_refused_in_one_line() {
     );
 }
 
+/// The safe pattern search keeps to its own budget: at most 30 failed laps in a 300-lap race
+/// by default, at most 10 with `--max-failed-laps 10`, each time with a best lap faster than
+/// the demonstration.
+#[test]
+fn the_safe_search_keeps_its_budget_in_a_race() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("cdbo-cli-safe-{}", std::process::id()));
+    for (budget, most) in [(None, 30), (Some("10"), 10)] {
+        let mut args = vec!["race", "--method", "safe-pattern-search", "--json", "--out"];
+        args.push(dir.to_str().unwrap());
+        if let Some(n) = budget {
+            args.extend(["--max-failed-laps", n]);
+        }
+        let raced = json(&args);
+        assert!(raced["failed_laps"].as_u64().unwrap() <= most, "{raced}");
+        assert!(
+            raced["best_reward_mps"].as_f64().unwrap() > raced["demo_reward_mps"].as_f64().unwrap(),
+            "{raced}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// `--max-failed-laps 10` caps a race's failed laps at 10 for every kind of method (a
 /// learner, the paper's GP method, a random search), where without it the same races fail
 /// more; the best lap is still a completed one.

@@ -224,6 +224,42 @@ fn ask_tell_workflow_and_bad_input() {
         "0.3",
     ];
     fails(&dir, &resumed, "created with --knob 0.1");
+    // A budget of failed laps: stored at creation, a resume with another refused.
+    ok(
+        &dir,
+        &[
+            "study",
+            "create",
+            "safe",
+            "--kernels",
+            "5",
+            "--demo",
+            "demo.csv",
+            "--method",
+            "safe-pattern-search",
+            "--max-failed-laps",
+            "3",
+        ],
+    );
+    let budgeted = |n: &'static str| {
+        [
+            "optimize",
+            "--evaluator",
+            "echo 1",
+            "--kernels",
+            "5",
+            "--laps",
+            "2",
+            "--storage",
+            "safe.cdbo.db",
+            "--demo",
+            "demo.csv",
+            "--max-failed-laps",
+            n,
+        ]
+    };
+    fails(&dir, &budgeted("4"), "created with --max-failed-laps 3");
+    ok(&dir, &budgeted("3"));
 }
 
 #[test]

@@ -76,6 +76,10 @@ pub struct StudyConfig {
     /// value (and in studies made before it could be set).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub knob: Option<f64>,
+    /// Failed laps allowed ([`Spec::max_failed_laps`]), where the user set it; absent: no
+    /// budget (the safe pattern search's own, [`crate::learner::safe_search::BUDGET`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_failed_laps: Option<usize>,
 }
 
 impl StudyConfig {
@@ -83,6 +87,10 @@ impl StudyConfig {
     pub fn spec(&self) -> Result<Spec> {
         let spec =
             Spec::told(self.method, self.seed, self.beta, self.knob)?.policy(self.lengthscale)?;
+        let spec = match self.max_failed_laps {
+            Some(max) => spec.max_failed_laps(max),
+            None => spec,
+        };
         self.track_length
             .map_or(Ok(spec), |length| spec.track_length(length))
     }
@@ -515,6 +523,7 @@ mod tests {
             track: None,
             track_length: None,
             knob: None,
+            max_failed_laps: None,
         }
     }
 

@@ -667,6 +667,7 @@ fn a_study_told_the_laps_length_drives_the_races_laps() {
                 track: None,
                 track_length,
                 knob: None,
+                max_failed_laps: None,
             },
         )
         .unwrap();

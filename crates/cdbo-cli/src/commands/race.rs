@@ -45,7 +45,8 @@ pub struct RaceArgs {
     #[arg(long, conflicts_with = "knob", allow_negative_numbers = true)]
     sigma0: Option<f64>,
     /// Failed laps allowed: once they have failed, only the best completed lap is driven
-    /// again (in the simulator a hard cap; default: no budget).
+    /// again (in the simulator a hard cap; default: no budget, except the safe pattern
+    /// search's own, 30).
     #[arg(long, value_name = "N")]
     max_failed_laps: Option<usize>,
     /// How the car steers.

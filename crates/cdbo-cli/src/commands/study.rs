@@ -73,6 +73,10 @@ pub struct InitialPolicy {
     /// The method's main knob, as `cdbo race --knob` (default: its race value).
     #[arg(long, allow_negative_numbers = true)]
     knob: Option<f64>,
+    /// Failed laps allowed: once they have failed, only the best completed lap is driven
+    /// again (default: no budget; the safe pattern search's own budget, 30).
+    #[arg(long, value_name = "N")]
+    max_failed_laps: Option<usize>,
 }
 
 impl InitialPolicy {
@@ -114,6 +118,7 @@ impl InitialPolicy {
             track: None,
             track_length: self.track_length,
             knob: self.knob,
+            max_failed_laps: self.max_failed_laps,
         })
     }
 
@@ -161,6 +166,15 @@ impl InitialPolicy {
         if let Some(k) = self.knob.filter(|k| Some(*k) != stored.knob) {
             let kept = stored.knob.map_or("no --knob".into(), |k| k.to_string());
             return differs("--knob", k.to_string(), kept);
+        }
+        if let Some(n) = self
+            .max_failed_laps
+            .filter(|n| Some(*n) != stored.max_failed_laps)
+        {
+            let kept = stored
+                .max_failed_laps
+                .map_or("no --max-failed-laps".into(), |k| k.to_string());
+            return differs("--max-failed-laps", n.to_string(), kept);
         }
         Ok(())
     }

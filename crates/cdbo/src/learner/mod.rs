@@ -10,3 +10,4 @@
 pub mod budget;
 pub mod pattern_search;
 pub mod repair;
+pub mod safe_search;

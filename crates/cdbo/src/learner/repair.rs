@@ -27,6 +27,19 @@ pub struct PedalRepair {
     /// [`REPAIR_SPACINGS`] kernel spacings (the ceiling's, and repairs saved before it was set).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub window: Option<f64>,
+    /// The first step δ₀ at each new place (the default [`REPAIR_STEP`] is not written).
+    #[serde(default = "default_step", skip_serializing_if = "is_default_step")]
+    pub first: f64,
+}
+
+/// δ₀ of repairs saved before it was set.
+fn default_step() -> f64 {
+    REPAIR_STEP
+}
+
+/// Whether δ₀ is the default, left out of a saved repair.
+fn is_default_step(step: &f64) -> bool {
+    *step == REPAIR_STEP
 }
 
 impl PedalRepair {
@@ -37,6 +50,16 @@ impl PedalRepair {
             step: REPAIR_STEP,
             last: None,
             window: None,
+            first: REPAIR_STEP,
+        }
+    }
+
+    /// These repairs with first step δ₀ = `first` at each new place.
+    pub fn starting_at(self, first: f64) -> PedalRepair {
+        PedalRepair {
+            first,
+            step: first,
+            ..self
         }
     }
 
@@ -65,7 +88,7 @@ impl PedalRepair {
                 self.step *= 0.5;
             }
             Some((x, _)) if x_fail <= x + self.spacing => {}
-            _ => self.step = REPAIR_STEP,
+            _ => self.step = self.first,
         }
         self.last = Some((x_fail, direction));
         let from = x_fail - self.window();

@@ -34,7 +34,7 @@ fn optimizer_seconds(
         Method::Rembo5d => cdbo(5.0),
         Method::Rembo10d => cdbo(10.0),
         Method::BoCmaes => cdbo(m) + 5e-5 * m * m * n,
-        Method::Cmaes | Method::Random | Method::PatternSearch => 0.0,
+        Method::Cmaes | Method::Random | Method::PatternSearch | Method::SafePatternSearch => 0.0,
     }
 }
 
@@ -42,7 +42,7 @@ fn optimizer_seconds(
 fn fits_a_gp(method: Method) -> bool {
     !matches!(
         method,
-        Method::Cmaes | Method::Random | Method::PatternSearch
+        Method::Cmaes | Method::Random | Method::PatternSearch | Method::SafePatternSearch
     )
 }
 
@@ -64,7 +64,7 @@ pub fn race_bytes(method: Method, kernels: usize, laps: usize) -> f64 {
     let (m, n) = (kernels as f64, laps as f64);
     match method {
         Method::Cmaes => 8.0 * 3.0 * m * m,
-        Method::Random | Method::PatternSearch => 8.0 * 4.0 * m,
+        Method::Random | Method::PatternSearch | Method::SafePatternSearch => 8.0 * 4.0 * m,
         _ => 8.0 * (4.0 * n * n + 2.0 * n * m),
     }
 }

@@ -119,6 +119,7 @@ impl Method {
             Method::PatternSearch => {
                 sigma0("first step σ₀", 0.05, &[0.03, 0.05, 0.08, 0.1, 0.12, 0.15])
             }
+            Method::SafePatternSearch => sigma0("first step σ₀ (the pattern search's)", 0.05, &[]),
             Method::Rembo5d => rembo_box(5.0, 0.1, &[0.01, 0.03, 0.1, 2.236]),
             Method::Rembo10d => rembo_box(10.0, 0.03, &[0.01, 0.03, 0.1, 3.162]),
             Method::Turbo => Knob {

@@ -17,7 +17,7 @@ use std::str::FromStr;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-use crate::learner::pattern_search;
+use crate::learner::{pattern_search, safe_search};
 use crate::optimizers::{bo, cmaes, linebo, random, rembo, turbo};
 
 /// A method [`Method::optimizer`] builds: the paper's CDBO, its baselines, and later peers.
@@ -42,11 +42,14 @@ pub enum Method {
     Random,
     /// The adaptive coordinate pattern search with failure repair.
     PatternSearch,
+    /// The pattern search within a budget of failed laps, skipping laps its failures predict
+    /// to fail.
+    SafePatternSearch,
 }
 
 impl Method {
     /// Every method, in the order tables and help list them.
-    pub const ALL: [Method; 9] = [
+    pub const ALL: [Method; 10] = [
         Method::Cdbo,
         Method::Cmaes,
         Method::BoCmaes,
@@ -56,6 +59,7 @@ impl Method {
         Method::Linebo,
         Method::Random,
         Method::PatternSearch,
+        Method::SafePatternSearch,
     ];
 
     /// The paper's CDBO and the baselines it compares with (Sec. V).
@@ -79,6 +83,7 @@ impl Method {
             Method::Linebo => linebo::NAME,
             Method::Random => random::NAME,
             Method::PatternSearch => pattern_search::NAME,
+            Method::SafePatternSearch => safe_search::NAME,
         }
     }
 
@@ -98,6 +103,9 @@ impl Method {
             Method::PatternSearch => {
                 "the whole pedal pushed and repaired where laps fail, then coordinate search around the best lap"
             }
+            Method::SafePatternSearch => {
+                "the pattern search within a budget of failed laps (--max-failed-laps, default 30), never driving a lap its failures predict to fail"
+            }
         }
     }
 
@@ -113,6 +121,7 @@ impl Method {
             Method::Linebo => (120, 120, 120),
             Method::Random => (230, 150, 0),
             Method::PatternSearch => (110, 40, 160),
+            Method::SafePatternSearch => (40, 150, 60),
         }
     }
 }

@@ -9,6 +9,7 @@ use super::{KnobKind, Method, PAPER_SIGMA0};
 use crate::error::{Error, Result};
 use crate::learner::budget::{self, FailureBudget};
 use crate::learner::pattern_search::{self, PatternSearch};
+use crate::learner::safe_search::{self, SafeSearch};
 use crate::optimizers::bo::{self, Bo};
 use crate::optimizers::cmaes::{self, Cmaes};
 use crate::optimizers::linebo::{self, LineBo};
@@ -181,12 +182,15 @@ impl Spec {
         self.knob
     }
 
-    /// The method's optimiser, from w₀ (within its failed-lap budget, if it has one).
+    /// The method's optimiser, from w₀ (within its failed-lap budget, if it has one; the safe
+    /// pattern search spends its budget itself, [`safe_search::BUDGET`] unless told).
     pub fn optimizer(&self, w0: Vec<f64>) -> Result<Box<dyn Optimizer + Send>> {
         let method = self.method_optimizer(w0)?;
         Ok(match self.max_failed_laps {
-            Some(max) => Box::new(FailureBudget::new(method, max)),
-            None => method,
+            Some(max) if self.method != Method::SafePatternSearch => {
+                Box::new(FailureBudget::new(method, max))
+            }
+            _ => method,
         })
     }
 
@@ -201,8 +205,18 @@ impl Spec {
             policy_lengthscale,
             track_length,
             pedal_kernels,
-            max_failed_laps: _,
+            max_failed_laps,
         } = *self;
+        let pattern_search = pattern_search::PatternSearchConfig {
+            seed,
+            sigma0,
+            box_radius,
+            repair: true,
+            lengthscale: policy_lengthscale,
+            track_length,
+            pedal_kernels,
+            ..pattern_search::PatternSearchConfig::default()
+        };
         let bo = |maximiser| bo::BoConfig {
             seed,
             acquisition: crate::acquisition::Acquisition::Ucb { beta },
@@ -262,19 +276,17 @@ impl Spec {
                     box_radius,
                 },
             )?),
-            Method::PatternSearch => Box::new(PatternSearch::new(
-                w0,
-                pattern_search::PatternSearchConfig {
-                    seed,
-                    sigma0,
-                    box_radius,
-                    repair: true,
-                    lengthscale: policy_lengthscale,
-                    track_length,
-                    pedal_kernels,
-                    ..pattern_search::PatternSearchConfig::default()
-                },
-            )?),
+            Method::PatternSearch => Box::new(PatternSearch::new(w0, pattern_search)?),
+            Method::SafePatternSearch => {
+                let config = safe_search::SafeSearchConfig::around(pattern_search);
+                Box::new(SafeSearch::new(
+                    w0,
+                    safe_search::SafeSearchConfig {
+                        budget: max_failed_laps.unwrap_or(config.budget),
+                        ..config
+                    },
+                )?)
+            }
         })
     }
 }
@@ -298,6 +310,7 @@ pub fn resume(saved: Saved) -> Result<Box<dyn Optimizer + Send>> {
         turbo::NAME => Box::new(Turbo::resume(saved.state("TuRBO")?)?),
         linebo::NAME => Box::new(LineBo::resume(saved.state("LineBO")?)?),
         pattern_search::NAME => Box::new(PatternSearch::resume(saved.state("pattern search")?)?),
+        safe_search::NAME => Box::new(SafeSearch::resume(saved.state("safe pattern search")?)?),
         budget::SAVED_KIND => Box::new(FailureBudget::resume(
             saved.state("failure budget")?,
             resume,
@@ -306,7 +319,7 @@ pub fn resume(saved: Saved) -> Result<Box<dyn Optimizer + Send>> {
             return Err(Error::NotFound {
                 what: "kind of saved optimiser",
                 name: format!("{kind:?}"),
-                detail: "available: bo, cmaes, random, rembo, turbo, linebo, pattern-search, failure-budget".into(),
+                detail: "available: bo, cmaes, random, rembo, turbo, linebo, pattern-search, safe-pattern-search, failure-budget".into(),
             });
         }
     })

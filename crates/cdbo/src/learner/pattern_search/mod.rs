@@ -109,6 +109,24 @@ pub struct PatternSearchConfig {
     /// none: every weight is the pedal's.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pedal_kernels: Option<usize>,
+    /// The push's first repair step δ₀ at each new place (the default
+    /// [`REPAIR_STEP`](crate::learner::repair::REPAIR_STEP) is not written).
+    #[serde(default = "repair_step", skip_serializing_if = "is_repair_step")]
+    pub repair_step: f64,
+    /// A failed start lap is first repaired where it fails until it completes (push 0), then
+    /// pushed.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub repair_start: bool,
+}
+
+/// The push's default repair step.
+fn repair_step() -> f64 {
+    crate::learner::repair::REPAIR_STEP
+}
+
+/// Whether a push's repair step is the default, left out of a saved search.
+fn is_repair_step(step: &f64) -> bool {
+    *step == repair_step()
 }
 
 /// Blocks of one weight and one repair: the settings of a search saved before they existed.
@@ -137,6 +155,8 @@ impl Default for PatternSearchConfig {
             lengthscale: None,
             track_length: None,
             pedal_kernels: None,
+            repair_step: repair_step(),
+            repair_start: false,
         }
     }
 }
@@ -240,29 +260,7 @@ pub type PatternSearch = AskTell<PatternSearchProposer>;
 impl PatternSearch {
     /// A search from `start` (driven first, unmoved).
     pub fn new(start: Vec<f64>, config: PatternSearchConfig) -> Result<PatternSearch> {
-        if start.is_empty() || start.iter().any(|v| !v.is_finite()) {
-            return Err(Error::invalid_value(
-                "pattern search's start point",
-                format!("{start:?}"),
-                "finite, of at least one weight",
-            ));
-        }
-        let n = start.len();
-        let proposer = PatternSearchProposer::resume(PatternSearchProgress {
-            steps: vec![config.sigma0; n],
-            sharp_steps: vec![config.sigma0; n],
-            rests: vec![Rest::default(); n],
-            sharp_rests: vec![Rest::default(); n],
-            sharpening: false,
-            order: Vec::new(),
-            cursor: 0,
-            sweeps: 0,
-            push: None,
-            pushed: false,
-            next: Trial::Start,
-            config,
-            start,
-        })?;
+        let proposer = PatternSearchProposer::new(start, config)?;
         Ok(AskTell::resumed(proposer, Told::default()))
     }
 
@@ -277,7 +275,43 @@ impl PatternSearch {
 }
 
 impl PatternSearchProposer {
-    fn resume(mut state: PatternSearchProgress) -> Result<PatternSearchProposer> {
+    /// A search from `start` (driven first, unmoved).
+    pub(crate) fn new(
+        start: Vec<f64>,
+        config: PatternSearchConfig,
+    ) -> Result<PatternSearchProposer> {
+        if start.is_empty() || start.iter().any(|v| !v.is_finite()) {
+            return Err(Error::invalid_value(
+                "pattern search's start point",
+                format!("{start:?}"),
+                "finite, of at least one weight",
+            ));
+        }
+        let n = start.len();
+        PatternSearchProposer::resume(PatternSearchProgress {
+            steps: vec![config.sigma0; n],
+            sharp_steps: vec![config.sigma0; n],
+            rests: vec![Rest::default(); n],
+            sharp_rests: vec![Rest::default(); n],
+            sharpening: false,
+            order: Vec::new(),
+            cursor: 0,
+            sweeps: 0,
+            push: None,
+            pushed: false,
+            next: Trial::Start,
+            config,
+            start,
+        })
+    }
+
+    /// The search's state.
+    pub(crate) fn progress(&self) -> &PatternSearchProgress {
+        &self.state
+    }
+
+    /// A search continuing from `state`.
+    pub(crate) fn resume(mut state: PatternSearchProgress) -> Result<PatternSearchProposer> {
         if !(state.config.sigma0.is_finite() && state.config.sigma0 > 0.0) {
             return Err(Error::invalid_value("σ₀", state.config.sigma0, "positive"));
         }
@@ -295,6 +329,13 @@ impl PatternSearchProposer {
             if let Some(v) = value.filter(|v| !(v.is_finite() && *v > 0.0)) {
                 return Err(Error::invalid_value(what, v, "positive"));
             }
+        }
+        if !(state.config.repair_step.is_finite() && state.config.repair_step > 0.0) {
+            return Err(Error::invalid_value(
+                "the push's repair step",
+                state.config.repair_step,
+                "positive",
+            ));
         }
         if !(state.config.give_back.is_finite() && state.config.give_back > 0.0) {
             return Err(Error::invalid_value(
@@ -333,7 +374,7 @@ impl PatternSearchProposer {
             || (state.next == Trial::Push) != state.push.is_some()
             || state.push.as_ref().is_some_and(|p| {
                 let pedal = state.config.pedal_kernels.unwrap_or(n);
-                state.config.lengthscale.is_none() || !p.is_sound(pedal)
+                state.config.lengthscale.is_none() || !p.is_sound(pedal, state.config.repair_start)
             })
         {
             return Err(Error::CorruptState {
@@ -374,12 +415,16 @@ impl PatternSearchProposer {
         let c = &self.state.config;
         let n = self.pedal_kernels();
         match (c.lengthscale, told.best()) {
-            (Some(l), Some((best, _)))
+            (Some(l), Some((best, reward)))
                 if c.push > 0.0
                     && number <= push::PUSHES
                     && (2..=push::MAX_KERNELS).contains(&n) =>
             {
-                Push::begin(number, &best[..n], l, c, previous).map(Some)
+                if number == 1 && reward == 0.0 && c.repair_start && previous.is_none() {
+                    Push::repairing(&best[..n], l, c).map(Some)
+                } else {
+                    Push::begin(number, &best[..n], l, c, previous).map(Some)
+                }
             }
             _ => Ok(None),
         }

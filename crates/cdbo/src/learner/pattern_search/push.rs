@@ -30,7 +30,9 @@ use serde::{Deserialize, Serialize};
 
 use super::PatternSearchConfig;
 use crate::error::Result;
-use crate::learner::repair::{PedalRepair, REPAIR_STEP};
+use crate::learner::repair::PedalRepair;
+#[cfg(test)]
+use crate::learner::repair::REPAIR_STEP;
 use crate::optimizers::{FailedLap, SearchBox, rng_for};
 use crate::policy::RkhsPolicy;
 use crate::policy::rkhs::DEFAULT_RIDGE;
@@ -86,16 +88,34 @@ impl Push {
         config: &PatternSearchConfig,
         previous: Option<&Push>,
     ) -> Result<Push> {
-        let policy = RkhsPolicy::new(best.to_vec(), lengthscale)?;
         let u: f64 = rng_for(config.seed, u64::MAX - u64::from(number)).random();
         let size = config.push / f64::from(1u32 << (number - 1).min(31))
             * (1.0 + JITTER * (2.0 * u - 1.0));
+        Push::sized(number, size, best, lengthscale, config, previous)
+    }
+
+    /// Push 0, of size 0: the best lap, a failed one, repaired where it fails until it
+    /// completes (a search told to repair a failed start first).
+    pub fn repairing(best: &[f64], lengthscale: f64, config: &PatternSearchConfig) -> Result<Push> {
+        Push::sized(0, 0.0, best, lengthscale, config, None)
+    }
+
+    /// Push `number` of size `size`.
+    fn sized(
+        number: u32,
+        size: f64,
+        best: &[f64],
+        lengthscale: f64,
+        config: &PatternSearchConfig,
+        previous: Option<&Push>,
+    ) -> Result<Push> {
+        let policy = RkhsPolicy::new(best.to_vec(), lengthscale)?;
         let g = targets_for(best.len());
         let repaired = previous
             .map(|p| p.repaired.clone())
             .filter(|r| r.len() == g)
             .unwrap_or_else(|| vec![0.0; g]);
-        let repair = PedalRepair::new(best.len());
+        let repair = PedalRepair::new(best.len()).starting_at(config.repair_step);
         Ok(Push {
             number,
             targets: (0..g)
@@ -111,12 +131,12 @@ impl Push {
     }
 
     /// Whether a saved push is one this code could have made for an M-kernel policy: a push
-    /// number in 1..=[`PUSHES`], [`targets_for`]`(M)` finite targets and net repairs, a
-    /// positive finite repair step and window at the policy's kernel spacing, at most [`LAPS`]
-    /// laps.
-    pub fn is_sound(&self, kernels: usize) -> bool {
+    /// number in 1..=[`PUSHES`] (0..=[`PUSHES`] for a search that repairs a failed start,
+    /// [`Push::repairing`]), [`targets_for`]`(M)` finite targets and net repairs, a positive
+    /// finite repair step and window at the policy's kernel spacing, at most [`LAPS`] laps.
+    pub fn is_sound(&self, kernels: usize, repair_start: bool) -> bool {
         let finite = |v: &[f64]| v.iter().all(|a| a.is_finite());
-        (1..=PUSHES).contains(&self.number)
+        (u32::from(!repair_start)..=PUSHES).contains(&self.number)
             && self.targets.len() == targets_for(kernels)
             && self.repaired.len() == self.targets.len()
             && finite(&self.targets)
@@ -125,6 +145,8 @@ impl Push {
             && self.repair.window() > 0.0
             && self.repair.step.is_finite()
             && self.repair.step > 0.0
+            && self.repair.first.is_finite()
+            && self.repair.first > 0.0
             && self.repair.spacing == PedalRepair::new(kernels).spacing
             && self
                 .repair
@@ -149,7 +171,7 @@ impl Push {
     /// Repairs the targets for a lap that failed as `failure` says; false if the push gives up
     /// instead (its repairs oscillate or it has driven [`LAPS`] laps).
     pub fn repair(&mut self, failure: FailedLap) -> bool {
-        if self.laps >= LAPS || self.repair.step < GIVE_UP * REPAIR_STEP {
+        if self.laps >= LAPS || self.repair.step < GIVE_UP * self.repair.first {
             return false;
         }
         let mut pairs = self.pairs();
@@ -304,6 +326,6 @@ mod tests {
             );
         }
         assert_eq!(second.repaired, first.repaired);
-        assert!(second.is_sound(best.len()));
+        assert!(second.is_sound(best.len(), false));
     }
 }
