@@ -9,11 +9,12 @@
  *
  * Throttle and brake follow a pedal a in [-1, 1] (a policy pi(x) of the lap fraction x, the
  * demonstrator's PI speed hold, or a constant); steering is cdbo's look-ahead PI law
- * (crates/cdbo/src/drive/steering.rs); the gear is chosen by cdbo's automatic gearbox
+ * (crates/cdbo/src/drive/steering.rs) or its path tracker on the centre line
+ * (crates/cdbo/src/drive/tracker.rs); the gear is chosen by cdbo's automatic gearbox
  * (crates/cdbo/src/sim/powertrain.rs) from shift points it is given; ABS and traction control
  * ease the pedals as cdbo's vehicle does; the lap fails by cdbo's rules (sim/lap.rs), judged
  * from the game's car state. On completion or failure it writes one JSON line and ends the
- * game process at once. The decisions themselves (pedal, steering law, gearbox, launch clutch)
+ * game process at once. The decisions themselves (pedal, steering laws, gearbox, launch clutch)
  * are the pure functions of drive.hpp, checked against cdbo's Rust by its tests; this file
  * reads the game's state for them and applies their commands.
  *
@@ -24,7 +25,16 @@
  *   trace PATH                   optional: every driver step (50 Hz) as CSV
  *   pedal demo V | pedal constant A | pedal rkhs L W1 ... WM | pedal table X1 A1 X2 A2 ...
  *   wheelbase L                  (m), the steering gain's L
- *   steering T_LA D_MIN K_I      look-ahead time (s), shortest look-ahead (m), integral gain
+ *   steering pi T_LA D_MIN K_I   the PI law: look-ahead time (s), shortest look-ahead (m),
+ *                                integral gain
+ *   steering tracker T_P X_MIN T_F C   the path tracker: preview time (s), shortest preview
+ *                                (m), feed-forward time (s), yaw-rate gain
+ *   chassis M A B                (the tracker) mass (kg), distances of the front and rear
+ *                                axle from the centre of gravity (m)
+ *   cornering_front V1 C1 ...    (the tracker) the axle's cornering stiffness (N/rad) on a
+ *   cornering_rear V1 C1 ...     surface of friction 1 at speeds V increasing (m/s), linear
+ *                                in between, held beyond the ends; scaled by the friction of
+ *                                the car's segment
  *   ratios G1 ... GN             total ratio engine -> wheel of each forward gear
  *   throttle_levels K            throttle levels of the shift map, a = k / (K - 1)
  *   upshift W11 ... W1K ... WNK  engine speed (rad/s) at which to leave each gear, a row of
@@ -72,7 +82,11 @@ struct Settings {
     std::string pedal = "demo";
     std::vector<double> pedal_args = {15.0};
     double wheelbase = 2.6;
+    bool tracker = false;  // the path tracker, else the PI law
     double lookahead_time = 0.8, lookahead_min = 12.0, ki = 0.1;
+    drive::TrackerGains gains = {0.4, 10.0, 0.15, 4.0};
+    double mass = 0.0, cg_to_front = 0.0, cg_to_rear = 0.0;
+    std::vector<double> cornering[2];  // (v, C) pairs per axle
     std::vector<double> ratios, upshift;
     size_t throttle_levels = 1;
     double downshift_margin = 0.85, shift_time = 0.2;
@@ -148,9 +162,22 @@ bool read_settings(const std::string &path, Settings *s, std::string *error) {
         else if (k == "trace") s->trace = word;
         else if (k == "pedal") { s->pedal = word; s->pedal_args = nums; }
         else if (k == "wheelbase") { if ((ok = need(1))) s->wheelbase = nums[0]; }
-        else if (k == "steering") {
-            if ((ok = need(3))) { s->lookahead_time = nums[0]; s->lookahead_min = nums[1]; s->ki = nums[2]; }
+        else if (k == "steering" && word == "pi") {
+            if ((ok = need(3))) { s->tracker = false; s->lookahead_time = nums[0]; s->lookahead_min = nums[1]; s->ki = nums[2]; }
         }
+        else if (k == "steering" && word == "tracker") {
+            if ((ok = need(4))) { s->tracker = true; s->gains = {nums[0], nums[1], nums[2], nums[3]}; }
+        }
+        else if (k == "steering") {
+            *error = path + ":" + std::to_string(number) + ": steering must be 'pi T_LA D_MIN K_I' or "
+                     "'tracker T_P X_MIN T_F C', got '" + word + "'";
+            ok = false;
+        }
+        else if (k == "chassis") {
+            if ((ok = need(3))) { s->mass = nums[0]; s->cg_to_front = nums[1]; s->cg_to_rear = nums[2]; }
+        }
+        else if (k == "cornering_front") s->cornering[0] = nums;
+        else if (k == "cornering_rear") s->cornering[1] = nums;
         else if (k == "ratios") s->ratios = nums;
         else if (k == "upshift") s->upshift = nums;
         else if (k == "throttle_levels") {
@@ -176,6 +203,18 @@ bool read_settings(const std::string &path, Settings *s, std::string *error) {
     if (s->ratios.empty() || s->ratios.size() * s->throttle_levels != s->upshift.size()) {
         *error = path + ": 'upshift' must give 'throttle_levels' numbers per gear of 'ratios'";
         return false;
+    }
+    if (s->tracker) {
+        bool chassis_ok = s->mass > 0.0 && s->cg_to_front > 0.0 && s->cg_to_rear > 0.0;
+        for (const std::vector<double> &c : s->cornering) {
+            chassis_ok = chassis_ok && c.size() >= 2 && c.size() % 2 == 0;
+            for (size_t i = 2; chassis_ok && i < c.size(); i += 2) chassis_ok = c[i] > c[i - 2];
+        }
+        if (!chassis_ok) {
+            *error = path + ": the path tracker needs 'chassis M A B' (positive) and "
+                            "'cornering_front' and 'cornering_rear' tables 'V1 C1 ...' with V increasing";
+            return false;
+        }
     }
     const std::string &p = s->pedal;
     bool pedal_ok = (p == "demo" && s->pedal_args.size() == 1 && s->pedal_args[0] > 0) ||
@@ -243,6 +282,38 @@ double steer(tCarElt *car, double speed, double dt) {
     centre_point(car->_distFromStartLine + d, &tx, &ty);
     double e = drive::bearing(tx - car->_pos_X, ty - car->_pos_Y, std::sin(car->_yaw), std::cos(car->_yaw));
     return drive::steering_law(e, d, lap.cfg.wheelbase, lap.cfg.ki, car->_steerLock, lap.steer_integral, dt);
+}
+
+/// The road-wheel angle (rad) of cdbo's path tracker (drive/tracker.rs) on the centre line:
+/// the centre line's points kPathStep either side of the car's station give its heading,
+/// three points around the station t_f v ahead its curvature, the car's offset from the
+/// middle is the lateral error, the cornering stiffness is read from the settings' tables at v
+/// and scaled by the friction of the car's segment.
+double tracker_steer(tCarElt *car, double speed) {
+    const Settings &c = lap.cfg;
+    double v = drive::tracker_speed(speed);
+    double s = car->_distFromStartLine;
+    double bx, by, ax, ay;
+    centre_point(s - drive::kPathStep, &bx, &by);
+    centre_point(s + drive::kPathStep, &ax, &ay);
+    drive::TrackerInput in;
+    // psi - theta_P: minus the bearing of the path's tangent from the car's heading.
+    in.heading_error = -drive::bearing(ax - bx, ay - by, std::sin(car->_yaw), std::cos(car->_yaw));
+    in.lateral_error = car->_trkPos.toMiddle;
+    double sf = s + c.gains.feedforward_time * v;
+    double p[6];
+    centre_point(sf - drive::kPathStep, &p[0], &p[1]);
+    centre_point(sf, &p[2], &p[3]);
+    centre_point(sf + drive::kPathStep, &p[4], &p[5]);
+    in.curvature = drive::curvature(p[0], p[1], p[2], p[3], p[4], p[5]);
+    in.speed = v;
+    in.yaw_rate = car->_yaw_rate;
+    double friction = car->_trkPos.seg->surface->kFriction;
+    for (int k = 0; k < 2; k++) {
+        in.cornering[k] = friction * drive::table_action(c.cornering[k].data(), c.cornering[k].size() / 2, v);
+    }
+    drive::TrackerCar tc = {c.mass, c.wheelbase, c.cg_to_front, c.cg_to_rear, car->_steerLock};
+    return drive::tracker_law(c.gains, tc, in);
 }
 
 /// Spin of an axle (rad/s): the mean of its two wheels (0, 1 front; 2, 3 rear).
@@ -333,7 +404,7 @@ void new_track(int, tTrack *track, void *, void **settings, tSituation *) {
         } else {
             fprintf(lap.trace,
                     "t_s,distance_m,x,speed_mps,pedal,steer_rad,lateral_m,heading_error_rad,"
-                    "slip_angle_rad,gear,rpm,pos_x_m,pos_y_m\n");
+                    "slip_angle_rad,gear,rpm,pos_x_m,pos_y_m,yaw_rate_rad_s\n");
         }
     }
     if (h) GfParmReleaseHandle(h);
@@ -418,7 +489,7 @@ void drive(int, tCarElt *car, tSituation *s) {
 
     double x = clamp(lap.distance / len, 0.0, 1.0);
     double a = pedal(x, speed, dt);
-    double delta = steer(car, speed, dt);
+    double delta = lap.cfg.tracker ? tracker_steer(car, speed) : steer(car, speed, dt);
     choose_gear(car, std::fmax(a, 0.0), dt);
 
     // Traction control and ABS, as cdbo's vehicle applies them (sim/vehicle.rs).
@@ -441,10 +512,10 @@ void drive(int, tCarElt *car, tSituation *s) {
     car->_clutchCmd = launch_clutch(car, throttle, dt);
 
     if (lap.trace) {
-        fprintf(lap.trace, "%.3f,%.3f,%.6f,%.4f,%.4f,%.5f,%.4f,%.5f,%.5f,%d,%.0f,%.3f,%.3f\n", t,
+        fprintf(lap.trace, "%.3f,%.3f,%.6f,%.4f,%.4f,%.5f,%.4f,%.5f,%.5f,%d,%.0f,%.3f,%.3f,%.5f\n", t,
                 lap.distance, x, speed, a, delta, lateral, heading_error,
                 std::atan2(vy, std::fmax(std::fabs(vx), 1e-9)), car->_gear, car->_enginerpm * 30.0 / M_PI,
-                car->_pos_X, car->_pos_Y);
+                car->_pos_X, car->_pos_Y, car->_yaw_rate);
     }
 }
 

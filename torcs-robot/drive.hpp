@@ -8,7 +8,8 @@
  * 2 of the License, or (at your option) any later version. See COPYING.
  *
  * Everything the robot (cdbo.cpp) decides from numbers it has gathered: the pedal (the policy
- * pi(x), the demonstrator's speed hold), the steering law, the gearbox and the launch clutch.
+ * pi(x), the demonstrator's speed hold), the steering laws (the PI law and the path tracker),
+ * the gearbox and the launch clutch.
  * No TORCS header is needed: cdbo.cpp reads the game's car and track and calls these, and
  * crates/cdbo/tests/robot_drive.rs compiles this header alone into a harness
  * (tests/harness.cpp) and checks each function against its Rust definition, named on each,
@@ -31,6 +32,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 
 namespace drive {
 
@@ -106,6 +108,77 @@ inline double bearing(double dx, double dy, double sin_yaw, double cos_yaw) {
 inline double steering_law(double e, double d, double wheelbase, double ki, double steer_lock,
                            double &integral, double dt) {
     return pi_control(2.0 * wheelbase / d, ki, steer_lock, integral, e, dt);
+}
+
+// ---- The path tracker ------------------------------------------------------------------------
+
+/// Half the spacing (m) of the path points the heading and curvature are read from
+/// (drive/tracker.rs PATH_STEP).
+constexpr double kPathStep = 2.0;
+/// The speed (m/s) below which the tracker's gains are those of this speed
+/// (drive/tracker.rs MIN_SPEED).
+constexpr double kTrackerMinSpeed = 1.0;
+
+/// The speed the tracker's gains are taken at, max(v, kTrackerMinSpeed)
+/// (drive/tracker.rs tracker_speed).
+inline double tracker_speed(double speed) { return std::fmax(speed, kTrackerMinSpeed); }
+
+/// The signed curvature (1/m, positive turning left) of the circle through three points
+/// (drive/tracker.rs curvature):
+/// 2 ((p1 - p0) x (p2 - p1)) / (|p1 - p0| |p2 - p1| |p2 - p0|).
+inline double curvature(double x0, double y0, double x1, double y1, double x2, double y2) {
+    double ax = x1 - x0, ay = y1 - y0;
+    double bx = x2 - x1, by = y2 - y1;
+    double cx = x2 - x0, cy = y2 - y0;
+    double norms = std::fmax(std::hypot(ax, ay) * std::hypot(bx, by) * std::hypot(cx, cy),
+                             std::numeric_limits<double>::min());
+    return 2.0 * (ax * by - ay * bx) / norms;
+}
+
+/// The path tracker's gains (drive/tracker.rs PathTracker).
+struct TrackerGains {
+    double preview_time;      ///< t_p (s)
+    double preview_min;       ///< x_min (m)
+    double feedforward_time;  ///< t_f (s)
+    double yaw_rate_gain;     ///< c
+};
+
+/// The car as the tracker's law reads it (drive/tracker.rs TrackerCar).
+struct TrackerCar {
+    double mass;         ///< m (kg)
+    double wheelbase;    ///< L (m)
+    double cg_to_front;  ///< a (m)
+    double cg_to_rear;   ///< b (m)
+    double steer_lock;   ///< delta_max (rad)
+};
+
+/// The car's state against the path (drive/tracker.rs TrackerInput).
+struct TrackerInput {
+    double lateral_error;  ///< e (m, positive left of the path)
+    double heading_error;  ///< psi - theta_P (rad)
+    double curvature;      ///< kappa_f, the path's curvature t_f v ahead (1/m)
+    double speed;          ///< v (m/s), tracker_speed of the car's speed
+    double yaw_rate;       ///< r (rad/s)
+    double cornering[2];   ///< C_f, C_r (N/rad) at this speed
+};
+
+/// The road-wheel angle (rad) of the path tracker (drive/tracker.rs PathTracker::law):
+/// delta = clamp(G (kappa_d + c (kappa_d - r / v)), -delta_max, delta_max), with
+/// kappa_d = kappa_f - (2 / x_p^2) (e + x_p (dpsi - dpsi_ss)), x_p = max(t_p v, x_min),
+/// dpsi_ss = kappa_f (m a v^2 / (L C_r) - b), G = max(L + K v^2, L / 4) and the understeer
+/// gradient K = (m / L) (b / C_f - a / C_r).
+inline double tracker_law(const TrackerGains &g, const TrackerCar &car, const TrackerInput &in) {
+    double l = car.wheelbase, a = car.cg_to_front, b = car.cg_to_rear, m = car.mass;
+    double e = in.lateral_error, heading_error = in.heading_error, kappa = in.curvature;
+    double v = in.speed;
+    double cf = in.cornering[0], cr = in.cornering[1];
+    double understeer = m / l * (b / cf - a / cr);
+    double steady_heading_error = kappa * (m * a * v * v / (l * cr) - b);
+    double x_p = std::fmax(g.preview_time * v, g.preview_min);
+    double kappa_d = kappa - 2.0 / (x_p * x_p) * (e + x_p * (heading_error - steady_heading_error));
+    double gain = std::fmax(l + understeer * v * v, 0.25 * l);
+    double delta = gain * (kappa_d + g.yaw_rate_gain * (kappa_d - in.yaw_rate / v));
+    return clamp(delta, -car.steer_lock, car.steer_lock);
 }
 
 // ---- The gearbox ----------------------------------------------------------------------------

@@ -86,6 +86,38 @@ const std::map<std::string, Case> kCases = {
          double out = drive::steering_law(e, d, l, ki, lock, integral, dt);
          return std::vector<double>{out, integral};
      }},
+    {"tracker_constants",  // -> kPathStep kTrackerMinSpeed
+     [](Args &) { return std::vector<double>{drive::kPathStep, drive::kTrackerMinSpeed}; }},
+    {"tracker_speed",  // SPEED -> v
+     [](Args &a) { return std::vector<double>{drive::tracker_speed(a.num())}; }},
+    {"curvature",  // X0 Y0 X1 Y1 X2 Y2 -> kappa
+     [](Args &a) {
+         double x0 = a.num(), y0 = a.num(), x1 = a.num(), y1 = a.num(), x2 = a.num();
+         return std::vector<double>{drive::curvature(x0, y0, x1, y1, x2, a.num())};
+     }},
+    {"tracker_law",  // T_P X_MIN T_F C  M L A B LOCK  E DPSI KAPPA V R CF CR -> delta
+     [](Args &a) {
+         drive::TrackerGains g;
+         g.preview_time = a.num();
+         g.preview_min = a.num();
+         g.feedforward_time = a.num();
+         g.yaw_rate_gain = a.num();
+         drive::TrackerCar car;
+         car.mass = a.num();
+         car.wheelbase = a.num();
+         car.cg_to_front = a.num();
+         car.cg_to_rear = a.num();
+         car.steer_lock = a.num();
+         drive::TrackerInput in;
+         in.lateral_error = a.num();
+         in.heading_error = a.num();
+         in.curvature = a.num();
+         in.speed = a.num();
+         in.yaw_rate = a.num();
+         in.cornering[0] = a.num();
+         in.cornering[1] = a.num();
+         return std::vector<double>{drive::tracker_law(g, car, in)};
+     }},
     {"gear_update",  // GEAR SHIFTING N R1..RN K U11..UNK MARGIN SHIFT_TIME W THROTTLE
                      //   -> GEAR' SHIFTING' upshift_at(gear, throttle)
      [](Args &a) {

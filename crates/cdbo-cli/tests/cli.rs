@@ -600,10 +600,6 @@ fn simulator_torcs_is_refused_where_it_is_not_supported() {
     let works = "--simulator torcs works with `lap`, `race`, `experiment`, `serve-sim` and `optimize --track T`";
     fails_with(&["--simulator", "torcs", "limit"], &[works]);
     fails_with(&["--simulator", "torcs", "ceiling"], &[works]);
-    fails_with(
-        &["--simulator", "torcs", "lap", "--steering", "tracker"],
-        &["--steering", "PI law only"],
-    );
     // A grid in the game runs in a folder; workers over storage drive cdbo's simulator only.
     let grid_db = scratch("torcs-grid.db", "");
     std::fs::remove_file(&grid_db).unwrap();

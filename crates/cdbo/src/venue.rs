@@ -44,20 +44,18 @@ impl Venue {
         })
     }
 
-    /// This venue with the car steered by `steering`; the game's robot steers with the PI law
-    /// only, so the path tracker is refused there.
-    pub fn steered(self, steering: Steering) -> Result<Venue> {
+    /// This venue with the car steered by `steering` (the game's robot steers the centre line
+    /// with either law).
+    pub fn steered(self, steering: Steering) -> Venue {
         match self {
             Venue::Simulator(mut sim) => {
                 sim.config.steering = steering;
-                Ok(Venue::Simulator(sim))
+                Venue::Simulator(sim)
             }
-            Venue::Game { .. } if matches!(steering, Steering::Pi(_)) => Ok(self),
-            Venue::Game { .. } => Err(Error::invalid_value(
-                "the steering in the game TORCS",
-                "the path tracker",
-                "the PI steering: cdbo's robot steers with the PI law only",
-            )),
+            Venue::Game { game, mut request } => {
+                request.config.steering = steering;
+                Venue::Game { game, request }
+            }
         }
     }
 

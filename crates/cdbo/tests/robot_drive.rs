@@ -19,15 +19,18 @@ mod common;
 use std::path::PathBuf;
 use std::process::Command;
 use std::sync::OnceLock;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use cdbo::car::Car;
 use cdbo::drive::demo::{self, SpeedHold};
-use cdbo::drive::steering::{self, PiSteering};
+use cdbo::drive::steering::{self, PiSteering, Steering};
+use cdbo::drive::tracker::{self, PathTracker, TrackerCar, TrackerInput};
 use cdbo::drive::{Observation, Pedal, pedal_command, pi_control};
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 use cdbo::policy::{PolicyTable, RkhsPolicy};
 use cdbo::sim::powertrain::{DOWNSHIFT_MARGIN, Gearbox, THROTTLE_LEVELS};
 use cdbo::sim::{Simulator, TracePoint};
+use cdbo::torcs::lap::cornering_tables;
 use cdbo::torcs::launch::{LaunchCar, launch_clutch};
 use cdbo::torcs::{ROBOT_CXXFLAGS, ROBOT_HEADER, ROBOT_HEADER_NAME};
 use cdbo::track::builtin::DEFAULT;
@@ -136,9 +139,11 @@ impl Calls {
             .push((format!("{what}: {name} {args:?}"), expected.to_vec(), agree));
     }
 
-    /// Runs the harness on every call and compares; returns the number of calls.
+    /// Runs the harness on every call and compares; returns the number of calls. Each run
+    /// has an input file of its own (the tests run in parallel).
     fn run(&self, exe: &PathBuf) -> usize {
-        let input = exe.with_extension("in");
+        static RUNS: AtomicUsize = AtomicUsize::new(0);
+        let input = exe.with_extension(format!("in{}", RUNS.fetch_add(1, Ordering::Relaxed)));
         std::fs::write(&input, &self.input).unwrap();
         let out = Command::new(exe)
             .stdin(std::fs::File::open(&input).unwrap())
@@ -354,6 +359,133 @@ fn the_robots_decisions_are_the_rust_ones_on_recorded_laps() {
 
     let n = calls.run(&exe);
     assert!(n > 10 * (demo.len() + fast.len()), "{n} calls");
+}
+
+/// The path tracker's steering in the robot is the Rust one: on every driver step of two laps
+/// of the simulator steered by the tracker (the demonstration and the learned policy), rebuilt
+/// from the recorded position, heading, speed and yaw rate, the C++ gives the same heading
+/// error, curvature and steering command, bit for bit; the cornering stiffness the robot
+/// interpolates in its tables (torcs/lap.rs `cornering_tables`) lies within 1e-4 of the
+/// vehicle's.
+#[test]
+fn the_robots_tracker_is_the_rust_one_on_a_recorded_lap() {
+    let Some(exe) = harness() else { return };
+    let car = Car::spirit_300();
+    let mut sim = Simulator::new(builtin(DEFAULT), &car);
+    sim.config.trace = true;
+    let tracker = PathTracker::new();
+    sim.config.steering = Steering::Tracker(tracker.clone());
+    let track = &sim.track;
+    let demo = lap(&sim, &mut SpeedHold::new(15.0));
+    let policy = RkhsPolicy::new(LEARNED.1.to_vec(), LEARNED.0).unwrap();
+    let fast = lap(&sim, &mut policy.pedal());
+
+    let mut calls = Calls::default();
+    calls.check(
+        "constants",
+        "tracker_constants",
+        &[],
+        &[tracker::PATH_STEP, tracker::MIN_SPEED],
+        Agree::Exactly,
+    );
+    let tables = cornering_tables(&sim.vehicle);
+    let table_args = tables.clone().map(|t| {
+        let mut args = vec![t.len() as f64];
+        args.extend(t.iter().flat_map(|&(v, c)| [v, c]));
+        args
+    });
+    let gains = [
+        tracker.preview_time,
+        tracker.preview_min,
+        tracker.feedforward_time,
+        tracker.yaw_rate_gain,
+    ];
+    let tc = TrackerCar::of(&car);
+    let chassis = [
+        tc.mass,
+        tc.wheelbase,
+        tc.cg_to_front,
+        tc.cg_to_rear,
+        tc.steer_lock,
+    ];
+    let (mut saturated, mut cornering, mut fastest) = (0, 0, 0.0_f64);
+    for (name, trace) in [("demonstration", &demo), ("learned policy", &fast)] {
+        let mut hint = 0;
+        for p in trace.iter() {
+            let at = format!("{name} at t = {} s", p.t);
+            let proj = track.project(p.pos_x, p.pos_y, hint);
+            hint = proj.index;
+            assert_eq!(proj.lateral.to_bits(), p.lateral.to_bits(), "{at}");
+            let yaw = p.heading_error + track.sample(proj.index).heading;
+            // The simulator's first driver step reads the car's (sin ψ, cos ψ) before its
+            // gearbox first synchronises them with ψ (Vehicle::at_rest leaves them (0, 0)):
+            // there every bearing is 0.
+            let (sin, cos) = if p.t == 0.0 {
+                (0.0, 0.0)
+            } else {
+                yaw.sin_cos()
+            };
+            let v = tracker::tracker_speed(p.speed);
+            calls.check(&at, "tracker_speed", &[p.speed], &[v], Agree::Exactly);
+            let (behind, ahead) = (
+                track.point_at(proj.s - tracker::PATH_STEP),
+                track.point_at(proj.s + tracker::PATH_STEP),
+            );
+            let (dx, dy) = (ahead.0 - behind.0, ahead.1 - behind.1);
+            let bearing = steering::bearing(dx, dy, (sin, cos));
+            calls.check(
+                &at,
+                "bearing",
+                &[dx, dy, sin, cos],
+                &[bearing],
+                Agree::Exactly,
+            );
+            let sf = proj.s + tracker.feedforward_time * v;
+            let points =
+                [-tracker::PATH_STEP, 0.0, tracker::PATH_STEP].map(|ds| track.point_at(sf + ds));
+            let kappa = tracker::curvature(points[0], points[1], points[2]);
+            let args: Vec<f64> = points.iter().flat_map(|&(x, y)| [x, y]).collect();
+            calls.check(&at, "curvature", &args, &[kappa], Agree::Exactly);
+            let friction = track.frame(proj.index).friction;
+            let stiffness = sim.vehicle.cornering_stiffness(v, friction);
+            for (k, args) in table_args.iter().enumerate() {
+                let args = [&args[..], &[v]].concat();
+                let exact = stiffness[k] / friction;
+                let tol = Agree::Within(1e-4 * exact);
+                calls.check(&at, "table", &args, &[exact], tol);
+                let linear = cdbo::interp::linear(&tables[k], v);
+                calls.check(&at, "table", &args, &[linear], Agree::Exactly);
+            }
+            let input = TrackerInput {
+                lateral_error: p.lateral,
+                heading_error: -bearing,
+                curvature: kappa,
+                speed: v,
+                yaw_rate: p.yaw_rate,
+                cornering_stiffness: stiffness,
+            };
+            let delta = tracker.law(&tc, &input);
+            // The replay is the simulator's steering (up to the rounding of the rebuilt yaw).
+            assert!(
+                (delta - p.steer).abs() < 1e-9,
+                "{at}: {delta} vs {}",
+                p.steer
+            );
+            let mut args = [&gains[..], &chassis[..]].concat();
+            args.extend([-bearing, kappa, v, p.yaw_rate, stiffness[0], stiffness[1]]);
+            args.insert(gains.len() + chassis.len(), p.lateral);
+            calls.check(&at, "tracker_law", &args, &[delta], Agree::Exactly);
+            saturated += usize::from(delta.abs() == car.steer_lock);
+            cornering += usize::from(kappa.abs() > 0.01);
+            fastest = fastest.max(p.speed);
+        }
+    }
+    // The states span the law: corners, a fast lap, the lock.
+    assert!(cornering > 1000, "{cornering} steps in corners");
+    assert!(fastest > 25.0, "{fastest} m/s");
+    assert!(saturated >= 1, "{saturated} steps at the lock");
+    let n = calls.run(&exe);
+    assert!(n > 7 * (demo.len() + fast.len()), "{n} calls");
 }
 
 /// The harness refuses what it does not know: a misspelt call or a short line fails the

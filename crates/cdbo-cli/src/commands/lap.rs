@@ -141,7 +141,6 @@ pub fn run(args: &LapArgs, data: &DataPath, simulator: Simulator) -> CliResult {
 /// A lap in the game TORCS, driven by cdbo's robot; the limit is cdbo's, on the game's track
 /// and car files.
 fn run_torcs(args: &LapArgs, data: &DataPath) -> CliResult {
-    super::check_game_steering(Simulator::Torcs, args.steering)?;
     if args.plot.is_some() {
         return Err(
             "--plot needs cdbo's simulator; with --simulator torcs write --trace and plot it"
@@ -172,6 +171,7 @@ fn run_torcs(args: &LapArgs, data: &DataPath) -> CliResult {
     let game = Game::ready()?;
     let car_name = Simulator::Torcs.car(&args.setup.car);
     let mut req = game.request(&args.setup.track, car_name, pedal)?;
+    req.config.steering = args.steering.steering();
     if let Some(path) = &args.trace {
         req.trace =
             Some(std::path::absolute(path).map_err(|e| format!("{}: {e}", path.display()))?);
@@ -181,7 +181,8 @@ fn run_torcs(args: &LapArgs, data: &DataPath) -> CliResult {
         .map_err(|reason| format!("TORCS drove no lap: {reason}"))?;
     let track = super::game_track(&args.setup.track, &game, data)?;
     let limit = limit_lap(&track, &req.car);
-    let ours = cdbo::sim::Simulator::new(track.clone(), &req.car);
+    let mut ours = cdbo::sim::Simulator::new(track.clone(), &req.car);
+    ours.config.steering = args.steering.steering();
     let (_, ceiling_mps) = cdbo::ceiling::tracked_profile(&ours, &limit)?;
     print_report(
         LapReport::new(&track.name, car_name, &lap, &limit, ceiling_mps, "torcs"),
@@ -243,12 +244,12 @@ fn write_trace(path: &std::path::Path, trace: &[cdbo::sim::TracePoint]) -> CliRe
     let mut w = std::io::BufWriter::new(file);
     writeln!(
         w,
-        "t_s,distance_m,x,speed_mps,pedal,steer_rad,lateral_m,heading_error_rad,slip_angle_rad,gear,rpm,pos_x_m,pos_y_m"
+        "t_s,distance_m,x,speed_mps,pedal,steer_rad,lateral_m,heading_error_rad,slip_angle_rad,gear,rpm,pos_x_m,pos_y_m,yaw_rate_rad_s"
     )?;
     for p in trace {
         writeln!(
             w,
-            "{:.3},{:.3},{:.6},{:.4},{:.4},{:.5},{:.4},{:.5},{:.5},{},{:.0},{:.3},{:.3}",
+            "{:.3},{:.3},{:.6},{:.4},{:.4},{:.5},{:.4},{:.5},{:.5},{},{:.0},{:.3},{:.3},{:.5}",
             p.t,
             p.distance_m,
             p.x,
@@ -261,7 +262,8 @@ fn write_trace(path: &std::path::Path, trace: &[cdbo::sim::TracePoint]) -> CliRe
             p.gear,
             p.rpm,
             p.pos_x,
-            p.pos_y
+            p.pos_y,
+            p.yaw_rate
         )?;
     }
     w.flush()?;

@@ -65,8 +65,8 @@ pub enum SteeringChoice {
     #[default]
     Pi,
     /// The path tracker: feed-forward from the path's curvature and the car's understeer
-    /// gradient, feedback on the previewed lateral error, yaw-rate damping (cdbo's simulator
-    /// only).
+    /// gradient, feedback on the previewed lateral error, yaw-rate damping (in the game on the
+    /// centre line).
     Tracker,
 }
 
@@ -78,14 +78,6 @@ impl SteeringChoice {
             SteeringChoice::Tracker => Steering::Tracker(PathTracker::new()),
         }
     }
-}
-
-/// Refuses a steering other than the PI in the game, whose robot steers with the PI law only.
-pub fn check_game_steering(simulator: Simulator, steering: SteeringChoice) -> CliResult {
-    if simulator == Simulator::Torcs && steering != SteeringChoice::Pi {
-        return Err("--steering: cdbo's robot in the game steers with the PI law only".into());
-    }
-    Ok(())
 }
 
 /// Where `--simulator` drives the laps of `setup`'s track and car, and cdbo's reading of them

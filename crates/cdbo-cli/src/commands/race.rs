@@ -128,11 +128,8 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     if let Some(w) = cdbo::method::cost::slow_race_warning(args.method, args.kernels, args.laps) {
         eprintln!("warning: {w}");
     }
-    super::check_game_steering(simulator, args.steering)?;
     let (venue, track, car) = super::venue(&args.setup, data, simulator)?;
-    let venue = venue
-        .steered(args.steering.steering())
-        .map_err(from_flag("--steering"))?;
+    let venue = venue.steered(args.steering.steering());
     let track_name = track.name.clone();
     let out = args.out.clone().unwrap_or_else(|| {
         PathBuf::from("runs").join(format!(

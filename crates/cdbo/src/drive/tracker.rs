@@ -33,6 +33,7 @@
 //! `the_tracker_holds_an_offset_on_a_circle` checks this steady state on the simulator's car.
 
 use super::steering::bearing;
+use crate::car::Car;
 use crate::sim::vehicle::{State, Vehicle};
 use crate::track::{Projection, Track};
 
@@ -49,9 +50,9 @@ pub const FEEDFORWARD_TIME: f64 = 0.15;
 /// Yaw-rate gain c (dimensionless: the steering per unit of curvature error in yaw).
 pub const YAW_RATE_GAIN: f64 = 4.0;
 /// Half the spacing of the path points the heading and curvature are read from (m).
-const PATH_STEP: f64 = 2.0;
+pub const PATH_STEP: f64 = 2.0;
 /// The speed below which the gains are those of this speed (m/s): the standing start.
-const MIN_SPEED: f64 = 1.0;
+pub const MIN_SPEED: f64 = 1.0;
 
 /// The path tracker's gains (it keeps no memory between steps).
 #[derive(Debug, Clone, PartialEq)]
@@ -77,6 +78,51 @@ impl Default for PathTracker {
     }
 }
 
+/// The car as the tracker's law reads it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrackerCar {
+    /// Mass m (kg).
+    pub mass: f64,
+    /// Wheelbase L (m).
+    pub wheelbase: f64,
+    /// Distance a of the front axle from the centre of gravity (m).
+    pub cg_to_front: f64,
+    /// Distance b of the rear axle from the centre of gravity (m).
+    pub cg_to_rear: f64,
+    /// Largest road-wheel angle δ_max (rad).
+    pub steer_lock: f64,
+}
+
+impl TrackerCar {
+    /// What the law reads of `car`.
+    pub fn of(car: &Car) -> TrackerCar {
+        TrackerCar {
+            mass: car.mass,
+            wheelbase: car.wheelbase,
+            cg_to_front: car.cg_to_front(),
+            cg_to_rear: car.cg_to_rear(),
+            steer_lock: car.steer_lock,
+        }
+    }
+}
+
+/// The car's state against the path, all the tracker's law reads of a driver step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrackerInput {
+    /// Lateral error e (m, positive left of the path).
+    pub lateral_error: f64,
+    /// Heading error Δψ = ψ − θ_P (rad).
+    pub heading_error: f64,
+    /// The path's curvature κ_f at the feed-forward station (1/m).
+    pub curvature: f64,
+    /// Speed v (m/s), at least [`MIN_SPEED`] ([`tracker_speed`]).
+    pub speed: f64,
+    /// Yaw rate r (rad/s).
+    pub yaw_rate: f64,
+    /// The front and rear axle's cornering stiffness C_f, C_r at this speed (N/rad).
+    pub cornering_stiffness: [f64; 2],
+}
+
 impl PathTracker {
     /// A tracker with the documented gains.
     pub fn new() -> PathTracker {
@@ -84,7 +130,9 @@ impl PathTracker {
     }
 
     /// The road-wheel angle (rad) for the car in `state` at `proj` holding the line `line(s)`
-    /// metres left of the centre line at station s (the [module](self)'s law).
+    /// metres left of the centre line at station s (the [module](self)'s law): the path's
+    /// points [`PATH_STEP`] either side of the car's station give its heading, three points
+    /// around the station t_f·v ahead its [`curvature`], and [`Self::law`] steers.
     pub fn update(
         &self,
         track: &Track,
@@ -93,32 +141,58 @@ impl PathTracker {
         proj: &Projection,
         line: &dyn Fn(f64) -> f64,
     ) -> f64 {
-        let car = &vehicle.car;
-        let (l, a, b, m) = (car.wheelbase, car.cg_to_front(), car.cg_to_rear(), car.mass);
-        let v = state.speed().max(MIN_SPEED);
+        let v = tracker_speed(state.speed());
         let path = |s: f64| track.point_off(s, line(track.wrap(s)));
         let s = proj.s;
         let (behind, ahead) = (path(s - PATH_STEP), path(s + PATH_STEP));
         // Δψ = ψ − θ_P: minus the bearing of the path's tangent from the car's heading.
         let heading_error = -bearing(ahead.0 - behind.0, ahead.1 - behind.1, state.yaw_sin_cos);
-        let e = proj.lateral - line(s);
         let sf = s + self.feedforward_time * v;
-        let kappa = curvature(path(sf - PATH_STEP), path(sf), path(sf + PATH_STEP));
-        let [cf, cr] = vehicle.cornering_stiffness(v, track.frame(proj.index).friction);
+        let input = TrackerInput {
+            lateral_error: proj.lateral - line(s),
+            heading_error,
+            curvature: curvature(path(sf - PATH_STEP), path(sf), path(sf + PATH_STEP)),
+            speed: v,
+            yaw_rate: state.yaw_rate,
+            cornering_stiffness: vehicle.cornering_stiffness(v, track.frame(proj.index).friction),
+        };
+        self.law(&TrackerCar::of(&vehicle.car), &input)
+    }
+
+    /// The road-wheel angle (rad) δ = clamp(G·(κ_d + c·(κ_d − r/v)), −δ_max, δ_max), with
+    /// κ_d = κ_f − (2/x_p²)·(e + x_p·(Δψ − Δψ_ss)), x_p = max(t_p·v, x_min),
+    /// Δψ_ss = κ_f·(m·a·v²/(L·C_r) − b), G = max(L + K·v², L/4), K = (m/L)·(b/C_f − a/C_r)
+    /// (the [module](self)'s law, a pure function of numbers so that the TORCS robot's
+    /// `torcs-robot/drive.hpp` can be checked against it, `tests/robot_drive.rs`).
+    pub fn law(&self, car: &TrackerCar, input: &TrackerInput) -> f64 {
+        let (l, a, b, m) = (car.wheelbase, car.cg_to_front, car.cg_to_rear, car.mass);
+        let (e, heading_error, kappa, v) = (
+            input.lateral_error,
+            input.heading_error,
+            input.curvature,
+            input.speed,
+        );
+        let [cf, cr] = input.cornering_stiffness;
         let understeer = m / l * (b / cf - a / cr);
         let steady_heading_error = kappa * (m * a * v * v / (l * cr) - b);
         let x_p = (self.preview_time * v).max(self.preview_min);
         let kappa_d =
             kappa - 2.0 / (x_p * x_p) * (e + x_p * (heading_error - steady_heading_error));
         let gain = (l + understeer * v * v).max(0.25 * l);
-        let delta = gain * (kappa_d + self.yaw_rate_gain * (kappa_d - state.yaw_rate / v));
+        let delta = gain * (kappa_d + self.yaw_rate_gain * (kappa_d - input.yaw_rate / v));
         delta.clamp(-car.steer_lock, car.steer_lock)
     }
 }
 
+/// The speed (m/s) the tracker's gains are taken at: max(v, [`MIN_SPEED`]).
+#[inline]
+pub fn tracker_speed(speed: f64) -> f64 {
+    speed.max(MIN_SPEED)
+}
+
 /// The signed curvature (1/m, positive turning left) of the circle through three points:
 /// 2·((p₁ − p₀) × (p₂ − p₁)) / (|p₁ − p₀|·|p₂ − p₁|·|p₂ − p₀|).
-fn curvature(p0: (f64, f64), p1: (f64, f64), p2: (f64, f64)) -> f64 {
+pub fn curvature(p0: (f64, f64), p1: (f64, f64), p2: (f64, f64)) -> f64 {
     let (ax, ay) = (p1.0 - p0.0, p1.1 - p0.1);
     let (bx, by) = (p2.0 - p1.0, p2.1 - p1.1);
     let (cx, cy) = (p2.0 - p0.0, p2.1 - p0.1);

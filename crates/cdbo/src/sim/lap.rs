@@ -115,6 +115,8 @@ pub struct TracePoint {
     pub pos_x: f64,
     /// Position (m).
     pub pos_y: f64,
+    /// Yaw rate (rad/s, positive turning left).
+    pub yaw_rate: f64,
 }
 
 /// The outcome of a lap.
@@ -282,6 +284,7 @@ impl Simulator {
                         rpm: state.engine_speed * 30.0 / std::f64::consts::PI,
                         pos_x: state.x,
                         pos_y: state.y,
+                        yaw_rate: state.yaw_rate,
                     });
                 }
             }

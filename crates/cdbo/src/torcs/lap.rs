@@ -181,8 +181,26 @@ fn first_driver(robot_xml: &str) -> usize {
         .unwrap_or(0)
 }
 
+/// The fastest speed (m/s) of the cornering-stiffness tables handed to the robot for the path
+/// tracker, one point per m/s from 0: linear in between, they stay within 1e-4 of
+/// [`Vehicle::cornering_stiffness`] (the test `the_robots_tracker_is_the_rust_one_on_a_recorded_lap`).
+pub const CORNERING_SPEEDS: usize = 120;
+
+/// The (speed, cornering stiffness) tables of the front and rear axle on a surface of friction
+/// 1 that the robot's path tracker reads (linear in between, scaled by the road's friction):
+/// [`Vehicle::cornering_stiffness`] at every m/s from 0 to [`CORNERING_SPEEDS`].
+pub fn cornering_tables(vehicle: &Vehicle) -> [Vec<(f64, f64)>; 2] {
+    [0, 1].map(|k| {
+        (0..=CORNERING_SPEEDS)
+            .map(|i| {
+                let v = i as f64;
+                (v, vehicle.cornering_stiffness(v, 1.0)[k])
+            })
+            .collect()
+    })
+}
+
 /// The robot's settings file (format in `torcs-robot/cdbo.cpp`).
-/// Refused for the path tracker: the robot steers with the PI law only.
 fn settings(
     req: &LapRequest,
     output: &Path,
@@ -214,18 +232,28 @@ fn settings(
     };
     let _ = writeln!(s, "pedal {pedal}");
     let _ = writeln!(s, "wheelbase {:e}", car.wheelbase);
-    let Steering::Pi(st) = &req.config.steering else {
-        return Err(Error::invalid_value(
-            "the steering of a lap in the game TORCS",
-            "the path tracker",
-            "the PI steering: cdbo's robot steers with the PI law only",
-        ));
-    };
-    let _ = writeln!(
-        s,
-        "steering {:e} {:e} {:e}",
-        st.lookahead_time, st.lookahead_min, st.ki
-    );
+    match &req.config.steering {
+        Steering::Pi(st) => {
+            let _ = writeln!(
+                s,
+                "steering pi {:e} {:e} {:e}",
+                st.lookahead_time, st.lookahead_min, st.ki
+            );
+        }
+        Steering::Tracker(t) => {
+            let _ = writeln!(
+                s,
+                "steering tracker {:e} {:e} {:e} {:e}",
+                t.preview_time, t.preview_min, t.feedforward_time, t.yaw_rate_gain
+            );
+            let (a, b) = (car.cg_to_front(), car.cg_to_rear());
+            let _ = writeln!(s, "chassis {:e} {a:e} {b:e}", car.mass);
+            for (axle, table) in ["front", "rear"].iter().zip(cornering_tables(&vehicle)) {
+                let mut pairs = table.into_iter().flat_map(|(v, c)| [v, c]);
+                let _ = writeln!(s, "cornering_{axle} {}", list(&mut pairs));
+            }
+        }
+    }
     let fd = car.final_drive;
     let _ = writeln!(s, "ratios {}", list(&mut car.gears.iter().map(|g| g * fd)));
     let _ = writeln!(s, "throttle_levels {THROTTLE_LEVELS}");
@@ -583,8 +611,8 @@ pub fn read_trace(path: &Path) -> Result<Vec<TracePoint>> {
                     .map_err(|_| bad(format!("{c:?} is not a number")))
             })
             .collect::<Result<Vec<f64>>>()?;
-        if v.len() != 13 {
-            return Err(bad(format!("expected 13 columns, found {}", v.len())));
+        if v.len() != 14 {
+            return Err(bad(format!("expected 14 columns, found {}", v.len())));
         }
         points.push(TracePoint {
             t: v[0],
@@ -600,6 +628,7 @@ pub fn read_trace(path: &Path) -> Result<Vec<TracePoint>> {
             rpm: v[10],
             pos_x: v[11],
             pos_y: v[12],
+            yaw_rate: v[13],
         });
     }
     Ok(points)
