@@ -64,6 +64,7 @@ fn study_config() -> StudyConfig {
         track: None,
         track_length: None,
         knob: None,
+        warm_start: None,
     }
 }
 

@@ -116,6 +116,7 @@ pub fn race(
         demo_speed,
         knob,
         max_failed_laps: max_failed,
+        warm_start: None,
     };
     let mut callback_error: Option<PyErr> = None;
     let outcome = py

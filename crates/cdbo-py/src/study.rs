@@ -102,6 +102,7 @@ impl PyStudy {
             track: None,
             track_length,
             knob,
+            warm_start: None,
         };
         let study = py.detach(|| Study::create(&path, config)).py()?;
         Ok(PyStudy {

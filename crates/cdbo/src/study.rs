@@ -76,13 +76,21 @@ pub struct StudyConfig {
     /// value (and in studies made before it could be set).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub knob: Option<f64>,
+    /// The policy file w₀ was read from when the study is warm-started from a learned policy
+    /// (the pattern search then does not push it: [`Spec::warm_started`]); absent: w₀ is a
+    /// demonstration's fit or initial weights, and in studies made before it was recorded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub warm_start: Option<String>,
 }
 
 impl StudyConfig {
     /// The study's specification of its method, for the weights of its lap policy.
     pub fn spec(&self) -> Result<Spec> {
-        let spec =
+        let mut spec =
             Spec::told(self.method, self.seed, self.beta, self.knob)?.policy(self.lengthscale)?;
+        if self.warm_start.is_some() {
+            spec = spec.warm_started();
+        }
         self.track_length
             .map_or(Ok(spec), |length| spec.track_length(length))
     }
@@ -515,6 +523,7 @@ mod tests {
             track: None,
             track_length: None,
             knob: None,
+            warm_start: None,
         }
     }
 

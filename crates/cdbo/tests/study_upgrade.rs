@@ -27,6 +27,7 @@ fn config() -> StudyConfig {
         track: None,
         track_length: None,
         knob: None,
+        warm_start: None,
     }
 }
 

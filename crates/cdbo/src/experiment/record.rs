@@ -174,6 +174,7 @@ pub fn run_at(
         demo_speed: grid.demo_speed,
         knob: Some(grid.knob_of(method)),
         max_failed_laps: None,
+        warm_start: None,
     };
     let (track_name, length_m) = (track.name.clone(), track.length);
     let venue = match grounds {

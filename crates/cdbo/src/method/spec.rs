@@ -29,6 +29,7 @@ pub struct Spec {
     policy_lengthscale: Option<f64>,
     track_length: Option<f64>,
     max_failed_laps: Option<usize>,
+    warm: bool,
 }
 
 impl Spec {
@@ -49,6 +50,7 @@ impl Spec {
             policy_lengthscale: None,
             track_length: None,
             max_failed_laps: None,
+            warm: false,
         }
         .with_checked_knob(method.knob().value)
     }
@@ -148,6 +150,15 @@ impl Spec {
         }
     }
 
+    /// This specification starting from a learned policy rather than a demonstration's fit
+    /// (a warm start): the pattern search does not push it (a learned policy is pushed
+    /// already) but repairs it where its first lap fails, as a push is repaired
+    /// ([`PatternSearchConfig::warm`](pattern_search::PatternSearchConfig::warm)); the other
+    /// methods are unchanged (their search box is centred on the start, as always).
+    pub fn warm_started(self) -> Spec {
+        Spec { warm: true, ..self }
+    }
+
     /// The method.
     pub fn method(&self) -> Method {
         self.method
@@ -189,6 +200,7 @@ impl Spec {
             policy_lengthscale,
             track_length,
             max_failed_laps: _,
+            warm,
         } = *self;
         let bo = |maximiser| bo::BoConfig {
             seed,
@@ -258,7 +270,11 @@ impl Spec {
                     repair: true,
                     lengthscale: policy_lengthscale,
                     track_length,
-                    ..pattern_search::PatternSearchConfig::default()
+                    ..if warm {
+                        pattern_search::PatternSearchConfig::warm()
+                    } else {
+                        pattern_search::PatternSearchConfig::default()
+                    }
                 },
             )?),
         })

@@ -72,6 +72,11 @@ pub struct Push {
     /// it; a later push holds the targets moved down (empty in pushes saved before it existed).
     #[serde(default)]
     pub repaired: Vec<f64>,
+    /// The weights the targets move, when this is the repair of a start rather than a push
+    /// ([`Push::repairing`]): the targets are then offsets to its pedal, and a lap's weights
+    /// are these plus the offsets' fit, the start kept exactly where no repair moved it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub base: Option<Vec<f64>>,
 }
 
 impl Push {
@@ -107,7 +112,28 @@ impl Push {
             },
             laps: 0,
             repaired,
+            base: None,
         })
+    }
+
+    /// The repair of the start `start` of a search set by `config` (a policy learned
+    /// elsewhere, whose lap here failed): a push of size 0 whose targets are offsets to the
+    /// start's pedal, all 0 until a repair moves them. Refitting the start's pedal itself
+    /// would smooth away its sharp braking points (measured: a 112.5 s lap became 137 s).
+    pub fn repairing(start: &[f64], config: &PatternSearchConfig) -> Push {
+        let g = targets_for(start.len());
+        let repair = PedalRepair::new(start.len());
+        Push {
+            number: 1,
+            targets: vec![0.0; g],
+            repair: match config.track_length {
+                Some(length) => repair.over(REPAIR_DISTANCE / length),
+                None => repair,
+            },
+            laps: 0,
+            repaired: vec![0.0; g],
+            base: Some(start.to_vec()),
+        }
     }
 
     /// Whether a saved push is one this code could have made for an M-kernel policy: a push
@@ -131,6 +157,10 @@ impl Push {
                 .last
                 .is_none_or(|(x, d)| x.is_finite() && d.is_finite())
             && self.laps <= LAPS
+            && self
+                .base
+                .as_ref()
+                .is_none_or(|b| b.len() == kernels && finite(b))
     }
 
     /// The weights of the push's next lap: its targets fitted by ridge regression, in the box.
@@ -142,6 +172,9 @@ impl Push {
             DEFAULT_RIDGE,
         )?
         .weights;
+        if let Some(base) = &self.base {
+            w.iter_mut().zip(base).for_each(|(w, b)| *w += b);
+        }
         bounds.clamp(&mut w);
         Ok(w)
     }
