@@ -813,3 +813,75 @@ fn endless_input_files_are_refused_at_their_bound() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `race --warm-start` starts from the file's policy: its first lap is the lap that policy
+/// drove as the earlier race's best, bit for bit, the kernels come from the file, and the
+/// summary says where it started; a file of other kernels than `--kernels` is refused in one
+/// line naming the file and both sizes, as is a study's.
+#[test]
+fn a_race_warm_starts_from_a_policy_file() {
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("cdbo-cli-warm-{}", std::process::id()));
+    let (learn, warm) = (out.join("learn"), out.join("warm"));
+    let common = [
+        "race",
+        "--method",
+        "pattern-search",
+        "--seed",
+        "2",
+        "--json",
+    ];
+    let learned = json(
+        &[
+            &common[..],
+            &[
+                "--kernels",
+                "12",
+                "--laps",
+                "20",
+                "--out",
+                learn.to_str().unwrap(),
+            ],
+        ]
+        .concat(),
+    );
+    let policy = learn.join("best_policy.json");
+    let policy = policy.to_str().unwrap();
+    let v = json(
+        &[
+            &common[..],
+            &[
+                "--laps",
+                "3",
+                "--warm-start",
+                policy,
+                "--out",
+                warm.to_str().unwrap(),
+            ],
+        ]
+        .concat(),
+    );
+    assert_eq!(v["kernels"], 12);
+    assert_eq!(v["warm_start"], policy);
+    assert_eq!(v["first_lap_reward_mps"], learned["best_reward_mps"]);
+    assert!(learned.get("warm_start").is_none());
+    fails_with(
+        &["race", "--kernels", "20", "--warm-start", policy],
+        &[policy, "12 kernels", "20 kernels"],
+    );
+    fails_with(
+        &[
+            "study",
+            "create",
+            "warm",
+            "--storage",
+            out.join("warm.cdbo.db").to_str().unwrap(),
+            "--kernels",
+            "20",
+            "--warm-start",
+            policy,
+        ],
+        &[policy, "12 kernels", "--kernels is 20"],
+    );
+    let _ = std::fs::remove_dir_all(&out);
+}

@@ -65,6 +65,7 @@ fn study_config() -> StudyConfig {
         track_length: None,
         knob: None,
         max_failed_laps: None,
+        warm_start: None,
     }
 }
 

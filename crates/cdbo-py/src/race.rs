@@ -117,6 +117,7 @@ pub fn race(
         knob,
         max_failed_laps: max_failed,
         line_kernels: None,
+        warm_start: None,
     };
     let mut callback_error: Option<PyErr> = None;
     let outcome = py

@@ -103,6 +103,7 @@ impl PyStudy {
             track_length,
             knob,
             max_failed_laps: None,
+            warm_start: None,
         };
         let study = py.detach(|| Study::create(&path, config)).py()?;
         Ok(PyStudy {

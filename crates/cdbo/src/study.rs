@@ -80,17 +80,24 @@ pub struct StudyConfig {
     /// budget (the safe pattern search's own, [`crate::learner::safe_search::BUDGET`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_failed_laps: Option<usize>,
+    /// The policy file w₀ was read from when the study is warm-started from a learned policy
+    /// (the pattern search then does not push it: [`Spec::warm_started`]); absent: w₀ is a
+    /// demonstration's fit or initial weights, and in studies made before it was recorded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub warm_start: Option<String>,
 }
 
 impl StudyConfig {
     /// The study's specification of its method, for the weights of its lap policy.
     pub fn spec(&self) -> Result<Spec> {
-        let spec =
+        let mut spec =
             Spec::told(self.method, self.seed, self.beta, self.knob)?.policy(self.lengthscale)?;
-        let spec = match self.max_failed_laps {
-            Some(max) => spec.max_failed_laps(max),
-            None => spec,
-        };
+        if let Some(max) = self.max_failed_laps {
+            spec = spec.max_failed_laps(max);
+        }
+        if self.warm_start.is_some() {
+            spec = spec.warm_started();
+        }
         self.track_length
             .map_or(Ok(spec), |length| spec.track_length(length))
     }
@@ -524,6 +531,7 @@ mod tests {
             track_length: None,
             knob: None,
             max_failed_laps: None,
+            warm_start: None,
         }
     }
 

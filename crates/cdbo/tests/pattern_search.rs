@@ -668,6 +668,7 @@ fn a_study_told_the_laps_length_drives_the_races_laps() {
                 track_length,
                 knob: None,
                 max_failed_laps: None,
+                warm_start: None,
             },
         )
         .unwrap();
@@ -759,4 +760,84 @@ fn a_race_learns_a_line_from_the_centre() {
         assert_eq!(raced.best.weights().len(), 20);
         assert!(raced.best_reward_mps > raced.demo.reward_mps, "{method}");
     }
+}
+
+/// A warm-started race starts from the policy it is given: its start is that policy, its first
+/// lap that policy's lap in the simulator, bit for bit; a policy of another shape is refused
+/// with both shapes named. The pattern search, warm-started, does not push: its second trial
+/// moves one weight, where a cold start raises the whole pedal.
+#[test]
+fn a_warm_started_race_starts_from_its_policy() {
+    use cdbo::experiment::race::{RaceConfig, race};
+
+    let track = || cdbo::track::builtin::load("ridgeway").unwrap().unwrap();
+    let car = cdbo::car::Car::spirit_300();
+    let venue = cdbo::venue::Venue::simulator(track(), &car);
+    let learn = RaceConfig {
+        method: Method::PatternSearch,
+        kernels: 12,
+        laps: 20,
+        seed: 3,
+        ..RaceConfig::default()
+    };
+    let learned = race(&venue, &track(), &car, &learn, |_| {}).unwrap().best;
+    let lap = cdbo::sim::Simulator::new(track(), &car).lap(&mut learned.driver());
+    assert!(lap.completed);
+    let warm = RaceConfig {
+        laps: 3,
+        warm_start: Some(learned.clone()),
+        ..learn.clone()
+    };
+    let raced = race(&venue, &track(), &car, &warm, |_| {}).unwrap();
+    assert_eq!(raced.initial, learned);
+    assert_eq!(
+        raced.laps[0].reward_mps.to_bits(),
+        lap.reward_mps.to_bits(),
+        "{} against {}",
+        raced.laps[0].reward_mps,
+        lap.reward_mps
+    );
+    let other = RaceConfig {
+        kernels: 10,
+        ..warm
+    };
+    let e = race(&venue, &track(), &car, &other, |_| {})
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("12 kernels") && e.contains("10 kernels"), "{e}");
+
+    // Warm, a completed start is followed by a block of at most 8 weights, where a cold
+    // start is pushed (every weight moves); a failed start is repaired before the failure,
+    // the start's pedal kept well before it, and saved mid-repair it resumes.
+    let w0 = learned.weights();
+    let spec = race_spec(Method::PatternSearch, 3)
+        .policy(learned.pedal.lengthscale)
+        .unwrap();
+    let second = |spec: Spec, failure: Option<FailedLap>| {
+        let mut search = spec.optimizer(w0.clone()).unwrap();
+        let start = search.ask().unwrap();
+        assert_eq!(start, w0);
+        let reward = if failure.is_some() { 0.0 } else { 30.0 };
+        search.tell_lap(&start, reward, failure).unwrap();
+        search.ask().unwrap()
+    };
+    let moved = |w: &[f64]| w.iter().zip(&w0).filter(|(a, b)| a != b).count();
+    assert!((1..=8).contains(&moved(&second(spec.warm_started(), None))));
+    assert_eq!(moved(&second(spec, None)), w0.len());
+    let repaired = second(spec.warm_started(), Some(FailedLap::too_fast(0.8)));
+    let pedal = |w: &[f64], x: f64| {
+        RkhsPolicy::new(w.to_vec(), learned.pedal.lengthscale)
+            .unwrap()
+            .raw(x)
+    };
+    assert!(pedal(&repaired, 0.75) < pedal(&w0, 0.75) - 0.05);
+    assert!((pedal(&repaired, 0.1) - pedal(&w0, 0.1)).abs() < 1e-3);
+    // A search saved mid-repair resumes to the same trial.
+    let mut search = spec.warm_started().optimizer(w0.clone()).unwrap();
+    let start = search.ask().unwrap();
+    search
+        .tell_lap(&start, 0.0, Some(FailedLap::too_fast(0.8)))
+        .unwrap();
+    let mut again = resume(search.save()).unwrap();
+    assert_eq!(again.ask().unwrap(), search.ask().unwrap());
 }

@@ -28,6 +28,7 @@ fn config() -> StudyConfig {
         track_length: None,
         knob: None,
         max_failed_laps: None,
+        warm_start: None,
     }
 }
 

@@ -7,19 +7,30 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 
+use super::policy::read_policy;
 use super::{CliResult, Setup, Simulator, from_flag, print_json};
 use cdbo::data_path::DataPath;
-use cdbo::experiment::race::{RaceConfig, RaceOutcome, race};
+use cdbo::experiment::race::{RaceConfig, RaceOutcome, check_warm_start, race};
 use cdbo::method::{KnobKind, Method};
 use cdbo::policy::Policy;
+
+/// Policy kernels M when neither `--kernels` nor a warm start gives them.
+const DEFAULT_KERNELS: usize = 30;
 
 #[derive(Debug, Args)]
 pub struct RaceArgs {
     #[command(flatten)]
     setup: Setup,
-    /// Policy kernels M (the paper: 10 to 100).
-    #[arg(long, default_value_t = 30, value_parser = super::value::kernels)]
-    kernels: usize,
+    /// Policy kernels M (the paper: 10 to 100; default 30, or the warm start's).
+    #[arg(long, value_parser = super::value::kernels)]
+    kernels: Option<usize>,
+    /// Start from this policy (JSON, as `cdbo race` writes `best_policy.json`) instead of the
+    /// demonstration's fitted w₀: say, one learned in cdbo's simulator, continued in the game.
+    /// Its kernels must be `--kernels` at the paper's length-scale; the search box is centred
+    /// on it, and the pattern search skips its push (the policy is pushed already) and
+    /// repairs it where its first lap fails (docs/results/torcs.md, "Sim, then game").
+    #[arg(long, value_name = "POLICY.json")]
+    warm_start: Option<PathBuf>,
     /// Optimiser.
     #[arg(long, value_parser = super::method_parser(), default_value_t = Method::Cdbo)]
     method: Method,
@@ -86,6 +97,13 @@ struct Summary {
     line_kernels: Option<usize>,
     laps: usize,
     seed: u64,
+    /// The policy file the race started from, if warm-started.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    warm_start: Option<String>,
+    /// The first lap's reward: the starting policy's lap where the race was driven.
+    first_lap_reward_mps: f64,
+    /// Its lap time, if it completed.
+    first_lap_time_s: Option<f64>,
     demo_reward_mps: f64,
     best_reward_mps: f64,
     best_lap_time_s: Option<f64>,
@@ -112,20 +130,32 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         )
         .into());
     }
+    let warm_start = match &args.warm_start {
+        Some(path) => Some(read_policy(path)?),
+        None => None,
+    };
+    let kernels = args
+        .kernels
+        .or(warm_start.as_ref().map(|p| p.pedal.kernels()))
+        .unwrap_or(DEFAULT_KERNELS);
+    if let (Some(path), Some(policy)) = (&args.warm_start, &warm_start) {
+        check_warm_start(policy, kernels).map_err(|e| format!("{}: {e}", path.display()))?;
+    }
     let config = RaceConfig {
         method: args.method,
-        kernels: args.kernels,
+        kernels,
         laps: args.laps,
         seed: args.seed,
         beta: args.beta,
         demo_speed: args.demo_speed,
         knob: args.knob.or(args.sigma0),
         max_failed_laps: args.max_failed_laps,
-        line_kernels: (args.line == Line::Learn).then(|| args.line_kernels.unwrap_or(args.kernels)),
+        line_kernels: (args.line == Line::Learn).then(|| args.line_kernels.unwrap_or(kernels)),
+        warm_start,
     };
     // A knob the method cannot take is refused before any lap is driven.
     config.spec()?;
-    if let Some(w) = cdbo::method::cost::slow_race_warning(args.method, args.kernels, args.laps) {
+    if let Some(w) = cdbo::method::cost::slow_race_warning(args.method, kernels, args.laps) {
         eprintln!("warning: {w}");
     }
     let (venue, track, car) = super::venue(&args.setup, data, simulator)?;
@@ -136,7 +166,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
             "race-{}-{}-m{}{}-s{}",
             slug(&track_name),
             args.method,
-            args.kernels,
+            kernels,
             config
                 .line_kernels
                 .map_or(String::new(), |m| format!("-line{m}")),
@@ -185,10 +215,13 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     let summary = Summary {
         method: args.method,
         track: track_name,
-        kernels: args.kernels,
+        kernels,
         line_kernels: config.line_kernels,
         laps: args.laps,
         seed: args.seed,
+        warm_start: args.warm_start.as_ref().map(|p| p.display().to_string()),
+        first_lap_reward_mps: outcome.laps.first().map_or(0.0, |l| l.reward_mps),
+        first_lap_time_s: outcome.laps.first().and_then(|l| l.lap_time_s),
         demo_reward_mps: outcome.demo.reward_mps,
         best_reward_mps: outcome.best_reward_mps,
         best_lap_time_s: best_lap,
@@ -228,6 +261,14 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         summary.demo_reward_mps,
         summary.failed_laps
     );
+    if let Some(file) = &summary.warm_start {
+        println!(
+            "Warm-started from {file}: its first lap here {}",
+            summary
+                .first_lap_time_s
+                .map_or("failed".into(), |t| format!("{t:.2} s")),
+        );
+    }
     println!(
         "{:.1} s wall: optimiser {:.1} s, simulator {:.1} s. Results in {}",
         summary.wall_s,

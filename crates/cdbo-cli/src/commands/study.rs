@@ -51,6 +51,12 @@ pub struct InitialPolicy {
     /// Initial weights (JSON written by `cdbo policy fit` or `cdbo race`).
     #[arg(long, value_name = "w0.json")]
     weights: Option<PathBuf>,
+    /// Start from a learned policy (JSON, as `cdbo race` writes `best_policy.json`): w₀ is its
+    /// weights, as with `--weights`, and the study records that it was warm-started from it
+    /// (the pattern search then skips its push, the policy being pushed already, and repairs
+    /// it where its first lap fails).
+    #[arg(long, value_name = "POLICY.json", conflicts_with_all = ["demo", "weights"])]
+    warm_start: Option<PathBuf>,
     /// Policy kernels M.
     #[arg(long, value_parser = super::value::kernels)]
     pub kernels: usize,
@@ -90,19 +96,27 @@ impl InitialPolicy {
         let lengthscale = self
             .lengthscale
             .unwrap_or_else(|| default_lengthscale(self.kernels));
-        let policy = match (&self.demo, &self.weights) {
-            (Some(demo), _) => {
+        let (policy, file) = match (
+            &self.demo,
+            self.weights.as_ref().or(self.warm_start.as_ref()),
+        ) {
+            (Some(demo), _) => (
                 RkhsPolicy::fit(&read_demo(demo)?, self.kernels, lengthscale, DEFAULT_RIDGE)
-                    .map_err(|e| format!("{}: {e}", demo.display()))?
-            }
-            (None, Some(w)) => read_pedal_policy(w, "a study")?,
+                    .map_err(|e| format!("{}: {e}", demo.display()))?,
+                demo,
+            ),
+            (None, Some(w)) => (read_pedal_policy(w, "a study")?, w),
             (None, None) => {
-                return Err("give the initial policy: --demo demo.csv or --weights w0.json".into());
+                return Err(
+                    "give the initial policy: --demo demo.csv, --weights w0.json or --warm-start POLICY.json"
+                        .into(),
+                );
             }
         };
         if policy.weights.len() != self.kernels {
             return Err(format!(
-                "the initial policy has {} weights but --kernels is {}",
+                "{}: the initial policy has {} kernels but --kernels is {}",
+                file.display(),
                 policy.weights.len(),
                 self.kernels
             )
@@ -119,6 +133,7 @@ impl InitialPolicy {
             track_length: self.track_length,
             knob: self.knob,
             max_failed_laps: self.max_failed_laps,
+            warm_start: self.warm_start.as_ref().map(|p| p.display().to_string()),
         })
     }
 
@@ -175,6 +190,14 @@ impl InitialPolicy {
                 .max_failed_laps
                 .map_or("no --max-failed-laps".into(), |k| k.to_string());
             return differs("--max-failed-laps", n.to_string(), kept);
+        }
+        let warm = self.warm_start.as_ref().map(|p| p.display().to_string());
+        if let Some(w) = warm.filter(|w| Some(w) != stored.warm_start.as_ref()) {
+            let kept = stored
+                .warm_start
+                .clone()
+                .map_or("no --warm-start".into(), |k| k);
+            return differs("--warm-start", w, kept);
         }
         Ok(())
     }

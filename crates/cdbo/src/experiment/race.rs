@@ -41,16 +41,25 @@ pub struct RaceConfig {
     /// (d = 0) and optimised with the pedal; `None`: the centre line.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub line_kernels: Option<usize>,
+    /// The policy the race starts from instead of the demonstration's fitted w₀ (a warm start:
+    /// say, a policy learned in cdbo's simulator, continued in the game). Its shape must be the
+    /// race's ([`check_warm_start`]); the search box is centred on it, and the pattern search
+    /// skips its push and repairs it where its first lap fails ([`Spec::warm_started`]).
+    /// `None`: the fitted w₀, as the paper does.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub warm_start: Option<Policy>,
 }
 
 impl RaceConfig {
     /// The race's specification of its method.
     pub fn spec(&self) -> Result<Spec> {
-        let spec = Spec::told(self.method, self.seed, self.beta, self.knob)?;
-        let spec = match self.line_kernels {
-            Some(_) => spec.pedal_kernels(self.kernels),
-            None => spec,
-        };
+        let mut spec = Spec::told(self.method, self.seed, self.beta, self.knob)?;
+        if self.line_kernels.is_some() {
+            spec = spec.pedal_kernels(self.kernels);
+        }
+        if self.warm_start.is_some() {
+            spec = spec.warm_started();
+        }
         Ok(match self.max_failed_laps {
             Some(max) => spec.max_failed_laps(max),
             None => spec,
@@ -80,8 +89,36 @@ impl Default for RaceConfig {
             knob: None,
             max_failed_laps: None,
             line_kernels: None,
+            warm_start: None,
         }
     }
+}
+
+/// Refuses a warm start whose shape is not a race's of `kernels` kernels: the paper's pedal
+/// (`kernels` kernels of length-scale [`default_lengthscale`]`(kernels)`), no line. The error
+/// gives both shapes.
+pub fn check_warm_start(policy: &Policy, kernels: usize) -> Result<()> {
+    let race = PolicyShape::pedal(Block::paper(kernels)?);
+    let shape = policy.shape();
+    let same_lengthscale =
+        (shape.pedal.lengthscale - race.pedal.lengthscale).abs() <= 1e-9 * race.pedal.lengthscale;
+    if shape.line.is_none() && shape.pedal.kernels == kernels && same_lengthscale {
+        return Ok(());
+    }
+    let line = shape.line.map_or(String::new(), |l| {
+        format!(" and a line of {} kernels", l.kernels)
+    });
+    Err(Error::invalid_value(
+        "the warm start's policy",
+        format!(
+            "{} kernels of length-scale {:.6}{line}",
+            shape.pedal.kernels, shape.pedal.lengthscale
+        ),
+        format!(
+            "the race's {kernels} kernels of length-scale {:.6}, no line (race with --kernels {})",
+            race.pedal.lengthscale, shape.pedal.kernels
+        ),
+    ))
 }
 
 /// One lap of the optimisation.
@@ -112,7 +149,7 @@ pub struct RaceOutcome {
     pub demo: LapResult,
     /// The demonstration's (x, a) pairs.
     pub demo_pairs: Vec<(f64, f64)>,
-    /// The fitted initial policy.
+    /// The policy the race started from: the demonstration's fit, or the warm start.
     pub initial: Policy,
     /// The best policy found.
     pub best: Policy,
@@ -178,13 +215,27 @@ fn race_with(
         });
     }
     let lengthscale = default_lengthscale(config.kernels);
-    // w₀: the pedal fitted to the demonstration, a line at the centre (d = 0).
+    // w₀: the warm start, or the pedal fitted to the demonstration and a line at the centre
+    // (d = 0).
     let shape = config.shape()?;
-    let initial = Policy {
-        pedal: RkhsPolicy::fit(&demo_pairs, config.kernels, lengthscale, DEFAULT_RIDGE)?,
-        line: match shape.line {
-            Some(line) => Some(RkhsPolicy::new(vec![0.0; line.kernels], line.lengthscale)?),
-            None => None,
+    let initial = match &config.warm_start {
+        Some(_) if shape.line.is_some() => {
+            return Err(Error::invalid_value(
+                "a warm start with a learned line",
+                "--warm-start and --line learn",
+                "one of them (a warm start is a pedal-only policy)",
+            ));
+        }
+        Some(policy) => {
+            check_warm_start(policy, config.kernels)?;
+            policy.clone()
+        }
+        None => Policy {
+            pedal: RkhsPolicy::fit(&demo_pairs, config.kernels, lengthscale, DEFAULT_RIDGE)?,
+            line: match shape.line {
+                Some(line) => Some(RkhsPolicy::new(vec![0.0; line.kernels], line.lengthscale)?),
+                None => None,
+            },
         },
     };
     let optimizer = config

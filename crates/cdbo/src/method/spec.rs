@@ -31,6 +31,7 @@ pub struct Spec {
     track_length: Option<f64>,
     pedal_kernels: Option<usize>,
     max_failed_laps: Option<usize>,
+    warm: bool,
 }
 
 impl Spec {
@@ -52,6 +53,7 @@ impl Spec {
             track_length: None,
             pedal_kernels: None,
             max_failed_laps: None,
+            warm: false,
         }
         .with_checked_knob(method.knob().value)
     }
@@ -161,6 +163,15 @@ impl Spec {
         }
     }
 
+    /// This specification starting from a learned policy rather than a demonstration's fit
+    /// (a warm start): the pattern search does not push it (a learned policy is pushed
+    /// already) but repairs it where its first lap fails, as a push is repaired
+    /// ([`PatternSearchConfig::warm`](pattern_search::PatternSearchConfig::warm)); the other
+    /// methods are unchanged (their search box is centred on the start, as always).
+    pub fn warm_started(self) -> Spec {
+        Spec { warm: true, ..self }
+    }
+
     /// The method.
     pub fn method(&self) -> Method {
         self.method
@@ -206,6 +217,7 @@ impl Spec {
             track_length,
             pedal_kernels,
             max_failed_laps,
+            warm,
         } = *self;
         let pattern_search = pattern_search::PatternSearchConfig {
             seed,
@@ -215,7 +227,11 @@ impl Spec {
             lengthscale: policy_lengthscale,
             track_length,
             pedal_kernels,
-            ..pattern_search::PatternSearchConfig::default()
+            ..if warm {
+                pattern_search::PatternSearchConfig::warm()
+            } else {
+                pattern_search::PatternSearchConfig::default()
+            }
         };
         let bo = |maximiser| bo::BoConfig {
             seed,

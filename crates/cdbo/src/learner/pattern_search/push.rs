@@ -74,6 +74,11 @@ pub struct Push {
     /// it; a later push holds the targets moved down (empty in pushes saved before it existed).
     #[serde(default)]
     pub repaired: Vec<f64>,
+    /// The weights the targets move, when this is the repair of a start rather than a push
+    /// ([`Push::repairing`]): the targets are then offsets to its pedal, and a lap's weights
+    /// are these plus the offsets' fit, the start kept exactly where no repair moved it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub base: Option<Vec<f64>>,
 }
 
 impl Push {
@@ -92,12 +97,6 @@ impl Push {
         let size = config.push / f64::from(1u32 << (number - 1).min(31))
             * (1.0 + JITTER * (2.0 * u - 1.0));
         Push::sized(number, size, best, lengthscale, config, previous)
-    }
-
-    /// Push 0, of size 0: the best lap, a failed one, repaired where it fails until it
-    /// completes (a search told to repair a failed start first).
-    pub fn repairing(best: &[f64], lengthscale: f64, config: &PatternSearchConfig) -> Result<Push> {
-        Push::sized(0, 0.0, best, lengthscale, config, None)
     }
 
     /// Push `number` of size `size`.
@@ -127,16 +126,37 @@ impl Push {
             },
             laps: 0,
             repaired,
+            base: None,
         })
     }
 
+    /// The repair of the start `start` of a search set by `config` (a policy learned
+    /// elsewhere, whose lap here failed): a push of size 0 whose targets are offsets to the
+    /// start's pedal, all 0 until a repair moves them. Refitting the start's pedal itself
+    /// would smooth away its sharp braking points (measured: a 112.5 s lap became 137 s).
+    pub fn repairing(start: &[f64], config: &PatternSearchConfig) -> Push {
+        let g = targets_for(start.len());
+        let repair = PedalRepair::new(start.len()).starting_at(config.repair_step);
+        Push {
+            number: 0,
+            targets: vec![0.0; g],
+            repair: match config.track_length {
+                Some(length) => repair.over(REPAIR_DISTANCE / length),
+                None => repair,
+            },
+            laps: 0,
+            repaired: vec![0.0; g],
+            base: Some(start.to_vec()),
+        }
+    }
+
     /// Whether a saved push is one this code could have made for an M-kernel policy: a push
-    /// number in 1..=[`PUSHES`] (0..=[`PUSHES`] for a search that repairs a failed start,
-    /// [`Push::repairing`]), [`targets_for`]`(M)` finite targets and net repairs, a positive
-    /// finite repair step and window at the policy's kernel spacing, at most [`LAPS`] laps.
-    pub fn is_sound(&self, kernels: usize, repair_start: bool) -> bool {
+    /// number in 1..=[`PUSHES`] (0 for the repair of a start, [`Push::repairing`]),
+    /// [`targets_for`]`(M)` finite targets and net repairs, a positive finite repair step and
+    /// window at the policy's kernel spacing, at most [`LAPS`] laps.
+    pub fn is_sound(&self, kernels: usize) -> bool {
         let finite = |v: &[f64]| v.iter().all(|a| a.is_finite());
-        (u32::from(!repair_start)..=PUSHES).contains(&self.number)
+        (u32::from(self.base.is_none())..=PUSHES).contains(&self.number)
             && self.targets.len() == targets_for(kernels)
             && self.repaired.len() == self.targets.len()
             && finite(&self.targets)
@@ -153,6 +173,10 @@ impl Push {
                 .last
                 .is_none_or(|(x, d)| x.is_finite() && d.is_finite())
             && self.laps <= LAPS
+            && self
+                .base
+                .as_ref()
+                .is_none_or(|b| b.len() == kernels && finite(b))
     }
 
     /// The weights of the push's next lap: its targets fitted by ridge regression, in the box.
@@ -164,6 +188,9 @@ impl Push {
             DEFAULT_RIDGE,
         )?
         .weights;
+        if let Some(base) = &self.base {
+            w.iter_mut().zip(base).for_each(|(w, b)| *w += b);
+        }
         bounds.clamp(&mut w);
         Ok(w)
     }
@@ -326,6 +353,6 @@ mod tests {
             );
         }
         assert_eq!(second.repaired, first.repaired);
-        assert!(second.is_sound(best.len(), false));
+        assert!(second.is_sound(best.len()));
     }
 }
