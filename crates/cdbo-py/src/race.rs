@@ -117,6 +117,7 @@ pub fn race(
         knob,
         max_failed_laps: max_failed,
         line_kernels: None,
+        base_line: Default::default(),
     };
     let mut callback_error: Option<PyErr> = None;
     let outcome = py

@@ -175,6 +175,7 @@ pub fn run_at(
         knob: Some(grid.knob_of(method)),
         max_failed_laps: None,
         line_kernels: None,
+        base_line: Default::default(),
     };
     let (track_name, length_m) = (track.name.clone(), track.length);
     let venue = match grounds {
