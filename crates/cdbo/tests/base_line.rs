@@ -82,3 +82,35 @@ fn a_race_on_the_min_curvature_line_is_deterministic() {
         }
     }
 }
+
+/// The ceiling on the line: its limit read at the centre line's stations keeps the line's lap
+/// time and reward, one speed per centre-line sample, none above the line's own fastest; the
+/// tracker holding the line tracks most of that profile (k = 0.984 on Ridgeway, a lap of
+/// 89 % of the line's limit) and beats its tracked lap on the centre line (k = 0.965).
+#[test]
+fn the_line_limit_read_on_the_centre_line_is_tracked() {
+    let (track, car) = ridgeway();
+    let line = BaseLine::MinCurvature.line(&track, &car).unwrap().unwrap();
+    let along = cdbo::limit::line_limit(&track, &line, &car).limit;
+    let limit = cdbo::limit::line_limit_on_centre(&track, &line, &car);
+    assert_eq!(limit.lap_time_s, along.lap_time_s);
+    assert_eq!(limit.reward_mps, along.reward_mps);
+    assert_eq!(limit.speed.len(), track.len() + 1);
+    let fastest = along.speed.iter().copied().fold(0.0, f64::max);
+    assert!(limit.speed.iter().all(|&v| (0.0..=fastest).contains(&v)));
+    let mut sim = cdbo::sim::Simulator::new(track.clone(), &car);
+    sim.config.steering = cdbo::drive::steering::Steering::Tracker(Default::default());
+    sim.config.line = Some(line);
+    let (k, reward) = cdbo::ceiling::tracked_profile(&sim, &limit).unwrap();
+    assert!(
+        k > 0.95 && reward > 0.85 * limit.reward_mps,
+        "k {k}, {reward} m/s"
+    );
+    sim.config.line = None;
+    let centre = cdbo::limit::limit_lap(&track, &car);
+    let (_, on_centre) = cdbo::ceiling::tracked_profile(&sim, &centre).unwrap();
+    assert!(
+        reward > on_centre,
+        "{reward} m/s, centre line {on_centre} m/s"
+    );
+}

@@ -60,7 +60,7 @@ pub struct RaceArgs {
     /// line, or the minimum-curvature line d₀(s) (the car holds d₀(s) + d(x)). Only with
     /// `--line learn`.
     #[arg(long, value_enum, requires = "line")]
-    line_start: Option<LineStart>,
+    line_start: Option<FixedLine>,
     /// Kernels of a learned line (default: --kernels).
     #[arg(long, value_parser = super::value::kernels, requires = "line")]
     line_kernels: Option<usize>,
@@ -84,25 +84,34 @@ enum Line {
     Learn,
 }
 
-/// Where a learned line starts (`--line-start`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-enum LineStart {
+/// A fixed line: where a learned line starts (`race --line-start`), the line of `ceiling
+/// --line`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum FixedLine {
     /// The centre line: d₀ = 0.
+    #[default]
     Centre,
     /// The minimum-curvature racing line.
     MinCurvature,
+}
+
+impl FixedLine {
+    /// The line as a race's base line.
+    pub fn base_line(self) -> BaseLine {
+        match self {
+            FixedLine::Centre => BaseLine::Centre,
+            FixedLine::MinCurvature => BaseLine::MinCurvature,
+        }
+    }
 }
 
 impl RaceArgs {
     /// The race's base line ([`BaseLine`]): the fixed line's, or a learned line's start.
     fn base_line(&self) -> Result<BaseLine, String> {
         match (self.line, self.line_start) {
-            (Line::Learn, Some(LineStart::MinCurvature)) | (Line::MinCurvature, None) => {
-                Ok(BaseLine::MinCurvature)
-            }
-            (Line::Learn, Some(LineStart::Centre) | None) | (Line::Centre, None) => {
-                Ok(BaseLine::Centre)
-            }
+            (Line::Learn, Some(start)) => Ok(start.base_line()),
+            (Line::MinCurvature, None) => Ok(BaseLine::MinCurvature),
+            (Line::Learn | Line::Centre, None) => Ok(BaseLine::Centre),
             (line, Some(_)) => Err(format!(
                 "--line-start: only a learned line starts somewhere (--line learn), not --line {}",
                 clap::ValueEnum::to_possible_value(&line)
