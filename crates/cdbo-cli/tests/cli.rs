@@ -363,6 +363,35 @@ fn a_race_with_a_learned_line_writes_and_drives_it() {
     let _ = std::fs::remove_dir_all(&out);
 }
 
+/// `--line min-curvature` races on the racing line and says so; `--line-start` is refused
+/// without `--line learn`.
+#[test]
+fn a_race_on_the_min_curvature_line_names_it() {
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("cdbo-cli-race-mincurv-{}", std::process::id()));
+    let v = json(&[
+        "race",
+        "--laps",
+        "5",
+        "--kernels",
+        "20",
+        "--line",
+        "min-curvature",
+        "--method",
+        "pattern-search",
+        "--json",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(v["base_line"].as_str(), Some("min-curvature"));
+    assert!(v["best_reward_mps"].as_f64().unwrap() > 0.0);
+    fails_with(
+        &["race", "--line", "centre", "--line-start", "min-curvature"],
+        &["--line-start", "--line learn"],
+    );
+    let _ = std::fs::remove_dir_all(&out);
+}
+
 #[test]
 fn a_short_race_writes_its_results() {
     // 20 kernels: since the gearbox shifts at the current throttle, the 10-kernel fit of the

@@ -118,6 +118,7 @@ pub fn race(
         max_failed_laps: max_failed,
         line_kernels: None,
         warm_start: None,
+        base_line: Default::default(),
     };
     let mut callback_error: Option<PyErr> = None;
     let outcome = py

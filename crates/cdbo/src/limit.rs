@@ -79,6 +79,35 @@ pub fn line_limit(track: &Track, line: &RacingLine, car: &Car) -> LineLimit {
     }
 }
 
+/// The QSS limit lap of `car` along `line` (as [`line_limit`]) with its speed profile read at
+/// `track`'s own samples, for a speed tracker that knows the lap fraction x = s/L of the
+/// centre line ([`crate::ceiling::ProfileTracker`]) while the car holds the line: at station s
+/// the speed of the line's sample nearest u(s) = u_j + (s/h − j)·(u_{j+1} − u_j), the chord
+/// length from p₀ at which the line crosses s (u_j = Σ_{i<j} |p_{i+1} − p_i|, h = L/N the
+/// stations' spacing, j = ⌊s/h⌋).
+pub fn line_limit_on_centre(track: &Track, line: &RacingLine, car: &Car) -> Limit {
+    let along = line_limit(track, line, car).limit;
+    let path = line.path(track);
+    let n = line.points.len();
+    let mut u = Vec::with_capacity(n + 1);
+    u.push(0.0);
+    for j in 0..n {
+        let (p, q) = (line.points[j], line.points[(j + 1) % n]);
+        u.push(u[j] + (q[0] - p[0]).hypot(q[1] - p[1]));
+    }
+    let h = track.length / n as f64;
+    let last = along.speed.len() - 1;
+    let speed = (0..=track.len())
+        .map(|i| {
+            let t = (i as f64 * track.ds).min(track.length) / h;
+            let j = (t.floor() as usize).min(n - 1);
+            let chord = u[j] + (t - j as f64) * (u[j + 1] - u[j]);
+            along.speed[((chord / path.ds).round() as usize).min(last)]
+        })
+        .collect();
+    Limit { speed, ..along }
+}
+
 /// Computes the QSS limit lap of `car` on `track`.
 pub fn limit_lap(track: &Track, car: &Car) -> Limit {
     let n = track.len();

@@ -3,11 +3,14 @@
 //! [`crate::evaluator::command`]). A venue drives the demonstration and any policy, and is the
 //! evaluator of a race's laps, so that no caller branches on which venue it is.
 
+use std::sync::Arc;
+
 use crate::car::Car;
 use crate::drive::steering::Steering;
 use crate::error::{Error, Result};
 use crate::evaluator::Evaluator;
 use crate::evaluator::simulator::SimEvaluator;
+use crate::line::RacingLine;
 use crate::policy::{Policy, PolicyShape};
 use crate::sim::{LapResult, Simulator};
 use crate::torcs::evaluator::{TorcsEvaluator, drive};
@@ -56,6 +59,19 @@ impl Venue {
                 request.config.steering = steering;
                 Venue::Game { game, request }
             }
+        }
+    }
+
+    /// This venue with the car holding `line` where a policy has none (a policy's line is
+    /// then an offset from it, [`crate::sim::LapConfig::line`]); the game's robot steers the
+    /// centre line only, so a line is refused there.
+    pub fn on_line(self, line: Arc<RacingLine>) -> Result<Venue> {
+        match self {
+            Venue::Simulator(mut sim) => {
+                sim.config.line = Some(line);
+                Ok(Venue::Simulator(sim))
+            }
+            Venue::Game { .. } => Err(line_in_game()),
         }
     }
 

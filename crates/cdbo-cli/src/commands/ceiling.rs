@@ -16,6 +16,10 @@ pub struct CeilingArgs {
     /// How the car steers.
     #[arg(long, value_enum, default_value_t)]
     steering: super::SteeringChoice,
+    /// The line the car holds: on the minimum-curvature line the profile tracked is that
+    /// line's limit (read at the centre line's stations) and the shares are of that limit.
+    #[arg(long, value_enum, default_value_t)]
+    line: super::race::FixedLine,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -27,9 +31,19 @@ pub fn run(args: &CeilingArgs, data: &DataPath) -> CliResult {
     }
     let (track, car) = args.setup.load(data)?;
     let name = track.name.clone();
-    let limit = cdbo::limit::limit_lap(&track, &car);
+    let line = args.line.base_line().line(&track, &car)?;
+    let limit = match &line {
+        Some(line) => cdbo::limit::line_limit_on_centre(&track, line, &car),
+        None => cdbo::limit::limit_lap(&track, &car),
+    };
+    let which = if line.is_some() {
+        "minimum-curvature-line"
+    } else {
+        "centre-line"
+    };
     let mut sim = cdbo::sim::Simulator::new(track, &car);
     sim.config.steering = args.steering.steering();
+    sim.config.line = line;
     let c = ceiling_with(&sim, &limit, args.kernels)?;
     if args.json {
         return print_json(&c);
@@ -46,7 +60,7 @@ pub fn run(args: &CeilingArgs, data: &DataPath) -> CliResult {
         format!("none completes within {} laps", cdbo::ceiling::REPAIR_LAPS)
     };
     println!(
-        "{} on {}: centre-line limit {:.2} m/s; tracking {:.3} x the limit's speed profile {:.2} m/s ({:.1} % of the centre-line limit); {}-kernel policy fitted to its pedal, repaired where it fails: {}",
+        "{} on {}: {which} limit {:.2} m/s; tracking {:.3} x the limit's speed profile {:.2} m/s ({:.1} % of the {which} limit); {}-kernel policy fitted to its pedal, repaired where it fails: {}",
         car.name,
         name,
         c.limit_mps,

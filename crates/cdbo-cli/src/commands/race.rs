@@ -10,7 +10,7 @@ use serde::Serialize;
 use super::policy::read_policy;
 use super::{CliResult, Setup, Simulator, from_flag, print_json};
 use cdbo::data_path::DataPath;
-use cdbo::experiment::race::{RaceConfig, RaceOutcome, check_warm_start, race};
+use cdbo::experiment::race::{BaseLine, RaceConfig, RaceOutcome, check_warm_start, race};
 use cdbo::method::{KnobKind, Method};
 use cdbo::policy::Policy;
 
@@ -63,10 +63,16 @@ pub struct RaceArgs {
     /// How the car steers.
     #[arg(long, value_enum, default_value_t)]
     steering: super::SteeringChoice,
-    /// The line the car holds: the centre line, or a line d(x) learned with the pedal (a
-    /// second action on its own kernels, starting at the centre line).
+    /// The line the car holds, the demonstration's included: the centre line, the
+    /// minimum-curvature racing line (fixed, as `cdbo limit` computes it), or a line d(x)
+    /// learned with the pedal (a second action on its own kernels, starting at --line-start).
     #[arg(long, value_enum, default_value_t)]
     line: Line,
+    /// Where a learned line starts, and what its offsets d(x) are measured from: the centre
+    /// line, or the minimum-curvature line d₀(s) (the car holds d₀(s) + d(x)). Only with
+    /// `--line learn`.
+    #[arg(long, value_enum, requires = "line")]
+    line_start: Option<FixedLine>,
     /// Kernels of a learned line (default: --kernels).
     #[arg(long, value_parser = super::value::kernels, requires = "line")]
     line_kernels: Option<usize>,
@@ -84,8 +90,47 @@ enum Line {
     /// The centre line.
     #[default]
     Centre,
+    /// The minimum-curvature racing line, fixed.
+    MinCurvature,
     /// A line d(x) learned with the pedal.
     Learn,
+}
+
+/// A fixed line: where a learned line starts (`race --line-start`), the line of `ceiling
+/// --line`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum FixedLine {
+    /// The centre line: d₀ = 0.
+    #[default]
+    Centre,
+    /// The minimum-curvature racing line.
+    MinCurvature,
+}
+
+impl FixedLine {
+    /// The line as a race's base line.
+    pub fn base_line(self) -> BaseLine {
+        match self {
+            FixedLine::Centre => BaseLine::Centre,
+            FixedLine::MinCurvature => BaseLine::MinCurvature,
+        }
+    }
+}
+
+impl RaceArgs {
+    /// The race's base line ([`BaseLine`]): the fixed line's, or a learned line's start.
+    fn base_line(&self) -> Result<BaseLine, String> {
+        match (self.line, self.line_start) {
+            (Line::Learn, Some(start)) => Ok(start.base_line()),
+            (Line::MinCurvature, None) => Ok(BaseLine::MinCurvature),
+            (Line::Learn | Line::Centre, None) => Ok(BaseLine::Centre),
+            (line, Some(_)) => Err(format!(
+                "--line-start: only a learned line starts somewhere (--line learn), not --line {}",
+                clap::ValueEnum::to_possible_value(&line)
+                    .map_or(String::new(), |v| v.get_name().to_owned())
+            )),
+        }
+    }
 }
 
 #[derive(Debug, Serialize)]
@@ -95,6 +140,8 @@ struct Summary {
     kernels: usize,
     #[serde(skip_serializing_if = "Option::is_none")]
     line_kernels: Option<usize>,
+    #[serde(skip_serializing_if = "BaseLine::is_centre")]
+    base_line: BaseLine,
     laps: usize,
     seed: u64,
     /// The policy file the race started from, if warm-started.
@@ -152,6 +199,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         max_failed_laps: args.max_failed_laps,
         line_kernels: (args.line == Line::Learn).then(|| args.line_kernels.unwrap_or(kernels)),
         warm_start,
+        base_line: args.base_line()?,
     };
     // A knob the method cannot take is refused before any lap is driven.
     config.spec()?;
@@ -163,13 +211,18 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     let track_name = track.name.clone();
     let out = args.out.clone().unwrap_or_else(|| {
         PathBuf::from("runs").join(format!(
-            "race-{}-{}-m{}{}-s{}",
+            "race-{}-{}-m{}{}{}-s{}",
             slug(&track_name),
             args.method,
             kernels,
             config
                 .line_kernels
                 .map_or(String::new(), |m| format!("-line{m}")),
+            if config.base_line.is_centre() {
+                ""
+            } else {
+                "-mincurv"
+            },
             args.seed
         ))
     });
@@ -204,7 +257,12 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     ceiling_sim.config.steering = args.steering.steering();
     let (_, ceiling_mps) = cdbo::ceiling::tracked_profile(&ceiling_sim, &outcome.limit)?;
     write_outputs(&out, &outcome)?;
-    // The speed plots re-drive the initial and best policies where the race was driven.
+    // The speed plots re-drive the initial and best policies where the race was driven, on
+    // its base line.
+    let venue = match &outcome.line {
+        Some(line) => venue.on_line(line.clone())?,
+        None => venue,
+    };
     let drive = |p: &Policy| venue.drive(p);
     write_plots(&out, &track, &outcome, &drive)?;
     let best_lap = outcome
@@ -217,6 +275,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         track: track_name,
         kernels,
         line_kernels: config.line_kernels,
+        base_line: config.base_line,
         laps: args.laps,
         seed: args.seed,
         warm_start: args.warm_start.as_ref().map(|p| p.display().to_string()),

@@ -1,12 +1,15 @@
 //! Learning to race one track (paper Sec. V): drive the demonstration, fit w₀, then optimise
 //! the policy weights for a number of laps, one lap per evaluation.
 
+use std::sync::Arc;
+
 use serde::{Deserialize, Serialize};
 
 use crate::car::Car;
 use crate::error::{Error, Result};
 use crate::evaluator::{Evaluator, Outcome};
 use crate::limit::{Limit, limit_lap};
+use crate::line::{LineOptions, RacingLine, SAFETY_MARGIN};
 use crate::method::{Method, Spec};
 use crate::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 use crate::policy::{Block, Policy, PolicyShape, RkhsPolicy};
@@ -37,8 +40,8 @@ pub struct RaceConfig {
     /// Failed laps allowed ([`crate::learner::budget`]); `None`: no budget.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_failed_laps: Option<usize>,
-    /// Kernels of a learned line d(x) ([`crate::policy::actions`]), starting at the centre line
-    /// (d = 0) and optimised with the pedal; `None`: the centre line.
+    /// Kernels of a learned line d(x) ([`crate::policy::actions`]), starting at the base line
+    /// (d = 0) and optimised with the pedal; `None`: the base line, fixed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub line_kernels: Option<usize>,
     /// The policy the race starts from instead of the demonstration's fitted w₀ (a warm start:
@@ -48,6 +51,41 @@ pub struct RaceConfig {
     /// `None`: the fitted w₀, as the paper does.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub warm_start: Option<Policy>,
+    /// The base line d₀(s): the line the car holds, the demonstration's included, and from
+    /// which a learned line's offsets are measured (the car holds d₀(s) + d(s/L)).
+    #[serde(default, skip_serializing_if = "BaseLine::is_centre")]
+    pub base_line: BaseLine,
+}
+
+/// The line a race's car holds where its policy has none, part of the track as the driver's
+/// reference ([`crate::sim::LapConfig::line`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BaseLine {
+    /// The centre line, d₀ = 0.
+    #[default]
+    Centre,
+    /// The minimum-curvature racing line ([`RacingLine::minimum_curvature`]) at half the car's
+    /// width plus [`SAFETY_MARGIN`] from the road's edges: |d₀(s)| ≤ w(s)/2 − w_car/2 − 0.5 m.
+    MinCurvature,
+}
+
+impl BaseLine {
+    /// Whether this is the centre line.
+    pub fn is_centre(&self) -> bool {
+        *self == BaseLine::Centre
+    }
+
+    /// The line on `track` for `car`; `None` for the centre line.
+    pub fn line(&self, track: &Track, car: &Car) -> Result<Option<Arc<RacingLine>>> {
+        Ok(match self {
+            BaseLine::Centre => None,
+            BaseLine::MinCurvature => Some(Arc::new(RacingLine::minimum_curvature(
+                track,
+                &LineOptions::for_car(car, SAFETY_MARGIN),
+            )?)),
+        })
+    }
 }
 
 impl RaceConfig {
@@ -90,6 +128,7 @@ impl Default for RaceConfig {
             max_failed_laps: None,
             line_kernels: None,
             warm_start: None,
+            base_line: BaseLine::Centre,
         }
     }
 }
@@ -159,10 +198,14 @@ pub struct RaceOutcome {
     pub laps: Vec<LapRecord>,
     /// The limit lap.
     pub limit: Limit,
+    /// The base line the laps were driven on ([`RaceConfig::base_line`]); `None`: the centre
+    /// line. Drive a policy again on it with [`Venue::on_line`].
+    pub line: Option<Arc<RacingLine>>,
 }
 
 /// Runs a race where `venue` drives its laps, on `track` with `car` (cdbo's reading of them,
-/// for the limit); `progress` is called after every lap.
+/// for the limit and the base line), the demonstration and every lap on the config's base line;
+/// `progress` is called after every lap.
 pub fn race(
     venue: &Venue,
     track: &Track,
@@ -171,16 +214,27 @@ pub fn race(
     progress: impl FnMut(&LapRecord),
 ) -> Result<RaceOutcome> {
     let limit = limit_lap(track, car);
+    let line = config.base_line.line(track, car)?;
+    let on_line;
+    let venue = match &line {
+        Some(l) => {
+            on_line = venue.clone().on_line(l.clone())?;
+            &on_line
+        }
+        None => venue,
+    };
     let demo = venue.demonstrate(config.demo_speed)?;
     let mut evaluator = venue.evaluator(config.shape()?)?;
-    race_with(
+    let mut outcome = race_with(
         &track.name,
         demo,
         limit,
         config,
         evaluator.as_mut(),
         progress,
-    )
+    )?;
+    outcome.line = line;
+    Ok(outcome)
 }
 
 /// Runs a race whose laps `evaluator` drives with policies of length-scale
@@ -215,7 +269,7 @@ fn race_with(
         });
     }
     let lengthscale = default_lengthscale(config.kernels);
-    // w₀: the warm start, or the pedal fitted to the demonstration and a line at the centre
+    // w₀: the warm start, or the pedal fitted to the demonstration and a line at the base line
     // (d = 0).
     let shape = config.shape()?;
     let initial = match &config.warm_start {
@@ -286,6 +340,7 @@ fn race_with(
         best_reward_mps: best.1,
         laps,
         limit,
+        line: None,
     })
 }
 

@@ -176,6 +176,7 @@ pub fn run_at(
         max_failed_laps: None,
         line_kernels: None,
         warm_start: None,
+        base_line: Default::default(),
     };
     let (track_name, length_m) = (track.name.clone(), track.length);
     let venue = match grounds {

@@ -4,9 +4,10 @@
 //! physics step (4 ms) the car is projected on the centre line; every driver step (20 ms) the
 //! pedal and the steering controller update their commands, which are held in between. The
 //! steering holds the driver's line ([`Pedal::line`]: the centre line unless the driver names
-//! another), bounded to the road: at station s the offset d(s/L) is clamped to
-//! ±max(0, w(s)/2 − w_car/2), the road's half-width less half the car's width. The lap
-//! ends when the car has covered the track's length, or fails when:
+//! another), measured from the lap's own line d₀(s) if it has one ([`LapConfig::line`], e.g.
+//! the minimum-curvature line) and bounded to the road: at station s the offset d₀(s) + d(s/L)
+//! is clamped to ±max(0, w(s)/2 − w_car/2), the road's half-width less half the car's width.
+//! The lap ends when the car has covered the track's length, or fails when:
 //! - **off track**: the car's centre is more than width/2 + 1 m from the centre line;
 //! - **spun**: the car faces more than 90° away from the track, or slides with a body slip
 //!   angle above 60° at more than 3 m/s;
@@ -16,6 +17,8 @@
 //!
 //! Nothing else ends a lap: whether these happen follows from speed, grip and steering.
 
+use std::sync::Arc;
+
 use serde::Serialize;
 
 use super::vehicle::{Controls, State, Vehicle};
@@ -23,6 +26,7 @@ use crate::car::Car;
 use crate::drive::demo::SpeedHold;
 use crate::drive::steering::{Steering, wrap_angle};
 use crate::drive::{Observation, Pedal, pedal_command};
+use crate::line::RacingLine;
 use crate::track::{Frame, Track};
 
 /// Why a lap failed.
@@ -155,6 +159,11 @@ pub struct LapConfig {
     /// The steering controller (its gains; its memory starts empty each lap): the PI by
     /// default.
     pub steering: Steering,
+    /// The line the car holds, part of the track as a driver's reference: offsets d₀(s) from
+    /// the centre line ([`RacingLine::offset_at`]); a policy's own line d(x) is driven as an
+    /// offset from it, d₀(s) + d(s/L), clamped to the road less half the car's width.
+    /// `None`: the centre line (d₀ = 0).
+    pub line: Option<Arc<RacingLine>>,
 }
 
 impl Default for LapConfig {
@@ -166,6 +175,7 @@ impl Default for LapConfig {
             time_limit: None,
             trace: false,
             steering: Steering::default(),
+            line: None,
         }
     }
 }
@@ -264,7 +274,12 @@ impl Simulator {
                 }));
                 let line = |s: f64| {
                     let bound = (track.frame(track.index_at(s)).half_width - half_car).max(0.0);
-                    pedal.line(s / track.length).clamp(-bound, bound)
+                    let d = pedal.line(s / track.length);
+                    let d = match &cfg.line {
+                        Some(base) => base.offset_at(s) + d,
+                        None => d,
+                    };
+                    d.clamp(-bound, bound)
                 };
                 let steer = steering.update(track, &self.vehicle, &state, &proj, &line, driver_dt);
                 controls = Controls::new(steer, a.max(0.0), (-a).max(0.0));
