@@ -32,7 +32,6 @@ fn the_min_curvature_start_line_lies_within_the_road() {
     let steering = cdbo::drive::steering::Steering::Tracker(Default::default());
     let venue = Venue::simulator(track.clone(), &car)
         .steered(steering)
-        .unwrap()
         .on_line(line.clone())
         .unwrap();
     let (demo, _) = venue.demonstrate(15.0).unwrap();
