@@ -169,36 +169,30 @@ impl InitialPolicy {
                 stored.lengthscale.to_string(),
             );
         }
-        if let Some(l) = self
-            .track_length
-            .filter(|l| Some(*l) != stored.track_length)
-        {
-            let kept = stored
-                .track_length
-                .map_or("no --track-length".into(), |k| k.to_string());
-            return differs("--track-length", l.to_string(), kept);
-        }
-        if let Some(k) = self.knob.filter(|k| Some(*k) != stored.knob) {
-            let kept = stored.knob.map_or("no --knob".into(), |k| k.to_string());
-            return differs("--knob", k.to_string(), kept);
-        }
-        if let Some(n) = self
-            .max_failed_laps
-            .filter(|n| Some(*n) != stored.max_failed_laps)
-        {
-            let kept = stored
-                .max_failed_laps
-                .map_or("no --max-failed-laps".into(), |k| k.to_string());
-            return differs("--max-failed-laps", n.to_string(), kept);
-        }
-        let warm = self.warm_start.as_ref().map(|p| p.display().to_string());
-        if let Some(w) = warm.filter(|w| Some(w) != stored.warm_start.as_ref()) {
-            let kept = stored
-                .warm_start
-                .clone()
-                .map_or("no --warm-start".into(), |k| k);
-            return differs("--warm-start", w, kept);
-        }
+        // A flag whose stored value may be absent (a study made without it, or before it).
+        let optional = |flag: &str, given: Option<String>, kept: Option<String>| match given {
+            Some(g) if Some(&g) != kept.as_ref() => {
+                differs(flag, g, kept.unwrap_or_else(|| format!("no {flag}")))
+            }
+            _ => Ok(()),
+        };
+        let text = |v: Option<f64>| v.map(|v| v.to_string());
+        optional(
+            "--track-length",
+            text(self.track_length),
+            text(stored.track_length),
+        )?;
+        optional("--knob", text(self.knob), text(stored.knob))?;
+        optional(
+            "--max-failed-laps",
+            self.max_failed_laps.map(|n| n.to_string()),
+            stored.max_failed_laps.map(|n| n.to_string()),
+        )?;
+        optional(
+            "--warm-start",
+            self.warm_start.as_ref().map(|p| p.display().to_string()),
+            stored.warm_start.clone(),
+        )?;
         Ok(())
     }
 }
