@@ -119,9 +119,31 @@ fn results_do_not_depend_on_jobs_and_shards_merge() {
         "curves_ridgeway.svg",
         "table1.md",
         "fig3a_policy_ridgeway.svg",
+        "tradeoff_ridgeway_6.png",
+        "tradeoff_ridgeway_6.svg",
     ] {
         assert!(dir.join("merged").join(f).is_file(), "{f}");
     }
+    // The budget line's best with no cap is the table's fastest method, by brute force over
+    // the table's rows: | ridgeway | 6 | METHOD | runs | MEAN ± SE | ….
+    let (method, best) = results
+        .lines()
+        .filter_map(|l| l.strip_prefix("| ridgeway | 6 | "))
+        .map(|l| {
+            let cols: Vec<&str> = l.split(" | ").collect();
+            (cols[0], cols[2].split(" ± ").next().unwrap())
+        })
+        .max_by(|a, b| a.1.parse::<f64>().unwrap().total_cmp(&b.1.parse().unwrap()))
+        .unwrap();
+    let line = results
+        .lines()
+        .find(|l| l.starts_with("- ridgeway 6: at most 10 % ("))
+        .expect("the panel's budget line");
+    assert!(
+        line.contains(&format!("no cap: {method} {best} ± ")),
+        "{line}"
+    );
+    assert!(results.contains("(tradeoff_ridgeway_6.png)"), "{results}");
 }
 
 /// Every run records the ceiling (the tracked limit profile's lap, as `cdbo ceiling`

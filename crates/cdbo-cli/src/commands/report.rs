@@ -188,18 +188,20 @@ pub fn run(args: &ReportArgs, data: &DataPath) -> CliResult {
     Ok(())
 }
 
+/// The policy sizes raced on `track`, ascending (the cells are ordered by track, size, method).
+fn sizes_on<V>(cells: &std::collections::BTreeMap<Cell, V>, track: &str) -> Vec<usize> {
+    let mut sizes: Vec<usize> = cells.keys().filter(|c| c.0 == track).map(|c| c.1).collect();
+    sizes.dedup();
+    sizes
+}
+
 fn learning_curves(
     out: &Path,
     name: &str,
     track: &str,
     curves: &std::collections::BTreeMap<(String, usize, String), Curve>,
 ) -> CliResult {
-    let mut sizes: Vec<usize> = curves
-        .keys()
-        .filter(|c| c.0 == track)
-        .map(|c| c.1)
-        .collect();
-    sizes.dedup();
+    let sizes = sizes_on(curves, track);
     let panels = Panels {
         titles: sizes
             .iter()
@@ -244,12 +246,7 @@ fn tradeoff_figures(
     track: &str,
     tradeoffs: &std::collections::BTreeMap<Cell, Tradeoff>,
 ) -> Result<Vec<(String, String)>, Box<dyn std::error::Error>> {
-    let mut sizes: Vec<usize> = tradeoffs
-        .keys()
-        .filter(|c| c.0 == track)
-        .map(|c| c.1)
-        .collect();
-    sizes.dedup();
+    let sizes = sizes_on(tradeoffs, track);
     let mut figures = Vec::new();
     for m in sizes {
         let panel: Vec<(&Cell, &Tradeoff)> = tradeoffs
