@@ -335,3 +335,50 @@ fn workers_fill_a_grid_in_an_sqlite_file() {
     );
     assert!(!dir.join("none.db").exists());
 }
+
+/// A grid's `steering = "tracker"` drives its runs and their ceiling as `cdbo race --steering
+/// tracker` does: the same best, ceiling and failed laps, and not those of the PI steering.
+#[test]
+fn a_grid_steers_with_the_tracker_as_race_does() {
+    let dir = fresh_dir("steering");
+    let grid = "laps = 8\nrepeats = 1\nmethods = [\"random\"]\nsteering = \"tracker\"\n\
+                [[tracks]]\ntrack = \"ridgeway\"\nkernels = [6]\n";
+    std::fs::write(dir.join("grid.toml"), grid).unwrap();
+    ok(&dir, &["experiment", "grid.toml", "--out", "g"]);
+    let run: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.join("g/runs/ridgeway-m6-random-r0.json")).unwrap(),
+    )
+    .unwrap();
+    let race = |steering: &str| -> serde_json::Value {
+        let args = [
+            "race",
+            "--kernels",
+            "6",
+            "--laps",
+            "8",
+            "--method",
+            "random",
+            "--knob",
+            "0.03",
+            "--seed",
+            "0",
+            "--steering",
+            steering,
+            "--json",
+            "--out",
+            steering,
+        ];
+        serde_json::from_str(&ok(&dir, &args)).unwrap()
+    };
+    let failed = run["laps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|l| !l["failure"].is_null())
+        .count();
+    let tracker = race("tracker");
+    assert_eq!(run["best_reward_mps"], tracker["best_reward_mps"]);
+    assert_eq!(run["ceiling_reward_mps"], tracker["ceiling_reward_mps"]);
+    assert_eq!(failed as u64, tracker["failed_laps"].as_u64().unwrap());
+    assert_ne!(run["ceiling_reward_mps"], race("pi")["ceiling_reward_mps"]);
+}

@@ -13,12 +13,15 @@
 //! kernels = [10, 50, 100]
 //! ```
 //!
+//! `steering = "tracker"` drives every run with the path tracker (default `"pi"`).
+//!
 //! Run r of every cell has seed r, so that the methods meet the same random numbers where
 //! they draw alike. The runs are listed in a fixed order; shard I of N takes every N-th run
 //! from the I-th, so shards partition the grid whatever machine runs them.
 
 use serde::{Deserialize, Serialize};
 
+use crate::drive::steering::SteeringLaw;
 use crate::method::{Method, Spec};
 
 use crate::error::{Error, Result};
@@ -60,6 +63,10 @@ pub struct ExperimentConfig {
         skip_serializing_if = "std::collections::BTreeMap::is_empty"
     )]
     pub knob: std::collections::BTreeMap<Method, f64>,
+    /// How every run's car steers, the ceiling's lap included: `"pi"` (the paper's, the
+    /// default) or `"tracker"` (the path tracker, as `cdbo race --steering tracker`).
+    #[serde(default, skip_serializing_if = "SteeringLaw::is_pi")]
+    pub steering: SteeringLaw,
 }
 
 fn default_demo_speed() -> f64 {
@@ -115,6 +122,7 @@ impl ExperimentConfig {
                 methods: methods(&[]),
                 tracks: paper_tracks,
                 knob: Default::default(),
+                steering: Default::default(),
             },
             "paper-plus" => ExperimentConfig {
                 methods: methods(&[
@@ -141,6 +149,7 @@ impl ExperimentConfig {
                     kernels: vec![10, 20],
                 }],
                 knob: Default::default(),
+                steering: Default::default(),
             },
             _ => return None,
         })
