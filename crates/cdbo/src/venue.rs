@@ -13,7 +13,7 @@ use crate::evaluator::Evaluator;
 use crate::evaluator::simulator::SimEvaluator;
 use crate::line::RacingLine;
 use crate::policy::{Policy, PolicyShape};
-use crate::sim::{LapResult, Simulator};
+use crate::sim::{LapConfig, LapResult, Simulator};
 use crate::torcs::evaluator::{TorcsPolicyEvaluator, drive, with_pedal, with_policy};
 use crate::torcs::{Game, GamePedal, LapRequest};
 use crate::track::Track;
@@ -56,9 +56,21 @@ impl Venue {
 
     /// This venue with the car steered by `steering` (in the game too, on any line).
     pub fn steered(self, steering: Steering) -> Venue {
+        self.configured(|config| config.steering = steering)
+    }
+
+    /// This venue with the car holding `line` where a policy has none (a policy's line is
+    /// then an offset from it, [`crate::sim::LapConfig::line`]), in the simulator and in the
+    /// game alike (there the robot is handed the line, [`crate::torcs::line`]).
+    pub fn on_line(self, line: Arc<RacingLine>) -> Result<Venue> {
+        Ok(self.configured(|config| config.line = Some(line)))
+    }
+
+    /// This venue with its laps' settings changed by `change`.
+    fn configured(self, change: impl FnOnce(&mut LapConfig)) -> Venue {
         match self {
             Venue::Simulator(mut sim) => {
-                sim.config.steering = steering;
+                change(&mut sim.config);
                 Venue::Simulator(sim)
             }
             Venue::Game {
@@ -66,7 +78,7 @@ impl Venue {
                 mut request,
                 track,
             } => {
-                request.config.steering = steering;
+                change(&mut request.config);
                 Venue::Game {
                     game,
                     request,
@@ -74,30 +86,6 @@ impl Venue {
                 }
             }
         }
-    }
-
-    /// This venue with the car holding `line` where a policy has none (a policy's line is
-    /// then an offset from it, [`crate::sim::LapConfig::line`]), in the simulator and in the
-    /// game alike.
-    pub fn on_line(self, line: Arc<RacingLine>) -> Result<Venue> {
-        Ok(match self {
-            Venue::Simulator(mut sim) => {
-                sim.config.line = Some(line);
-                Venue::Simulator(sim)
-            }
-            Venue::Game {
-                game,
-                mut request,
-                track,
-            } => {
-                request.config.line = Some(line);
-                Venue::Game {
-                    game,
-                    request,
-                    track,
-                }
-            }
-        })
     }
 
     /// The car as cdbo reads it (for the limit and the plots).
