@@ -9,8 +9,9 @@
  *
  * Throttle and brake follow a pedal a in [-1, 1] (a policy pi(x) of the lap fraction x, the
  * demonstrator's PI speed hold, or a constant); steering is cdbo's look-ahead PI law
- * (crates/cdbo/src/drive/steering.rs) or its path tracker on the centre line
- * (crates/cdbo/src/drive/tracker.rs); the gear is chosen by cdbo's automatic gearbox
+ * (crates/cdbo/src/drive/steering.rs) or its path tracker (crates/cdbo/src/drive/tracker.rs),
+ * either holding the path P(s) = c(s) + d(s) n(s) of a line d(s) metres left of the centre
+ * line c(s) (n the left normal; the centre line itself unless the settings give a line); the gear is chosen by cdbo's automatic gearbox
  * (crates/cdbo/src/sim/powertrain.rs) from shift points it is given; ABS and traction control
  * ease the pedals as cdbo's vehicle does; the lap fails by cdbo's rules (sim/lap.rs), judged
  * from the game's car state. On completion or failure it writes one JSON line and ends the
@@ -20,11 +21,15 @@
  *
  * Settings: the file named by the attribute "settings" of section "cdbo" in
  * drivers/cdbo/cdbo.xml, relative to the game's local directory (-l) unless absolute. One
- * "key values..." per line, '#' starts a comment:
+ * "key values..." per line (of any length), '#' starts a comment:
  *   output PATH                  the JSON line goes here (appended)
  *   trace PATH                   optional: every driver step (50 Hz) as CSV
  *   pedal demo V | pedal constant A | pedal rkhs L W1 ... WM | pedal table X1 A1 X2 A2 ...
  *   wheelbase L                  (m), the steering gain's L
+ *   line L D1 ... DN             optional: the line both steerings hold, offsets (m, positive
+ *                                left of the centre line) at the N >= 2 stations (j - 1) L / N
+ *                                of a lap of length L (m), linear in between and around the
+ *                                lap's end (drive::periodic_linear); without it the centre line
  *   steering pi T_LA D_MIN K_I   the PI law: look-ahead time (s), shortest look-ahead (m),
  *                                integral gain
  *   steering tracker T_P X_MIN T_F C   the path tracker: preview time (s), shortest preview
@@ -82,6 +87,8 @@ struct Settings {
     std::string pedal = "demo";
     std::vector<double> pedal_args = {15.0};
     double wheelbase = 2.6;
+    double line_length = 0.0;
+    std::vector<double> line;  // the line's offsets; empty: the centre line
     bool tracker = false;  // the path tracker, else the PI law
     double lookahead_time = 0.8, lookahead_min = 12.0, ki = 0.1;
     drive::TrackerGains gains = {0.4, 10.0, 0.15, 4.0};
@@ -124,9 +131,16 @@ bool read_settings(const std::string &path, Settings *s, std::string *error) {
         *error = "cannot read the settings file " + path;
         return false;
     }
-    char line[1 << 16];
+    // getline grows the buffer to the longest line (a line's table is one line per lap metre).
+    char *line = nullptr;
+    size_t capacity = 0;
     int number = 0;
-    while (fgets(line, sizeof line, f)) {
+    auto fail = [&]() {
+        free(line);
+        fclose(f);
+        return false;
+    };
+    while (getline(&line, &capacity, f) != -1) {
         number++;
         if (char *hash = strchr(line, '#')) *hash = 0;
         char *save = nullptr;
@@ -144,8 +158,7 @@ bool read_settings(const std::string &path, Settings *s, std::string *error) {
             } else {
                 *error = path + ":" + std::to_string(number) + ": " + key + ": '" + tok +
                          "' is not a finite number";
-                fclose(f);
-                return false;
+                return fail();
             }
         }
         std::string k = key;
@@ -162,6 +175,10 @@ bool read_settings(const std::string &path, Settings *s, std::string *error) {
         else if (k == "trace") s->trace = word;
         else if (k == "pedal") { s->pedal = word; s->pedal_args = nums; }
         else if (k == "wheelbase") { if ((ok = need(1))) s->wheelbase = nums[0]; }
+        else if (k == "line") {
+            if ((ok = need(3) && nums[0] > 0.0)) { s->line_length = nums[0]; s->line.assign(nums.begin() + 1, nums.end()); }
+            else *error = path + ":" + std::to_string(number) + ": line needs a positive length and at least 2 offsets";
+        }
         else if (k == "steering" && word == "pi") {
             if ((ok = need(3))) { s->tracker = false; s->lookahead_time = nums[0]; s->lookahead_min = nums[1]; s->ki = nums[2]; }
         }
@@ -194,11 +211,9 @@ bool read_settings(const std::string &path, Settings *s, std::string *error) {
             *error = path + ":" + std::to_string(number) + ": unknown setting '" + k + "'";
             ok = false;
         }
-        if (!ok) {
-            fclose(f);
-            return false;
-        }
+        if (!ok) return fail();
     }
+    free(line);
     fclose(f);
     if (s->ratios.empty() || s->ratios.size() * s->throttle_levels != s->upshift.size()) {
         *error = path + ": 'upshift' must give 'throttle_levels' numbers per gear of 'ratios'";
@@ -248,8 +263,9 @@ double pedal(double x, double speed, double dt) {
     return drive::pedal_command(v);
 }
 
-/// The centre-line point s metres from the start line (wrapped onto the lap).
-void centre_point(double s, double *px, double *py) {
+/// The centre-line point s metres from the start line (wrapped onto the lap), and the centre
+/// line's heading there (rad).
+void centre_point(double s, double *px, double *py, double *heading) {
     double len = lap.track->length;
     s = std::fmod(s, len);
     if (s < 0) s += len;
@@ -265,46 +281,66 @@ void centre_point(double s, double *px, double *py) {
     if (seg->type == TR_STR) {
         *px = sx + t * std::cos(h);
         *py = sy + t * std::sin(h);
+        *heading = h;
         return;
     }
     double turn = seg->type == TR_LFT ? 1.0 : -1.0;
     double phi = t / seg->radius * turn;
+    *heading = h + phi;
     // Rotate the start point about the arc's centre by phi.
     double dx = sx - seg->center.x, dy = sy - seg->center.y;
     *px = seg->center.x + dx * std::cos(phi) - dy * std::sin(phi);
     *py = seg->center.y + dx * std::sin(phi) + dy * std::cos(phi);
 }
 
-/// The road-wheel angle (rad) of cdbo's look-ahead PI steering (drive/steering.rs).
+/// The line's offset d(s) (m, positive left) at station s: the settings' table, linear
+/// (drive::periodic_linear); 0 on the centre line.
+double line_offset(double s) {
+    const Settings &c = lap.cfg;
+    return c.line.empty() ? 0.0 : drive::periodic_linear(c.line.data(), c.line.size(), c.line_length, s);
+}
+
+/// The path's point at station s: the centre line's point d(s) metres along its left normal
+/// (drive::offset_left); the centre-line point itself where d(s) = 0, as cdbo's
+/// Track::point_off.
+void path_point(double s, double *px, double *py) {
+    double heading;
+    centre_point(s, px, py, &heading);
+    double d = line_offset(s);
+    if (d != 0.0) drive::offset_left(*px, *py, std::sin(heading), std::cos(heading), d, px, py);
+}
+
+/// The road-wheel angle (rad) of cdbo's look-ahead PI steering (drive/steering.rs), aimed at
+/// the path's point the look-ahead distance ahead of the car's station.
 double steer(tCarElt *car, double speed, double dt) {
     double d = drive::lookahead(lap.cfg.lookahead_time, lap.cfg.lookahead_min, speed);
     double tx, ty;
-    centre_point(car->_distFromStartLine + d, &tx, &ty);
+    path_point(car->_distFromStartLine + d, &tx, &ty);
     double e = drive::bearing(tx - car->_pos_X, ty - car->_pos_Y, std::sin(car->_yaw), std::cos(car->_yaw));
     return drive::steering_law(e, d, lap.cfg.wheelbase, lap.cfg.ki, car->_steerLock, lap.steer_integral, dt);
 }
 
-/// The road-wheel angle (rad) of cdbo's path tracker (drive/tracker.rs) on the centre line:
-/// the centre line's points kPathStep either side of the car's station give its heading,
-/// three points around the station t_f v ahead its curvature, the car's offset from the
-/// middle is the lateral error, the cornering stiffness is read from the settings' tables at v
+/// The road-wheel angle (rad) of cdbo's path tracker (drive/tracker.rs) on the path: its
+/// points kPathStep either side of the car's station give its heading, three points around the
+/// station t_f v ahead its curvature, the car's offset from the middle less the line's offset
+/// d(s) is the lateral error, the cornering stiffness is read from the settings' tables at v
 /// and scaled by the friction of the car's segment.
 double tracker_steer(tCarElt *car, double speed) {
     const Settings &c = lap.cfg;
     double v = drive::tracker_speed(speed);
     double s = car->_distFromStartLine;
     double bx, by, ax, ay;
-    centre_point(s - drive::kPathStep, &bx, &by);
-    centre_point(s + drive::kPathStep, &ax, &ay);
+    path_point(s - drive::kPathStep, &bx, &by);
+    path_point(s + drive::kPathStep, &ax, &ay);
     drive::TrackerInput in;
     // psi - theta_P: minus the bearing of the path's tangent from the car's heading.
     in.heading_error = -drive::bearing(ax - bx, ay - by, std::sin(car->_yaw), std::cos(car->_yaw));
-    in.lateral_error = car->_trkPos.toMiddle;
+    in.lateral_error = car->_trkPos.toMiddle - line_offset(s);
     double sf = s + c.gains.feedforward_time * v;
     double p[6];
-    centre_point(sf - drive::kPathStep, &p[0], &p[1]);
-    centre_point(sf, &p[2], &p[3]);
-    centre_point(sf + drive::kPathStep, &p[4], &p[5]);
+    path_point(sf - drive::kPathStep, &p[0], &p[1]);
+    path_point(sf, &p[2], &p[3]);
+    path_point(sf + drive::kPathStep, &p[4], &p[5]);
     in.curvature = drive::curvature(p[0], p[1], p[2], p[3], p[4], p[5]);
     in.speed = v;
     in.yaw_rate = car->_yaw_rate;

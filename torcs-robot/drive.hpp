@@ -8,8 +8,8 @@
  * 2 of the License, or (at your option) any later version. See COPYING.
  *
  * Everything the robot (cdbo.cpp) decides from numbers it has gathered: the pedal (the policy
- * pi(x), the demonstrator's speed hold), the steering laws (the PI law and the path tracker),
- * the gearbox and the launch clutch.
+ * pi(x), the demonstrator's speed hold), the line it holds, the steering laws (the PI law and
+ * the path tracker), the gearbox and the launch clutch.
  * No TORCS header is needed: cdbo.cpp reads the game's car and track and calls these, and
  * crates/cdbo/tests/robot_drive.rs compiles this header alone into a harness
  * (tests/harness.cpp) and checks each function against its Rust definition, named on each,
@@ -108,6 +108,30 @@ inline double bearing(double dx, double dy, double sin_yaw, double cos_yaw) {
 inline double steering_law(double e, double d, double wheelbase, double ki, double steer_lock,
                            double &integral, double dt) {
     return pi_control(2.0 * wheelbase / d, ki, steer_lock, integral, e, dt);
+}
+
+// ---- The line -------------------------------------------------------------------------------
+
+/// The periodic function through the n >= 1 values y_j at x_j = j P / n (y_0 again at P) at x
+/// wrapped into [0, P) (interp.rs periodic_linear): u = (x mod P) / (P / n),
+/// j = min(floor(u), n - 1), t = u - j, y_j (1 - t) + y_((j + 1) mod n) t. The robot's line:
+/// the offsets d_j (m, positive left) at stations j L / n of a lap of length L.
+inline double periodic_linear(const double *values, std::size_t n, double period, double x) {
+    double h = period / double(n);
+    double r = std::fmod(x, period);  // Rust's rem_euclid: the remainder made non-negative
+    if (r < 0.0) r += std::fabs(period);
+    double u = r / h;
+    std::size_t j = std::min(std::size_t(std::floor(u)), n - 1);
+    double t = u - double(j);
+    return values[j] * (1.0 - t) + values[(j + 1) % n] * t;
+}
+
+/// The point d metres left of (x, y) on a line heading (cos h, sin h): (x - d sin h,
+/// y + d cos h) (track/mod.rs offset_left, the path point c(s) + d(s) n(s)).
+inline void offset_left(double x, double y, double sin_h, double cos_h, double d, double *px,
+                        double *py) {
+    *px = x - d * sin_h;
+    *py = y + d * cos_h;
 }
 
 // ---- The path tracker ------------------------------------------------------------------------

@@ -46,6 +46,10 @@ struct Args {
 
 using Case = std::function<std::vector<double>(Args &)>;
 
+/// The line's table periodic_linear reads (set by line_table; a table is long, the calls many).
+std::vector<double> line_values;
+double line_period = 0.0;
+
 /// Each function of drive.hpp: its inputs as read, its outputs (then updated state) as printed.
 const std::map<std::string, Case> kCases = {
     {"rkhs",  // L M W1..WM X -> w^T phi(x)
@@ -85,6 +89,29 @@ const std::map<std::string, Case> kCases = {
                 lock = a.num(), dt = a.num();
          double out = drive::steering_law(e, d, l, ki, lock, integral, dt);
          return std::vector<double>{out, integral};
+     }},
+    {"line_table",  // N Y1..YN PERIOD -> N: the table periodic_linear reads from now on
+     [](Args &a) {
+         std::size_t n = a.count();
+         std::vector<double> y = a.list(n);
+         double period = a.num();
+         if (a.short_line || n == 0) return std::vector<double>{};
+         line_values = y;
+         line_period = period;
+         return std::vector<double>{double(n)};
+     }},
+    {"periodic_linear",  // X -> y of the last line_table
+     [](Args &a) {
+         double x = a.num();
+         if (line_values.empty()) return std::vector<double>{};
+         return std::vector<double>{
+             drive::periodic_linear(line_values.data(), line_values.size(), line_period, x)};
+     }},
+    {"offset_left",  // X Y SIN COS D -> PX PY
+     [](Args &a) {
+         double x = a.num(), y = a.num(), s = a.num(), c = a.num(), d = a.num(), px, py;
+         drive::offset_left(x, y, s, c, d, &px, &py);
+         return std::vector<double>{px, py};
      }},
     {"tracker_constants",  // -> kPathStep kTrackerMinSpeed
      [](Args &) { return std::vector<double>{drive::kPathStep, drive::kTrackerMinSpeed}; }},

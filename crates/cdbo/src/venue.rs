@@ -6,14 +6,15 @@
 use std::sync::Arc;
 
 use crate::car::Car;
+use crate::drive::demo::SpeedHold;
 use crate::drive::steering::Steering;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::evaluator::Evaluator;
 use crate::evaluator::simulator::SimEvaluator;
 use crate::line::RacingLine;
 use crate::policy::{Policy, PolicyShape};
-use crate::sim::{LapResult, Simulator};
-use crate::torcs::evaluator::{TorcsEvaluator, drive};
+use crate::sim::{LapConfig, LapResult, Simulator};
+use crate::torcs::evaluator::{TorcsPolicyEvaluator, drive, with_pedal, with_policy};
 use crate::torcs::{Game, GamePedal, LapRequest};
 use crate::track::Track;
 
@@ -27,8 +28,12 @@ pub enum Venue {
     Game {
         /// The set-up game.
         game: Game,
-        /// The track and car every lap is driven with (its pedal is each lap's).
+        /// The track, car, steering and base line every lap is driven with (its pedal and
+        /// line are each lap's).
         request: Box<LapRequest>,
+        /// cdbo's reading of the game's track: the line the robot holds is bounded to its road
+        /// and sampled on it as the simulator's car would hold it ([`crate::torcs::line`]).
+        track: Arc<Track>,
     },
 }
 
@@ -38,40 +43,48 @@ impl Venue {
         Venue::Simulator(Box::new(Simulator::new(track, car)))
     }
 
-    /// The game on its track `track` with its car `car` (TORCS names).
-    pub fn game(game: &Game, track: &str, car: &str) -> Result<Venue> {
-        let request = game.request(track, car, GamePedal::Demo(0.0))?;
+    /// The game on its track `name` with its car `car` (TORCS names); `track` is cdbo's reading
+    /// of that track.
+    pub fn game(game: &Game, name: &str, car: &str, track: Track) -> Result<Venue> {
+        let request = game.request(name, car, GamePedal::Demo(0.0))?;
         Ok(Venue::Game {
             game: game.clone(),
             request: Box::new(request),
+            track: Arc::new(track),
         })
     }
 
-    /// This venue with the car steered by `steering` (the game's robot steers the centre line
-    /// with either law).
+    /// This venue with the car steered by `steering` (in the game too, on any line).
     pub fn steered(self, steering: Steering) -> Venue {
-        match self {
-            Venue::Simulator(mut sim) => {
-                sim.config.steering = steering;
-                Venue::Simulator(sim)
-            }
-            Venue::Game { game, mut request } => {
-                request.config.steering = steering;
-                Venue::Game { game, request }
-            }
-        }
+        self.configured(|config| config.steering = steering)
     }
 
     /// This venue with the car holding `line` where a policy has none (a policy's line is
-    /// then an offset from it, [`crate::sim::LapConfig::line`]); the game's robot steers the
-    /// centre line only, so a line is refused there.
+    /// then an offset from it, [`crate::sim::LapConfig::line`]), in the simulator and in the
+    /// game alike (there the robot is handed the line, [`crate::torcs::line`]).
     pub fn on_line(self, line: Arc<RacingLine>) -> Result<Venue> {
+        Ok(self.configured(|config| config.line = Some(line)))
+    }
+
+    /// This venue with its laps' settings changed by `change`.
+    fn configured(self, change: impl FnOnce(&mut LapConfig)) -> Venue {
         match self {
             Venue::Simulator(mut sim) => {
-                sim.config.line = Some(line);
-                Ok(Venue::Simulator(sim))
+                change(&mut sim.config);
+                Venue::Simulator(sim)
             }
-            Venue::Game { .. } => Err(line_in_game()),
+            Venue::Game {
+                game,
+                mut request,
+                track,
+            } => {
+                change(&mut request.config);
+                Venue::Game {
+                    game,
+                    request,
+                    track,
+                }
+            }
         }
     }
 
@@ -88,8 +101,15 @@ impl Venue {
     pub fn demonstrate(&self, speed: f64) -> Result<(LapResult, Vec<(f64, f64)>)> {
         match self {
             Venue::Simulator(sim) => Ok(sim.demonstrate(speed)),
-            Venue::Game { game, request } => {
-                let lap = drive(game, &recorded(request), GamePedal::Demo(speed))?;
+            Venue::Game {
+                game,
+                request,
+                track,
+            } => {
+                let pedal = GamePedal::Demo(speed);
+                let hold = SpeedHold::new(speed);
+                let req = with_pedal(&recorded(request), track, pedal, &hold, false);
+                let lap = drive(game, &req)?;
                 let pairs = lap.trace.iter().map(|p| (p.x, p.pedal)).collect();
                 Ok((lap, pairs))
             }
@@ -100,43 +120,34 @@ impl Venue {
     pub fn drive(&self, policy: &Policy) -> Result<LapResult> {
         match self {
             Venue::Simulator(sim) => Ok(traced(sim).lap(&mut policy.driver())),
-            Venue::Game { game, request } => drive(
+            Venue::Game {
                 game,
-                &recorded(request),
-                GamePedal::Rkhs(policy.pedal_only().ok_or_else(line_in_game)?.clone()),
-            ),
+                request,
+                track,
+            } => drive(game, &with_policy(&recorded(request), track, policy)),
         }
     }
 
-    /// The evaluator of policy weights of shape `shape` here; the game's robot drives the
-    /// pedal only, on its centre line, so a shape with a line is refused there.
+    /// The evaluator of policy weights of shape `shape` here (a pedal and, if the shape has
+    /// one, a line).
     pub fn evaluator(&self, shape: PolicyShape) -> Result<Box<dyn Evaluator + Send>> {
         Ok(match self {
             Venue::Simulator(sim) => Box::new(SimEvaluator {
                 sim: sim.as_ref().clone(),
                 shape,
             }),
-            Venue::Game { game, request } => {
-                if shape.line.is_some() {
-                    return Err(line_in_game());
-                }
-                Box::new(TorcsEvaluator {
-                    game: game.clone(),
-                    request: request.as_ref().clone(),
-                    lengthscale: shape.pedal.lengthscale,
-                })
-            }
+            Venue::Game {
+                game,
+                request,
+                track,
+            } => Box::new(TorcsPolicyEvaluator {
+                game: game.clone(),
+                request: request.as_ref().clone(),
+                track: track.clone(),
+                shape,
+            }),
         })
     }
-}
-
-/// The game's robot drives the pedal only, on the centre line.
-fn line_in_game() -> Error {
-    Error::invalid_value(
-        "a policy's line in the game TORCS",
-        "a line d(x)",
-        "none: cdbo's robot steers the centre line (drive the line in cdbo's simulator)",
-    )
 }
 
 /// The simulator, recording a trace of its laps.

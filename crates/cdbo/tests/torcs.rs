@@ -10,8 +10,10 @@ use std::sync::{Mutex, MutexGuard, OnceLock};
 use cdbo::drive::demo::SpeedHold;
 use cdbo::drive::steering::Steering;
 use cdbo::drive::tracker::PathTracker;
+use cdbo::experiment::race::BaseLine;
 use cdbo::sim::{FailureReason, Simulator};
 use cdbo::torcs::{self, Game, GamePedal, Install};
+use cdbo::venue::Venue;
 
 /// One lap at a time in this file, so that a test can see the lap folders emptied.
 fn one_at_a_time() -> MutexGuard<'static, ()> {
@@ -89,6 +91,50 @@ fn a_demonstration_lap_in_the_game_agrees_with_the_simulator() {
 /// the start line (corkscrew) included. Measured: 36 of 38 complete in both, the largest
 /// difference 0.79 % (mixed-2); dirt-2 and mixed-1 fail in both. About 40 s: run with the slow
 /// suites (`cargo test --release -- --ignored`, as CI does).
+/// The demonstrator holding 15 m/s round Forza on its minimum-curvature line, steered by the
+/// path tracker, in the game and in cdbo's simulator (`Venue::on_line`): the game's lap within
+/// 1 % of the simulator's, and the game's car on the line (RMS of its offset from d₀(s) under
+/// 0.3 m, as the simulator's), metres off the centre line.
+#[test]
+#[ignore = "slow: the minimum-curvature line of Forza, and a game lap"]
+fn the_game_holds_the_racing_line_as_the_simulator_does() {
+    let _one = one_at_a_time();
+    let Some(game) = game() else { return };
+    let data = cdbo::data_path::DataPath::new(std::slice::from_ref(&game.install.data_dir));
+    let track = cdbo::track::catalog::find("forza", &data).unwrap();
+    let car = game.car("car1-trb1").unwrap();
+    let line = BaseLine::MinCurvature.line(&track, &car).unwrap().unwrap();
+    let steering = Steering::Tracker(PathTracker::new());
+    let in_game = Venue::game(game, "forza", "car1-trb1", track.clone()).unwrap();
+    let ours = Venue::simulator(track.clone(), &car);
+    let [(game_lap, _), (sim_lap, _)] = [in_game, ours].map(|venue| {
+        let venue = venue.steered(steering.clone()).on_line(line.clone());
+        venue.unwrap().demonstrate(15.0).unwrap()
+    });
+    let (t_game, t_ours) = (game_lap.lap_time_s.unwrap(), sim_lap.lap_time_s.unwrap());
+    let diff = (t_game - t_ours).abs() / t_ours;
+    assert!(diff < 0.01, "game {t_game:.2} s, cdbo {t_ours:.2} s");
+    for (lap, what) in [(&game_lap, "game"), (&sim_lap, "cdbo")] {
+        let n = lap.trace.len() as f64;
+        let off_line = lap
+            .trace
+            .iter()
+            .map(|p| (p.lateral - line.offset_at(p.distance_m)).powi(2))
+            .sum::<f64>();
+        let rms = (off_line / n).sqrt();
+        assert!(rms < 0.3, "{what}: {rms:.3} m (RMS) off the line");
+        let wide = lap
+            .trace
+            .iter()
+            .map(|p| p.lateral.abs())
+            .fold(0.0, f64::max);
+        assert!(
+            wide > 3.0,
+            "{what}: at most {wide:.2} m off the centre line"
+        );
+    }
+}
+
 #[test]
 #[ignore = "slow: a game lap on each of the installed tracks"]
 fn every_installed_track_drives_the_demonstration_as_cdbo_does() {

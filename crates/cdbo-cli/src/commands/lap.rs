@@ -147,6 +147,8 @@ fn run_torcs(args: &LapArgs, data: &DataPath) -> CliResult {
                 .into(),
         );
     }
+    // A policy with a line holds it in the game as in cdbo's simulator.
+    let mut policy = None;
     let pedal = match (args.demo, args.throttle, &args.policy) {
         (_, Some(a), _) => {
             if !(-1.0..=1.0).contains(&a) {
@@ -155,7 +157,10 @@ fn run_torcs(args: &LapArgs, data: &DataPath) -> CliResult {
             GamePedal::Constant(a)
         }
         (_, _, Some(path)) if path.extension().is_some_and(|e| e == "json") => {
-            GamePedal::Rkhs(super::policy::read_pedal_policy(path, "the game's robot")?)
+            let read = super::policy::read_policy(path)?;
+            let pedal = GamePedal::Rkhs(read.pedal.clone());
+            policy = Some(read);
+            pedal
         }
         (_, _, Some(path)) => GamePedal::Table(PolicyTable::read_csv(path)?.points().to_vec()),
         (speed, _, _) => {
@@ -172,6 +177,10 @@ fn run_torcs(args: &LapArgs, data: &DataPath) -> CliResult {
     let car_name = Simulator::Torcs.car(&args.setup.car);
     let mut req = game.request(&args.setup.track, car_name, pedal)?;
     req.config.steering = args.steering.steering();
+    let track = super::game_track(&args.setup.track, &game, data)?;
+    if let Some(policy) = policy.filter(|p| p.line.is_some()) {
+        req = cdbo::torcs::evaluator::with_policy(&req, &track, &policy);
+    }
     if let Some(path) = &args.trace {
         req.trace =
             Some(std::path::absolute(path).map_err(|e| format!("{}: {e}", path.display()))?);
@@ -179,7 +188,6 @@ fn run_torcs(args: &LapArgs, data: &DataPath) -> CliResult {
     let lap = game
         .lap(&req)?
         .map_err(|reason| format!("TORCS drove no lap: {reason}"))?;
-    let track = super::game_track(&args.setup.track, &game, data)?;
     let limit = limit_lap(&track, &req.car);
     let mut ours = cdbo::sim::Simulator::new(track.clone(), &req.car);
     ours.config.steering = args.steering.steering();

@@ -64,8 +64,7 @@ pub enum SteeringChoice {
     #[default]
     Pi,
     /// The path tracker: feed-forward from the path's curvature and the car's understeer
-    /// gradient, feedback on the previewed lateral error, yaw-rate damping (in the game on the
-    /// centre line).
+    /// gradient, feedback on the previewed lateral error, yaw-rate damping.
     Tracker,
 }
 
@@ -94,9 +93,11 @@ pub fn venue(
         }
         Simulator::Torcs => {
             let game = cdbo::torcs::Game::ready()?;
-            let venue = Venue::game(&game, &setup.track, simulator.car(&setup.car))?;
+            let track = game_track(&setup.track, &game, data)?;
+            let car_name = simulator.car(&setup.car);
+            let venue = Venue::game(&game, &setup.track, car_name, track.clone())?;
             let car = venue.car().cloned().unwrap_or_else(Car::spirit_300);
-            (venue, game_track(&setup.track, &game, data)?, car)
+            (venue, track, car)
         }
     })
 }

@@ -184,7 +184,7 @@ fn compare_track(
         let mut req: LapRequest = base.clone();
         req.pedal = pedal;
         req.record = record;
-        cdbo::torcs::evaluator::drive(game, &req, req.pedal.clone())
+        cdbo::torcs::evaluator::drive(game, &req)
     };
     let mut demos = Vec::new();
     for &v in &args.demo {

@@ -181,7 +181,7 @@ pub fn run_at(
     let (track_name, length_m) = (track.name.clone(), track.length);
     let venue = match grounds {
         Grounds::Simulator => Venue::simulator(track.clone(), car),
-        Grounds::Torcs { game, car } => Venue::game(game, &spec.track, car)?,
+        Grounds::Torcs { game, car } => Venue::game(game, &spec.track, car, track.clone())?,
     }
     .steered(grid.steering.steering());
     let outcome = race(&venue, &track, car, &config, progress)?;

@@ -67,12 +67,7 @@ impl RacingLine {
     /// The offset (m) at centre-line station `s` (wrapped into the lap), linear between
     /// stations.
     pub fn offset_at(&self, s: f64) -> f64 {
-        let n = self.stations.len();
-        let h = self.centre_length_m / n as f64;
-        let u = s.rem_euclid(self.centre_length_m) / h;
-        let j = (u.floor() as usize).min(n - 1);
-        let t = u - j as f64;
-        self.offsets[j] * (1.0 - t) + self.offsets[(j + 1) % n] * t
+        crate::interp::periodic_linear(&self.offsets, self.centre_length_m, s)
     }
 
     /// The largest |dⱼ| (m).

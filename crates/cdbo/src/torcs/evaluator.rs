@@ -1,13 +1,19 @@
-//! The game TORCS as an evaluator: one lap of the RKHS policy with the given weights, driven
-//! by cdbo's robot in a fresh game process.
+//! The game TORCS as an evaluator: one lap of the policy with the given weights (its pedal and,
+//! if it has one, its line), driven by cdbo's robot in a fresh game process.
 
+use std::sync::Arc;
+
+use super::line::LineTable;
 use super::{Game, GamePedal, LapRequest};
+use crate::drive::Pedal;
 use crate::error::Result;
 use crate::evaluator::{Evaluator, Outcome};
-use crate::policy::RkhsPolicy;
+use crate::policy::{Policy, PolicyShape, RkhsPolicy};
 use crate::sim::lap::{Failure, FailureReason, LapResult};
+use crate::track::Track;
 
-/// Laps in TORCS with RKHS policies of a fixed length-scale.
+/// Laps in TORCS with the paper's pedal-only RKHS policies of a fixed length-scale, on the
+/// request's line (the centre line unless `request.line` gives one).
 #[derive(Debug, Clone)]
 pub struct TorcsEvaluator {
     /// The set-up game.
@@ -22,18 +28,50 @@ impl Evaluator for TorcsEvaluator {
     fn evaluate(&mut self, _trial: i64, weights: &[f64]) -> Result<Outcome> {
         let policy = RkhsPolicy::new(weights.to_vec(), self.lengthscale)?;
         self.request.pedal = GamePedal::Rkhs(policy);
-        Ok(match self.game.lap(&self.request)? {
-            // The robot measures the reward; the lap's length follows from it and the time.
-            Ok(lap) => Outcome::of_lap(&lap, lap.reward_mps * lap.lap_time_s.unwrap_or(0.0)),
-            Err(reason) => {
-                eprintln!("warning: TORCS drove no lap: {reason}");
-                Outcome::Failed {
-                    at: None,
-                    reason: Some(reason),
-                }
-            }
-        })
+        lap_outcome(&self.game, &self.request)
     }
+}
+
+/// Laps in TORCS with policies of a fixed shape: the pedal and, if the shape has one, the
+/// line, held from the request's base line `config.line` as the simulator holds it
+/// ([`with_policy`]).
+#[derive(Debug, Clone)]
+pub struct TorcsPolicyEvaluator {
+    /// The set-up game.
+    pub game: Game,
+    /// The lap to drive (its base line in `config.line`); its pedal and line are each
+    /// policy's.
+    pub request: LapRequest,
+    /// cdbo's reading of the game's track, which the line is bounded and sampled on.
+    pub track: Arc<Track>,
+    /// The policies' shape.
+    pub shape: PolicyShape,
+}
+
+impl Evaluator for TorcsPolicyEvaluator {
+    fn evaluate(&mut self, _trial: i64, weights: &[f64]) -> Result<Outcome> {
+        let policy = self.shape.policy(weights)?;
+        lap_outcome(
+            &self.game,
+            &with_policy(&self.request, &self.track, &policy),
+        )
+    }
+}
+
+/// The outcome of one lap of `request` in the game; a lap it did not drive fails (the reason
+/// on standard error).
+fn lap_outcome(game: &Game, request: &LapRequest) -> Result<Outcome> {
+    Ok(match game.lap(request)? {
+        // The robot measures the reward; the lap's length follows from it and the time.
+        Ok(lap) => Outcome::of_lap(&lap, lap.reward_mps * lap.lap_time_s.unwrap_or(0.0)),
+        Err(reason) => {
+            eprintln!("warning: TORCS drove no lap: {reason}");
+            Outcome::Failed {
+                at: None,
+                reason: Some(reason),
+            }
+        }
+    })
 }
 
 /// A lap the game did not drive (it hung and was killed, or crashed) counts as a failed lap
@@ -55,9 +93,34 @@ fn failed_lap(reason: &str) -> LapResult {
     }
 }
 
-/// Drives `req` with `pedal`: the game's lap, or a failed lap if it drove none.
-pub fn drive(game: &Game, req: &LapRequest, pedal: GamePedal) -> Result<LapResult> {
-    let mut req = req.clone();
-    req.pedal = pedal;
-    Ok(game.lap(&req)?.unwrap_or_else(|reason| failed_lap(&reason)))
+/// Drives `req`: the game's lap, or a failed lap if it drove none.
+pub fn drive(game: &Game, req: &LapRequest) -> Result<LapResult> {
+    Ok(game.lap(req)?.unwrap_or_else(|reason| failed_lap(&reason)))
+}
+
+/// `req` with the pedal `pedal` and the line the simulator's car holds on `track` for the
+/// driver `driver` ([`LineTable::held`]: `req`'s base line `config.line` plus the driver's
+/// line); the centre line, no table, where there is neither (`own_line` false and no base
+/// line), so that a centre-line lap is the robot's as it always was.
+pub fn with_pedal(
+    req: &LapRequest,
+    track: &Track,
+    pedal: GamePedal,
+    driver: &dyn Pedal,
+    own_line: bool,
+) -> LapRequest {
+    let base = req.config.line.as_deref();
+    let line = (own_line || base.is_some())
+        .then(|| LineTable::held(track, 0.5 * req.car.width, base, driver));
+    LapRequest {
+        pedal,
+        line,
+        ..req.clone()
+    }
+}
+
+/// `req` driving `policy`: its pedal, and its line on the base line ([`with_pedal`]).
+pub fn with_policy(req: &LapRequest, track: &Track, policy: &Policy) -> LapRequest {
+    let pedal = GamePedal::Rkhs(policy.pedal.clone());
+    with_pedal(req, track, pedal, &policy.driver(), policy.line.is_some())
 }

@@ -4,8 +4,8 @@
 //!
 //! The lap folder is the game's local directory (`-l`): it holds the race (one car, our robot,
 //! standing on the start line), the robot's `drivers/cdbo/cdbo.xml` naming the car and the
-//! settings file, the settings themselves (pedal, steering gains, shift points, driver aids,
-//! failure margins; see `torcs-robot/cdbo.cpp`) and the JSON line the robot writes.
+//! settings file, the settings themselves (pedal, line, steering gains, shift points, driver
+//! aids, failure margins; see `torcs-robot/cdbo.cpp`) and the JSON line the robot writes.
 
 use std::fmt::Write as _;
 use std::io::{Read, Seek, SeekFrom};
@@ -17,6 +17,7 @@ use std::time::{Duration, Instant};
 
 use serde::Deserialize;
 
+use super::line::LineTable;
 use super::{Game, ROBOT};
 use crate::bounded;
 use crate::car::Car;
@@ -51,6 +52,8 @@ pub struct LapRequest {
     pub car: Car,
     /// The pedal.
     pub pedal: GamePedal,
+    /// The line both steerings hold, sampled ([`LineTable`]); `None`: the centre line.
+    pub line: Option<LineTable>,
     /// Lap settings: the steering gains, the off-track margin and the time limit.
     pub config: LapConfig,
     /// Write the robot's 50 Hz trace here (CSV, the columns of `cdbo lap --trace`).
@@ -232,6 +235,14 @@ fn settings(
     };
     let _ = writeln!(s, "pedal {pedal}");
     let _ = writeln!(s, "wheelbase {:e}", car.wheelbase);
+    if let Some(line) = &req.line {
+        let _ = writeln!(
+            s,
+            "line {:e} {}",
+            line.length,
+            list(&mut line.offsets.iter().copied())
+        );
+    }
     match &req.config.steering {
         Steering::Pi(st) => {
             let _ = writeln!(
@@ -295,6 +306,7 @@ impl Game {
             car_name: car.to_owned(),
             car: self.car(car)?,
             pedal,
+            line: None,
             config: LapConfig::default(),
             trace: None,
             record: false,

@@ -8,8 +8,10 @@
 //!
 //! The robot drives exactly what [`crate::sim::Simulator`] drives: the pedal a(x) (a policy,
 //! the demonstrator or a constant), the look-ahead PI steering of
-//! [`crate::drive::steering`], the automatic gearbox of [`crate::sim::powertrain`] (its shift
-//! points are handed over from the car's [`crate::sim::vehicle::Vehicle`]), the same ABS and
+//! [`crate::drive::steering`] or the path tracker of [`crate::drive::tracker`] on the lap's
+//! line (the centre line, or the base and policy line sampled by [`line`]), the automatic
+//! gearbox of [`crate::sim::powertrain`] (its shift points are handed over from the car's
+//! [`crate::sim::vehicle::Vehicle`]), the same ABS and
 //! traction control, and the same failure rules, judged from the game's car state. Its
 //! decisions are the pure functions of [`ROBOT_HEADER`], which `tests/robot_drive.rs` checks
 //! against the Rust ones (and the robot's own launch clutch against [`launch`]) on states
@@ -18,6 +20,7 @@
 pub mod evaluator;
 pub mod lap;
 pub mod launch;
+pub mod line;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};

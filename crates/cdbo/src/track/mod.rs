@@ -242,14 +242,20 @@ impl Track {
         if d == 0.0 {
             return (x, y);
         }
+        offset_left((x, y), self.heading_sin_cos(s), d)
+    }
+
+    /// (sin θ, cos θ) of the centre line's heading θ = θᵢ + κᵢ·(s − sᵢ) at station `s`
+    /// (wrapping around the lap), along the arc from the sample before it.
+    #[inline]
+    pub fn heading_sin_cos(&self, s: f64) -> (f64, f64) {
         let s = self.wrap(s);
         let f = &self.frames[self.index_at(s)];
         let (sin, cos) = (f.curvature * (s - f.s)).sin_cos();
-        let (sin_heading, cos_heading) = (
+        (
             f.sin_heading * cos + f.cos_heading * sin,
             f.cos_heading * cos - f.sin_heading * sin,
-        );
-        (x - d * sin_heading, y + d * cos_heading)
+        )
     }
 
     /// Projects (x, y) on the centre line, searching from `hint` (the last known index).
@@ -477,6 +483,15 @@ pub fn advance(x: f64, y: f64, heading: f64, k: f64, d: f64) -> (f64, f64, f64) 
             h1,
         )
     }
+}
+
+/// The point `d` metres left of `(x, y)` (right if negative) on a line heading θ, given as
+/// `heading_sin_cos` = (sin θ, cos θ): (x − d·sin θ, y + d·cos θ). The TORCS robot's
+/// `drive::offset_left` is the same arithmetic (`tests/robot_drive.rs`).
+#[inline]
+pub fn offset_left((x, y): (f64, f64), heading_sin_cos: (f64, f64), d: f64) -> (f64, f64) {
+    let (sin_heading, cos_heading) = heading_sin_cos;
+    (x - d * sin_heading, y + d * cos_heading)
 }
 
 #[cfg(test)]
