@@ -31,8 +31,9 @@ fn observed_with(track: &Track, base: &Car, truth: &Scales) -> TrackLaps {
 }
 
 /// Grip 15 % down and the launch 15 % up on the Spirit 300 round Ridgeway: the fit of those
-/// two from the stock car finds both within 2 % (measured: 0.8497 and 1.146), and its cost
-/// falls a hundredfold; the same fit again gives the same scales to the bit.
+/// two from the stock car, on the launch-and-brake and the fast probes, finds both within 2 %
+/// (with all five probes: 0.8497 and 1.146), and its cost falls a hundredfold; the same fit
+/// again gives the same scales to the bit.
 #[test]
 fn the_fit_recovers_known_scales_from_its_own_laps() {
     let track = common::builtin("ridgeway");
@@ -42,7 +43,13 @@ fn the_fit_recovers_known_scales_from_its_own_laps() {
         launch: 1.15,
         ..Scales::ONE
     };
-    let observed = [observed_with(&track, &base, &truth)];
+    // The launch-and-brake and the fast probe only: the slow speed holds show neither
+    // scale much, and this test stays fast.
+    let mut observed = [observed_with(&track, &base, &truth)];
+    observed[0]
+        .laps
+        .retain(|l| !l.probe.name.starts_with("demo"));
+    assert_eq!(observed[0].laps.len(), 2);
     let config = FitConfig {
         free: vec![
             Scales::index("grip").unwrap(),
