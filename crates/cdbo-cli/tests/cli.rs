@@ -914,3 +914,95 @@ fn a_race_warm_starts_from_a_policy_file() {
     );
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// `torcs calibrate --log`: a `cdbo lap --trace` file is a one-lap log; the fit writes a car
+/// file `--car` takes. A bad log (a missing column, NaN, a station off the track) is one line
+/// naming the file, line and column, and nothing is written.
+#[test]
+fn calibrate_from_a_log_writes_a_car_and_refuses_bad_logs() {
+    let dir = scratch("calibrate-placeholder", "")
+        .parent()
+        .unwrap()
+        .to_path_buf();
+    let trace = dir.join("calibrate-trace.csv");
+    let out = dir.join("calibrate-out");
+    let _ = std::fs::remove_dir_all(&out);
+    let (trace_s, out_s) = (trace.to_str().unwrap(), out.to_str().unwrap());
+    succeed(&["lap", "--demo", "20", "--trace", trace_s]);
+    let run = |log: &str| {
+        cdbo(&[
+            "torcs",
+            "calibrate",
+            "--track",
+            "ridgeway",
+            "--car",
+            "spirit-300",
+            "--log",
+            log,
+            "--fit",
+            "rolling",
+            "--evaluations",
+            "12",
+            "--out",
+            out_s,
+        ])
+    };
+    let text = std::fs::read_to_string(&trace).unwrap();
+    // The trace with cell `col` of every row from line `from` on (1-based) set to `v`.
+    let set = |from: usize, col: usize, v: &str| {
+        let lines: Vec<String> = text
+            .lines()
+            .enumerate()
+            .map(|(i, l)| {
+                if i + 1 < from {
+                    return l.to_owned();
+                }
+                let mut cells: Vec<&str> = l.split(',').collect();
+                cells[col] = v;
+                cells.join(",")
+            })
+            .collect();
+        lines.join("\n")
+    };
+    let bad = [
+        (
+            "no-yaw.csv",
+            text.replace(",yaw_rate_rad_s", ",yaw"),
+            ":1: column yaw_rate_rad_s: missing",
+        ),
+        (
+            "nan.csv",
+            set(6, 3, "NaN"),
+            ":6: column speed_mps: \"NaN\" is not a finite number",
+        ),
+        (
+            "far.csv",
+            set(2, 1, "99999"),
+            ":2: column distance_m: 99999 lies outside the track",
+        ),
+    ];
+    for (name, content, needle) in bad {
+        let log = scratch(name, &content);
+        let o = run(log.to_str().unwrap());
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{name}: {err}");
+        assert_eq!(err.lines().count(), 1, "{name}: {err}");
+        assert!(
+            err.contains(log.to_str().unwrap()) && err.contains(needle),
+            "{name}: {err}"
+        );
+        assert!(!out.exists(), "{name}: wrote {}", out.display());
+    }
+    let o = run(trace_s);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let car = out.join("car.toml");
+    let lap = json(&[
+        "lap",
+        "--car",
+        car.to_str().unwrap(),
+        "--demo",
+        "20",
+        "--json",
+    ]);
+    assert_eq!(lap["completed"], true, "{lap}");
+}

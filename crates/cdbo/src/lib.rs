@@ -60,6 +60,7 @@
 pub mod acquisition;
 pub mod benchmarks;
 pub mod bounded;
+pub mod calibrate;
 pub mod car;
 pub mod ceiling;
 pub mod data_path;

@@ -197,8 +197,10 @@ pub fn limit_lap(track: &Track, car: &Car) -> Limit {
         let c = track.sample(i);
         let vi = v[i];
         let push = engine_force(vi).min(traction(vi, c.friction) * ellipse(vi, i));
-        let acc =
-            push / m - car.drag(vi) / m - c.rolling_resistance.unwrap_or(rolling) * G - G * c.grade;
+        let acc = push / m
+            - car.drag(vi) / m
+            - c.rolling_resistance.unwrap_or(rolling) * car.scales.rolling * G
+            - G * c.grade;
         let next = (vi * vi + 2.0 * ds * acc).max(0.0).sqrt();
         v[i + 1] = next.min(cap[i + 1]);
     }
@@ -207,8 +209,10 @@ pub fn limit_lap(track: &Track, car: &Car) -> Limit {
         let c = track.sample(i);
         let vn = v[i + 1];
         let stop = (total_grip(vn, c.friction) * ellipse(vn, i)).min(brake_force);
-        let dec =
-            stop / m + car.drag(vn) / m + c.rolling_resistance.unwrap_or(rolling) * G + G * c.grade;
+        let dec = stop / m
+            + car.drag(vn) / m
+            + c.rolling_resistance.unwrap_or(rolling) * car.scales.rolling * G
+            + G * c.grade;
         let allowed = (vn * vn + 2.0 * ds * dec.max(0.0)).sqrt();
         v[i] = v[i].min(allowed);
     }

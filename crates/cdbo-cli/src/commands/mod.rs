@@ -14,6 +14,7 @@ pub mod report;
 pub mod serve_sim;
 pub mod study;
 pub mod torcs;
+pub mod torcs_calibrate;
 pub mod torcs_compare;
 pub mod track;
 

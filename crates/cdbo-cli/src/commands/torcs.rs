@@ -34,6 +34,11 @@ pub enum TorcsCommand {
     /// cdbo's simulator against the game: demonstrations, full throttle, policies drawn
     /// around a learned one, speed along the lap, the limit against a built-in robot.
     Compare(super::torcs_compare::CompareArgs),
+    /// Fit the simulator's uncertain car parameters (grip, peak slip, drag, downforce,
+    /// rolling resistance, launch) to traced laps of chosen policies in the game, or to a real
+    /// car's logged laps (--log); write the calibrated car (car.toml, for --car) and the
+    /// agreement before and after, on the calibration and the check tracks.
+    Calibrate(super::torcs_calibrate::CalibrateArgs),
     /// Time every shipped TORCS robot that can drive the car: its standing first lap and its
     /// best (flying) lap of two, alone, from a clean start, headless — the table cdbo's
     /// learned laps are judged against — beside cdbo's QSS limit on the centre line.
@@ -72,6 +77,7 @@ fn report(game: &Game) -> SetupReport {
 pub fn run(cmd: &TorcsCommand, data: &cdbo::data_path::DataPath) -> CliResult {
     match cmd {
         TorcsCommand::Compare(args) => super::torcs_compare::run(args, data),
+        TorcsCommand::Calibrate(args) => super::torcs_calibrate::run(args, data),
         TorcsCommand::Robots { track, car, json } => robots(track, car, *json),
         TorcsCommand::Setup { json } => {
             let install = Install::find()?;

@@ -34,6 +34,10 @@ pub struct CompareArgs {
     /// TORCS car.
     #[arg(long, default_value = cdbo::torcs::DEFAULT_CAR)]
     car: String,
+    /// The car of cdbo's simulator side, if not the game's car file: e.g. a calibrated car
+    /// (`cdbo torcs calibrate`'s car.toml); the game drives --car.
+    #[arg(long, value_name = "CAR")]
+    sim_car: Option<String>,
     /// Demonstration speeds (m/s), comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "10,15,20")]
     demo: Vec<f64>,
@@ -178,7 +182,10 @@ fn compare_track(
 ) -> Result<TrackReport, Box<dyn std::error::Error>> {
     let base = game.request(name, &args.car, GamePedal::Demo(15.0))?;
     let track = super::game_track(name, game, data)?;
-    let car = base.car.clone();
+    let car = match &args.sim_car {
+        Some(spec) => cdbo::car::catalog::find(spec, data)?,
+        None => base.car.clone(),
+    };
     let mut sim = Simulator::new(track.clone(), &car);
     let in_game = |pedal: GamePedal, record: bool| -> Result<LapResult, cdbo::Error> {
         let mut req: LapRequest = base.clone();

@@ -3,10 +3,13 @@
 //! Read from TORCS / Speed Dreams car files merged over their category ([`torcs`]); the
 //! built-in default is the paper's car, the Speed Dreams Spirit 300 ([`Car::spirit_300`]).
 
+pub mod calibration;
 pub mod catalog;
 pub mod torcs;
 
 use serde::Serialize;
+
+pub use calibration::Scales;
 
 /// Which axle the engine drives.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -141,6 +144,10 @@ pub struct Car {
     /// Overall width of the body (m), TORCS `Car/overall width` (else `body width`): how
     /// much of the road a racing line leaves between the car's centre and the edge.
     pub width: f64,
+    /// Calibration scales over the car file's values ([`calibration`]): 1 for a stock car.
+    /// Grip and peak slip are already in the tyres; drag, downforce, rolling resistance and
+    /// the launch are applied where those forces are computed.
+    pub scales: Scales,
 }
 
 impl Car {
@@ -215,6 +222,7 @@ impl Car {
             },
             steer_lock: 45f64.to_radians(),
             width: 1.90,
+            scales: Scales::ONE,
         }
     }
 
@@ -269,15 +277,15 @@ impl Car {
         self.brake_pressure * share * b.piston_area * b.pad_mu * b.disc_radius
     }
 
-    /// Aerodynamic drag force at speed v: F = 0.645·Cx·A·v² plus the wings' (N), 0.645 = ρ/2
-    /// with ρ = 1.29.
+    /// Aerodynamic drag force at speed v: F = (0.645·Cx·A·v² plus the wings')·s_drag (N),
+    /// 0.645 = ρ/2 with ρ = 1.29, s_drag the calibration's scale (1 for a stock car).
     pub fn drag(&self, v: f64) -> f64 {
         let wings: f64 = self.wings.iter().map(Wing::drag_per_v2).sum();
-        (AIR_HALF_RHO * self.cx * self.front_area + wings) * v * v
+        (AIR_HALF_RHO * self.cx * self.front_area + wings) * v * v * self.scales.drag
     }
 
     /// Downforce on the front and rear axles at speed v: Fᵢ = 0.645·Clᵢ·A·v² plus the wings',
-    /// each shared between the axles by its position (N).
+    /// each shared between the axles by its position, times the calibration's scale (N).
     pub fn downforce(&self, v: f64) -> [f64; 2] {
         let q = AIR_HALF_RHO * self.front_area * v * v;
         let mut f = [q * self.clift[0], q * self.clift[1]];
@@ -286,7 +294,7 @@ impl Car {
             f[0] += d * w.front_share;
             f[1] += d * (1.0 - w.front_share);
         }
-        f
+        f.map(|f| f * self.scales.downforce)
     }
 }
 

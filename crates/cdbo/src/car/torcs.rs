@@ -271,6 +271,7 @@ pub fn from_params(p: &Params) -> Result<Car> {
             sec("Steer").num_or("steer lock", 0.43)?,
         )?,
         width: positive(car, "overall width", car_width(car)?)?,
+        scales: super::Scales::ONE,
     })
 }
 

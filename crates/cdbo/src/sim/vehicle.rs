@@ -18,7 +18,8 @@
 //!   I_z ṙ = a(F_xf sin δ + F_yf cos δ) − b F_yr, with β the banking.
 //! - Drag F = 0.645·Cx·A·v², downforce Dᵢ = 0.645·Clᵢ·A·v², rolling resistance
 //!   F = c_rr·(F_zf + F_zr)·sgn vₓ, c_rr the road surface's where the track gives one (as
-//!   TORCS's simuv2 does), else the tyres'.
+//!   TORCS's simuv2 does), else the tyres'; a calibrated car ([`crate::car::calibration`])
+//!   scales drag, downforce and c_rr, and the drive torque in first gear (its launch).
 //! - Brakes: T = p·share·A_piston·μ_pad·r_disc per wheel, with ABS easing the pressure while an
 //!   axle's slip exceeds half the tyre's peak slip; traction control eases the throttle
 //!   likewise (the Spirit 300 has both; TORCS robots implement them in the driver).
@@ -131,6 +132,10 @@ pub struct Vehicle {
     inv_yaw_inertia: f64,
     inv_mass: f64,
     rolling: f64,
+    /// The calibration's scale of the rolling resistance (1 for a stock car).
+    rolling_scale: f64,
+    /// The calibration's scale of the drive torque in first gear (1 for a stock car).
+    launch_scale: f64,
     /// m·g·b/L and m·g·a/L: the axles' static loads on level ground (N).
     static_load: [f64; 2],
     /// m·h/L: load moved from front to rear per m/s² of acceleration (kg).
@@ -177,6 +182,8 @@ impl Vehicle {
             inv_yaw_inertia: 1.0 / car.yaw_inertia(),
             inv_mass: 1.0 / car.mass,
             rolling: 0.5 * (car.front_tyre.rolling_resistance + car.rear_tyre.rolling_resistance),
+            rolling_scale: car.scales.rolling,
+            launch_scale: car.scales.launch,
             car: car.clone(),
         }
     }
@@ -278,6 +285,11 @@ impl Vehicle {
             s.gearbox
                 .wheel_torque(car, &self.engine_map, throttle, self.driven_omega(s));
         s.engine_speed = engine_speed;
+        let drive_torque = if s.gearbox.gear == 0 {
+            drive_torque * self.launch_scale
+        } else {
+            drive_torque
+        };
         s.gearbox.shifting = (s.gearbox.shifting - dt).max(0.0);
 
         let mut fx = [0.0; 2];
@@ -322,7 +334,7 @@ impl Vehicle {
         // Body forces and moments.
         // Rolling resistance opposes motion; sgn vₓ is smoothed over ±0.5 m/s for standing starts.
         // The road's coefficient where the track gives one (simuv2), else the tyres'.
-        let c_rr = frame.rolling_resistance.unwrap_or(self.rolling);
+        let c_rr = frame.rolling_resistance.unwrap_or(self.rolling) * self.rolling_scale;
         let roll = c_rr * (fz[0] + fz[1]) * (s.vx / 0.5).clamp(-1.0, 1.0);
         // Drag 0.645·Cx·A·v² along the velocity: its x component is 0.645·Cx·A·v·vₓ.
         let drag = self.drag_per_v2 * v2.sqrt() * s.vx;
