@@ -25,6 +25,10 @@
 //! over the limit per push, and fewer laps fail at each. Where the start lap itself fails, it
 //! is first repaired where it fails until it completes (a push of size 0), then pushed.
 //!
+//! **A lifted budget.** A budget of at least H failed laps cannot bind within the horizon: the
+//! learner is then the pattern search itself, its push, repairs and laps exactly
+//! ([`SafeSearchConfig::within`]).
+//!
 //! Measured on the issue's four panels (6 seeds × 300 laps): README, "A learner within a
 //! budget".
 //!
