@@ -103,3 +103,24 @@ fn the_safe_search_is_deterministic_and_resumes_bit_for_bit() {
         assert_eq!(rest, asked[cut..], "cut at {cut}");
     }
 }
+
+/// A budget of at least the horizon's laps is lifted: the safe search asks exactly the laps
+/// the pattern search asks, failures and all.
+#[test]
+fn a_lifted_budget_is_the_pattern_search() {
+    let lifted = Some(cdbo::learner::safe_search::HORIZON);
+    for seed in 0..3 {
+        let (safe, safe_failed) = drive(
+            on_cliff(Method::SafePatternSearch, seed, lifted).as_mut(),
+            200,
+        );
+        let (plain, plain_failed) =
+            drive(on_cliff(Method::PatternSearch, seed, None).as_mut(), 200);
+        assert_eq!(safe, plain, "seed {seed}");
+        assert_eq!(safe_failed, plain_failed);
+        assert!(
+            plain_failed > 10,
+            "seed {seed}: the cliff fails {plain_failed} laps"
+        );
+    }
+}

@@ -294,14 +294,9 @@ impl Spec {
             )?),
             Method::PatternSearch => Box::new(PatternSearch::new(w0, pattern_search)?),
             Method::SafePatternSearch => {
-                let config = safe_search::SafeSearchConfig::around(pattern_search);
-                Box::new(SafeSearch::new(
-                    w0,
-                    safe_search::SafeSearchConfig {
-                        budget: max_failed_laps.unwrap_or(config.budget),
-                        ..config
-                    },
-                )?)
+                let budget = max_failed_laps.unwrap_or(safe_search::BUDGET);
+                let config = safe_search::SafeSearchConfig::within(pattern_search, budget);
+                Box::new(SafeSearch::new(w0, config)?)
             }
         })
     }

@@ -96,9 +96,14 @@ impl Pedals {
 
     /// The places (first and one past the last) over the window before lap fraction `at`.
     fn stretch(&self, at: f64) -> (usize, usize) {
+        self.stretch_over(at, self.window)
+    }
+
+    /// The places (first and one past the last) over `window` before lap fraction `at`.
+    fn stretch_over(&self, at: f64, window: f64) -> (usize, usize) {
         let last = self.points().saturating_sub(1) as f64;
         let to = (at.clamp(0.0, 1.0) * last).floor() as usize;
-        let from = ((at - self.window).max(0.0) * last).ceil() as usize;
+        let from = ((at - window).max(0.0) * last).ceil() as usize;
         (from.min(to), to + 1)
     }
 }
@@ -179,15 +184,28 @@ impl FailureMemory {
     }
 
     /// Remembers a lap of pedal `failed` that failed as `failure` says, a move from the lap of
-    /// pedal `reference`.
+    /// pedal `reference`: over the window before the failure, or from where the failed lap
+    /// first had more pedal than the reference (over a tenth of its largest excess) if that
+    /// lies further back, at most `reach_back` windows before the failure.
     pub fn failed(
         &mut self,
         pedals: &Pedals,
         failed: &[f64],
         reference: &[f64],
         failure: FailedLap,
+        reach_back: f64,
     ) {
-        let (from, to) = pedals.stretch(failure.at);
+        let (mut from, to) = pedals.stretch(failure.at);
+        if reach_back > 1.0 {
+            let (far, _) = pedals.stretch_over(failure.at, reach_back * pedals.window());
+            let s = if failure.too_slow { -1.0 } else { 1.0 };
+            let most = (far..to)
+                .map(|k| s * (failed[k] - reference[k]))
+                .fold(0.0, f64::max);
+            if let Some(k) = (far..to).find(|&k| s * (failed[k] - reference[k]) > 0.1 * most) {
+                from = from.min(k);
+            }
+        }
         let bracket = Bracket {
             at: failure.at,
             too_slow: failure.too_slow,
@@ -241,7 +259,7 @@ mod tests {
         let best = vec![0.5; 11];
         let mut failed = best.clone();
         (4..=6).for_each(|i| failed[i] += 0.2);
-        memory.failed(&pedals(), &failed, &best, FailedLap::too_fast(0.6));
+        memory.failed(&pedals(), &failed, &best, FailedLap::too_fast(0.6), 1.0);
         assert_eq!(memory.brackets[0].from, 4);
         let moved = |d: f64| {
             let mut w = best.clone();
@@ -267,12 +285,35 @@ mod tests {
             too_slow: true,
         };
         let mut memory = FailureMemory::default();
-        memory.failed(&pedals(), &moved(-0.2), &best, stall);
+        memory.failed(&pedals(), &moved(-0.2), &best, stall, 1.0);
         assert_eq!(memory.predict(&moved(-0.1), 0.5), Some(stall));
         assert_eq!(memory.predict(&moved(-0.05), 0.5), None);
         // The start lap's own failure (no excess over itself) brackets nothing.
-        memory.failed(&pedals(), &best, &best, FailedLap::too_fast(0.3));
+        memory.failed(&pedals(), &best, &best, FailedLap::too_fast(0.3), 1.0);
         assert_eq!(memory.brackets.len(), 1);
+    }
+
+    /// A failed step of more pedal far before where it failed (weights 1–2, failing at 0.6)
+    /// brackets from where it added pedal when it may reach back that far: the same move is
+    /// predicted to fail there, a move after the failure is not; over one window it is not.
+    #[test]
+    fn a_bracket_reaches_back_to_where_the_failed_lap_added_pedal() {
+        let best = vec![0.5; 11];
+        let mut failed = best.clone();
+        (1..=2).for_each(|i| failed[i] += 0.2);
+        let mut memory = FailureMemory::default();
+        memory.failed(&pedals(), &failed, &best, FailedLap::too_fast(0.6), 3.0);
+        assert_eq!(memory.brackets[0].from, 1);
+        assert_eq!(memory.predict(&failed, 0.5), Some(FailedLap::too_fast(0.6)));
+        let mut later = best.clone();
+        later[8] += 0.2;
+        assert_eq!(memory.predict(&later, 0.5), None);
+        let mut near = FailureMemory::default();
+        near.failed(&pedals(), &failed, &best, FailedLap::too_fast(0.6), 1.0);
+        assert!(
+            near.brackets.is_empty(),
+            "no excess over one window: no bracket"
+        );
     }
 
     /// A completed lap with more pedal than the reference narrows the bracket from below; one
@@ -286,7 +327,7 @@ mod tests {
             (4..=6).for_each(|i| w[i] += d);
             w
         };
-        memory.failed(&pedals(), &with(0.2), &best, FailedLap::too_fast(0.6));
+        memory.failed(&pedals(), &with(0.2), &best, FailedLap::too_fast(0.6), 1.0);
         memory.completed(&with(0.1));
         assert_eq!(memory.brackets[0].reference, vec![0.6; 3]);
         // Now half-way between 0.6 and 0.7 is predicted with κ = ½.
