@@ -183,7 +183,11 @@ fn in_the_game_the_fit_brings_the_laps_closer() {
         .unwrap()
         .into_iter()
         .map(|p| {
-            let lap = cdbo::torcs::evaluator::drive(&game, &req, p.game_pedal()).unwrap();
+            let req = cdbo::torcs::LapRequest {
+                pedal: p.game_pedal(),
+                ..req.clone()
+            };
+            let lap = cdbo::torcs::evaluator::drive(&game, &req).unwrap();
             assert!(!lap.trace.is_empty(), "{}: no trace", p.name);
             Observed::of_lap(p, &lap)
         })

@@ -229,7 +229,11 @@ fn in_game(
         probes
             .into_par_iter()
             .map(|p| {
-                let lap = cdbo::torcs::evaluator::drive(game, &req, p.game_pedal())?;
+                let req = cdbo::torcs::LapRequest {
+                    pedal: p.game_pedal(),
+                    ..req.clone()
+                };
+                let lap = cdbo::torcs::evaluator::drive(game, &req)?;
                 Ok(Observed::of_lap(p, &lap))
             })
             .collect::<Result<Vec<_>, cdbo::Error>>()
