@@ -66,6 +66,8 @@ fn study_config() -> StudyConfig {
         knob: None,
         max_failed_laps: None,
         warm_start: None,
+        line_kernels: None,
+        base_line: Default::default(),
     }
 }
 

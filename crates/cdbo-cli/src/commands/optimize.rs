@@ -11,6 +11,7 @@ use super::study::InitialPolicy;
 use super::{CliResult, Simulator};
 use cdbo::evaluator::Evaluator;
 use cdbo::evaluator::command::CommandEvaluator;
+use cdbo::experiment::line::LineSetting;
 use cdbo::study::claim::{DEFAULT_LEASE, Worker};
 use cdbo::study::run::Event;
 use cdbo::study::{Location, Outcome, Study};
@@ -110,6 +111,14 @@ pub fn run(args: &OptimizeArgs, simulator: Simulator) -> CliResult {
     }
     let lengthscale = study.config().lengthscale;
     let mut evaluator: Box<dyn Evaluator> = match (game, &args.evaluator) {
+        (Some(_), _) if study.config().shape()?.line.is_some() || !study.config().base_line.is_centre() => {
+            return Err(format!(
+                "{}: a study on line {}; cdbo's robot in the game steers the centre line (drive the line with cdbo's simulator through --evaluator)",
+                study.path().display(),
+                LineSetting::of(study.config().base_line, study.config().line_kernels).label()
+            )
+            .into());
+        }
         (Some((game, mut request)), _) => {
             request.timeout = Duration::from_secs_f64(args.timeout);
             Box::new(TorcsEvaluator {
@@ -122,7 +131,8 @@ pub fn run(args: &OptimizeArgs, simulator: Simulator) -> CliResult {
             template: template.clone(),
             timeout: Duration::from_secs_f64(args.timeout),
             files: policy_files(&location),
-            lengthscale,
+            shape: study.config().shape()?,
+            base_line: study.config().base_line,
         }),
         (None, None) => {
             return Err("give an --evaluator command or --track (with --simulator torcs)".into());

@@ -194,6 +194,20 @@ fn facing_away(state: &State, frame: &Frame) -> bool {
     cy * frame.cos_heading + sy * frame.sin_heading < 0.0
 }
 
+/// The offset (m, positive left of the centre line) the car holds at centre-line station `s`:
+/// the base line's d₀(s) (0 without one) plus the policy's d, clamped to the road less half the
+/// car's width, |d₀ + d| ≤ max(w(s)/2 − `half_car`, 0). One definition for the lap and for
+/// whatever draws the line a lap holds.
+#[inline]
+pub fn held_offset(track: &Track, half_car: f64, base: Option<&RacingLine>, d: f64, s: f64) -> f64 {
+    let bound = (track.frame(track.index_at(s)).half_width - half_car).max(0.0);
+    let d = match base {
+        Some(base) => base.offset_at(s) + d,
+        None => d,
+    };
+    d.clamp(-bound, bound)
+}
+
 /// A track and a car, ready to run laps.
 #[derive(Debug, Clone)]
 pub struct Simulator {
@@ -272,15 +286,8 @@ impl Simulator {
                     speed: state.speed(),
                     time: t,
                 }));
-                let line = |s: f64| {
-                    let bound = (track.frame(track.index_at(s)).half_width - half_car).max(0.0);
-                    let d = pedal.line(s / track.length);
-                    let d = match &cfg.line {
-                        Some(base) => base.offset_at(s) + d,
-                        None => d,
-                    };
-                    d.clamp(-bound, bound)
-                };
+                let line =
+                    |s: f64| held_offset(track, half_car, cfg.line.as_deref(), pedal.line(s / track.length), s);
                 let steer = steering.update(track, &self.vehicle, &state, &proj, &line, driver_dt);
                 controls = Controls::new(steer, a.max(0.0), (-a).max(0.0));
                 self.vehicle.shift(&mut state, controls.throttle());
