@@ -206,7 +206,16 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         None => venue,
     };
     let drive = |p: &Policy| venue.drive(p);
-    write_plots(&out, &track, &outcome, &drive)?;
+    // The map draws the line the best policy holds, where it is not the centre line.
+    let held = (outcome.line.is_some() || outcome.best.line.is_some()).then(|| {
+        let raced = RacedPolicy {
+            policy: outcome.best.clone(),
+            base_line: config.base_line,
+        };
+        super::plot::policy_line(&track, &car, outcome.line.clone(), &raced)
+    });
+    let held = held.as_ref().map(|(n, p)| (n.as_str(), p.as_slice()));
+    write_plots(&out, &track, &outcome, &drive, held)?;
     let best_lap = outcome
         .laps
         .iter()
@@ -345,6 +354,7 @@ fn write_plots(
     track: &cdbo::track::Track,
     o: &RaceOutcome,
     drive: &dyn Fn(&Policy) -> Result<cdbo::sim::LapResult, cdbo::Error>,
+    line: Option<(&str, &[[f64; 2]])>,
 ) -> CliResult {
     use crate::figures::{LineChart, draw, speed_chart, speed_map};
     use plotters::style::{BLACK, BLUE, GREEN, RED};
@@ -401,7 +411,7 @@ fn write_plots(
         draw(&out.join(format!("learning_curve.{ext}")), &curve)?;
         draw(&out.join(format!("policy.{ext}")), &policies)?;
         draw(&out.join(format!("speed.{ext}")), &speeds)?;
-        speed_map(&out.join(format!("map.{ext}")), track, &best_lap)?;
+        speed_map(&out.join(format!("map.{ext}")), track, &best_lap, line)?;
     }
     Ok(())
 }

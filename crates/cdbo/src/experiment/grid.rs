@@ -13,12 +13,17 @@
 //! kernels = [10, 50, 100]
 //! ```
 //!
+//! `line = "learn"` (with `line_kernels = 20`, `line_start = "min-curvature"`) or `line =
+//! "min-curvature"` races every run on that line, as `cdbo race --line`; a grid without it
+//! races the centre line, the paper's.
+//!
 //! Run r of every cell has seed r, so that the methods meet the same random numbers where
 //! they draw alike. The runs are listed in a fixed order; shard I of N takes every N-th run
 //! from the I-th, so shards partition the grid whatever machine runs them.
 
 use serde::{Deserialize, Serialize};
 
+use super::line::{BaseLine, LineKind, LineSetting};
 use crate::method::{Method, Spec};
 
 use crate::error::{Error, Result};
@@ -60,6 +65,16 @@ pub struct ExperimentConfig {
         skip_serializing_if = "std::collections::BTreeMap::is_empty"
     )]
     pub knob: std::collections::BTreeMap<Method, f64>,
+    /// The line every run's car holds, as `cdbo race --line`: `centre` (the paper; the
+    /// default), `min-curvature` or `learn`.
+    #[serde(default, skip_serializing_if = "LineKind::is_centre")]
+    pub line: LineKind,
+    /// Kernels of a learned line (default: each panel's pedal kernels), as `--line-kernels`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub line_kernels: Option<usize>,
+    /// Where a learned line starts, as `--line-start`: `centre` or `min-curvature`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub line_start: Option<BaseLine>,
 }
 
 fn default_demo_speed() -> f64 {
@@ -74,6 +89,15 @@ fn default_beta() -> f64 {
 pub const PRESETS: &[&str] = &["paper", "paper-plus", "quick"];
 
 impl ExperimentConfig {
+    /// The grid's line.
+    pub fn line(&self) -> LineSetting {
+        LineSetting {
+            line: self.line,
+            kernels: self.line_kernels,
+            start: self.line_start,
+        }
+    }
+
     /// The main knob `method` runs at in this grid: its entry in the `[knob]` table, else its
     /// published setting ([`Knob::published`](crate::method::Knob::published): σ₀ 0.03,
     /// TuRBO's 0.8, LineBO's whole line, REMBO's √d), so that a grid names every tuned value
@@ -115,6 +139,9 @@ impl ExperimentConfig {
                 methods: methods(&[]),
                 tracks: paper_tracks,
                 knob: Default::default(),
+                line: LineKind::Centre,
+                line_kernels: None,
+                line_start: None,
             },
             "paper-plus" => ExperimentConfig {
                 methods: methods(&[
@@ -141,6 +168,9 @@ impl ExperimentConfig {
                     kernels: vec![10, 20],
                 }],
                 knob: Default::default(),
+                line: LineKind::Centre,
+                line_kernels: None,
+                line_start: None,
             },
             _ => return None,
         })
@@ -223,6 +253,7 @@ impl ExperimentConfig {
             }
             Spec::race(m).knob(v)?;
         }
+        self.line().resolve(2)?;
         if !(self.demo_speed.is_finite() && self.demo_speed > 0.0) {
             return Err(Error::invalid_value(
                 "demo_speed",

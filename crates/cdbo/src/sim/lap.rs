@@ -208,6 +208,19 @@ pub fn held_offset(track: &Track, half_car: f64, base: Option<&RacingLine>, d: f
     d.clamp(-bound, bound)
 }
 
+/// A point of the line a lap holds ([`Simulator::held_line`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct HeldPoint {
+    /// Station on the centre line (m).
+    pub s: f64,
+    /// Offset from the centre line (m, positive left), within the road less half the car.
+    pub offset: f64,
+    /// Position (m).
+    pub x: f64,
+    /// Position (m).
+    pub y: f64,
+}
+
 /// A track and a car, ready to run laps.
 #[derive(Debug, Clone)]
 pub struct Simulator {
@@ -227,6 +240,34 @@ impl Simulator {
             vehicle: Vehicle::new(car),
             config: LapConfig::default(),
         }
+    }
+
+    /// The line a policy with line `d(x)` holds, as its laps steer it ([`held_offset`]): at
+    /// every track sample sᵢ, the offset dᵢ (m, positive left) and the point cᵢ + dᵢ·nᵢ, nᵢ
+    /// the centre line's left normal (−sin θᵢ, cos θᵢ).
+    pub fn held_line(&self, d: impl Fn(f64) -> f64) -> Vec<HeldPoint> {
+        let track = &self.track;
+        let half_car = 0.5 * self.vehicle.car.width;
+        track
+            .samples
+            .iter()
+            .map(|p| {
+                let offset = held_offset(
+                    track,
+                    half_car,
+                    self.config.line.as_deref(),
+                    d(p.s / track.length),
+                    p.s,
+                );
+                let (sin, cos) = p.heading.sin_cos();
+                HeldPoint {
+                    s: p.s,
+                    offset,
+                    x: p.x - offset * sin,
+                    y: p.y + offset * cos,
+                }
+            })
+            .collect()
     }
 
     /// The time limit of a lap (s).
