@@ -56,6 +56,19 @@ impl LineArgs {
     }
 }
 
+/// The flags that ask for `setting`: `--line learn --line-kernels 8 --line-start
+/// min-curvature`, `--line centre`.
+pub fn flags(setting: &LineSetting) -> String {
+    let mut flags = format!("--line {}", setting.line.name());
+    if let Some(k) = setting.kernels {
+        flags += &format!(" --line-kernels {k}");
+    }
+    if let Some(start) = setting.start {
+        flags += &format!(" --line-start {}", start.name());
+    }
+    flags
+}
+
 /// The line the car holds (`--line`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 enum Line {

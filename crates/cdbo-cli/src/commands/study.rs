@@ -251,7 +251,12 @@ impl InitialPolicy {
                 .map(|(base, kernels)| LineSetting::of(base, kernels))?;
             let kept = LineSetting::of(stored.base_line, stored.line_kernels);
             if given != kept {
-                return differs("--line", given.label(), kept.label());
+                return Err(format!(
+                    "{}: the study was created with {}, not {}; resume it with those flags (or leave them out), or start a new study elsewhere",
+                    study.display(),
+                    super::line::flags(&kept),
+                    super::line::flags(&given)
+                ));
             }
         }
         Ok(())
@@ -524,10 +529,14 @@ fn status(s: &Study, json: bool) -> CliResult {
         return print_json(&v);
     }
     println!(
-        "{}: {} with {} kernels{}; {told} trials told ({failed} failed){}; best {}",
+        "{}: {} with {} kernels{}{}; {told} trials told ({failed} failed){}; best {}",
         s.path().display(),
         c.method,
         c.kernels,
+        match LineSetting::of(c.base_line, c.line_kernels) {
+            line if line == LineSetting::centre() => String::new(),
+            line => format!(" on line {}", line.label()),
+        },
         c.track_length
             .map_or(String::new(), |l| format!(" on a {l} m lap")),
         pending.map_or(String::new(), |p| format!(", trial {p} pending")),
