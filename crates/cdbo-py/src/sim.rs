@@ -7,11 +7,11 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyType};
 
 use cdbo::car::Car;
+use cdbo::experiment::line::BaseLine;
 use cdbo::limit::{Limit, limit_lap};
 use cdbo::optimizers::FailedLap;
-use cdbo::experiment::line::BaseLine;
-use cdbo::policy::{Policy, RkhsPolicy};
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
+use cdbo::policy::{Policy, RkhsPolicy};
 use cdbo::sim::{LapResult, Simulator};
 use cdbo::track::Track;
 

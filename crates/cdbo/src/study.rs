@@ -29,11 +29,11 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-use crate::experiment::line::{BaseLine, RacedPolicy};
-use crate::policy::{Block, PolicyShape};
 pub use crate::evaluator::Outcome;
+use crate::experiment::line::{BaseLine, RacedPolicy};
 use crate::method::{Method, Spec, resume};
 use crate::optimizers::{Optimizer, Saved};
+use crate::policy::{Block, PolicyShape};
 use claim::{Handout, Worker};
 use storage::{Dump, Storage, Told, Transaction};
 

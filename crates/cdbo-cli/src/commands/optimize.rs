@@ -111,7 +111,9 @@ pub fn run(args: &OptimizeArgs, simulator: Simulator) -> CliResult {
     }
     let lengthscale = study.config().lengthscale;
     let mut evaluator: Box<dyn Evaluator> = match (game, &args.evaluator) {
-        (Some(_), _) if study.config().shape()?.line.is_some() || !study.config().base_line.is_centre() => {
+        (Some(_), _)
+            if study.config().shape()?.line.is_some() || !study.config().base_line.is_centre() =>
+        {
             return Err(format!(
                 "{}: a study on line {}; cdbo's robot in the game steers the centre line (drive the line with cdbo's simulator through --evaluator)",
                 study.path().display(),

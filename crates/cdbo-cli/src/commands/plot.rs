@@ -7,9 +7,9 @@ use clap::{Subcommand, ValueEnum};
 
 use super::{CliResult, load_track, value};
 use crate::figures::{TrackMap, draw, read_trace_speeds};
+use cdbo::car::Car;
 use cdbo::car::catalog as cars;
 use cdbo::data_path::DataPath;
-use cdbo::car::Car;
 use cdbo::experiment::line::RacedPolicy;
 use cdbo::line::{LineOptions, RacingLine, SAFETY_MARGIN};
 use cdbo::sim::Simulator;

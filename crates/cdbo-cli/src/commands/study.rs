@@ -6,8 +6,8 @@ use clap::{Args, Subcommand, ValueEnum};
 
 use super::line::LineArgs;
 use super::policy::{read_demo, read_raced_policy};
-use cdbo::experiment::line::{LineSetting, RacedPolicy};
 use super::{CliResult, from_flag, print_json};
+use cdbo::experiment::line::{LineSetting, RacedPolicy};
 use cdbo::method::Method;
 use cdbo::policy::RkhsPolicy;
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};

@@ -107,7 +107,11 @@ impl std::str::FromStr for LineKind {
             .into_iter()
             .find(|k| k.name() == s)
             .ok_or_else(|| {
-                Error::invalid_value("the line", format!("{s:?}"), "centre, min-curvature or learn")
+                Error::invalid_value(
+                    "the line",
+                    format!("{s:?}"),
+                    "centre, min-curvature or learn",
+                )
             })
     }
 }
@@ -262,7 +266,10 @@ mod tests {
         .resolve(12)
         .unwrap_err()
         .to_string();
-        assert!(e.contains("line start") && e.contains("min-curvature"), "{e}");
+        assert!(
+            e.contains("line start") && e.contains("min-curvature"),
+            "{e}"
+        );
         let e = LineSetting {
             kernels: Some(5),
             ..LineSetting::centre()

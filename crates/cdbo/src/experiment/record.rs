@@ -10,10 +10,10 @@ use serde::{Deserialize, Serialize};
 use super::grid::{ExperimentConfig, RunSpec};
 use super::line::{BaseLine, LineSetting, RacedPolicy};
 use super::race::{LapRecord, RaceConfig, race};
-use crate::policy::{Block, PolicyShape};
 use crate::bounded;
 use crate::car::Car;
 use crate::error::{Error, Result};
+use crate::policy::{Block, PolicyShape};
 use crate::track::Track;
 use crate::venue::Venue;
 

@@ -327,8 +327,15 @@ impl Simulator {
                     speed: state.speed(),
                     time: t,
                 }));
-                let line =
-                    |s: f64| held_offset(track, half_car, cfg.line.as_deref(), pedal.line(s / track.length), s);
+                let line = |s: f64| {
+                    held_offset(
+                        track,
+                        half_car,
+                        cfg.line.as_deref(),
+                        pedal.line(s / track.length),
+                        s,
+                    )
+                };
                 let steer = steering.update(track, &self.vehicle, &state, &proj, &line, driver_dt);
                 controls = Controls::new(steer, a.max(0.0), (-a).max(0.0));
                 self.vehicle.shift(&mut state, controls.throttle());
