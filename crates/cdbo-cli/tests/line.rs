@@ -29,11 +29,11 @@ fn a_study_learning_a_line_resumes_with_the_races_laps() {
     let dir = fresh_dir("study-line");
     let line = ["--line", "learn", "--line-kernels", "6"];
     let method = ["--method", "pattern-search", "--seed", "2"];
-    let laps = 16;
+    let laps = 10;
     let summary = race(
         &dir,
         "r",
-        &[&method[..], &line[..], &["--laps", "16"]].concat(),
+        &[&method[..], &line[..], &["--laps", "10"]].concat(),
     );
     let length = json(&ok(&dir, &["track", "info", "ridgeway", "--json"]))["length_m"].to_string();
     let study = ["--storage", "s.db", "--kernels", "10"];
@@ -49,7 +49,7 @@ fn a_study_learning_a_line_resumes_with_the_races_laps() {
     );
     ok(&dir, &create);
     let evaluator = format!("{CDBO} lap --policy {{policy}} --json");
-    for (total, flags) in [(6, &line[..]), (laps, &[][..])] {
+    for (total, flags) in [(4, &line[..]), (laps, &[][..])] {
         let total = total.to_string();
         let mut optimize = vec!["optimize", "--evaluator", &evaluator, "--laps", &total];
         optimize.extend([&study[..], flags].concat());

@@ -421,6 +421,32 @@ mod tests {
         assert!(e.contains("length"), "{e}");
     }
 
+    /// A grid's line reads and writes as the flags name it; a grid without one is the centre
+    /// line's (every grid written before it), and a start without a learned line is refused.
+    #[test]
+    fn the_line_of_a_grid() {
+        let head = "laps = 3\nrepeats = 1\nmethods = [\"random\"]\ntracks = [{track = \"x\", kernels = [5]}]\n";
+        let old = ExperimentConfig::from_toml(head, "g").unwrap();
+        assert_eq!(old.line(), LineSetting::centre());
+        assert!(!toml::to_string(&old).unwrap().contains("line"));
+        let text =
+            format!("line = \"learn\"\nline_kernels = 4\nline_start = \"min-curvature\"\n{head}");
+        let grid = ExperimentConfig::from_toml(&text, "g").unwrap();
+        assert_eq!(
+            grid.line().resolve(5).unwrap(),
+            (BaseLine::MinCurvature, Some(4))
+        );
+        let saved = toml::to_string(&grid).unwrap();
+        assert_eq!(ExperimentConfig::from_toml(&saved, "g").unwrap(), grid);
+        let e = ExperimentConfig::from_toml(
+            &format!("line_start = \"min-curvature\"\n{head}"),
+            "g.toml",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("g.toml") && e.contains("line start"), "{e}");
+    }
+
     #[test]
     fn shards_partition_the_grid() {
         let runs = ExperimentConfig::preset("paper").unwrap().runs();
