@@ -75,3 +75,45 @@ pub fn drive(track: Track, car: &Car, key: String, raced: &RacedPolicy) -> Resul
         line_y: held.iter().map(|p| p.y).collect(),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cdbo::experiment::line::BaseLine;
+    use cdbo::policy::{Policy, RkhsPolicy};
+
+    /// A learned line is drawn (within the road less half the car's width, as the lap holds
+    /// it) and the lap is driven on it; the paper's pedal-only policy has no line to draw.
+    #[test]
+    fn the_map_draws_the_line_a_policy_holds() {
+        let track = cdbo::track::builtin::load("ridgeway").unwrap().unwrap();
+        let car = Car::spirit_300();
+        let pedal = RkhsPolicy::new(vec![0.3; 6], 0.2).unwrap();
+        let line = RkhsPolicy::new(vec![1.5, -1.5, 0.0, 2.0], 1.0 / 3.0).unwrap();
+        let paper = RacedPolicy {
+            policy: Policy::from(pedal.clone()),
+            base_line: BaseLine::Centre,
+        };
+        let learned = RacedPolicy {
+            policy: Policy {
+                pedal,
+                line: Some(line),
+            },
+            ..paper.clone()
+        };
+        let centre = drive(track.clone(), &car, "a".into(), &paper).unwrap();
+        assert!(centre.line_x.is_empty() && centre.line_y.is_empty());
+        let map = drive(track.clone(), &car, "b".into(), &learned).unwrap();
+        assert_eq!(map.line_x.len(), map.centre_x.len());
+        let room = |i: usize| 0.5 * track.samples[i].width - 0.5 * car.width;
+        let every = track.samples.len().div_ceil(MAP_POINTS).max(1);
+        for (k, (x, y)) in map.line_x.iter().zip(&map.line_y).enumerate() {
+            let d = (x - map.centre_x[k]).hypot(y - map.centre_y[k]);
+            assert!(d <= room(k * every) + 1e-9, "{d} m off the centre line");
+        }
+        let sim = Simulator::new(track, &car);
+        let lap = sim.lap(&mut learned.policy.driver());
+        assert_eq!(map.reward, lap.reward_mps);
+        assert_eq!(map.x.len(), map.speed.len());
+    }
+}
