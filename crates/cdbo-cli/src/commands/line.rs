@@ -43,16 +43,22 @@ impl LineArgs {
     /// start or kernels without `--line learn` refused naming the flag.
     pub fn resolve(&self, pedal_kernels: usize) -> Result<(BaseLine, Option<usize>), String> {
         let setting = self.setting();
-        setting.resolve(pedal_kernels).map_err(|e| {
-            let flag = if self.line_start.is_some() && setting.line != LineKind::Learn {
-                "--line-start"
-            } else if self.line_kernels.is_some() && setting.line != LineKind::Learn {
-                "--line-kernels"
-            } else {
-                "--line"
+        if setting.line != LineKind::Learn {
+            let given = match (setting.start, setting.kernels) {
+                (Some(start), _) => Some(format!("--line-start {}", start.name())),
+                (None, Some(k)) => Some(format!("--line-kernels {k}")),
+                (None, None) => None,
             };
-            format!("{flag}: {e}")
-        })
+            if let Some(given) = given {
+                return Err(format!(
+                    "{given}: only a learned line starts somewhere and has kernels of its own: add --line learn (not --line {})",
+                    setting.line.name()
+                ));
+            }
+        }
+        setting
+            .resolve(pedal_kernels)
+            .map_err(|e| format!("--line-kernels: {e}"))
     }
 }
 

@@ -140,12 +140,9 @@ impl LineSetting {
     pub fn resolve(&self, pedal_kernels: usize) -> Result<(BaseLine, Option<usize>)> {
         let refused = |what: &str, value: String| {
             Err(Error::invalid_value(
-                what,
+                format!("{what} of line {}", self.line.name()),
                 value,
-                format!(
-                    "none with line {}: only a learned line (learn) has one",
-                    self.line.name()
-                ),
+                "none: only a learned line (learn) starts somewhere and has kernels of its own",
             ))
         };
         match (self.line, self.start, self.kernels) {
