@@ -77,6 +77,10 @@ pub fn run(args: &OptimizeArgs, simulator: Simulator) -> CliResult {
         }
         (Simulator::Cdbo, None) => None,
     };
+    // A line in the game is refused before a study is made for it.
+    if game.is_some() && args.initial.line.setting() != LineSetting::centre() {
+        return Err("--line: cdbo's robot in the game steers the centre line (drive a line with cdbo's simulator through --evaluator)".into());
+    }
     let location = Location::parse(&args.storage, args.study.as_deref())?;
     let (mut study, created) = match Study::open_at(&location) {
         Err(cdbo::Error::NoStudy { .. }) => {
