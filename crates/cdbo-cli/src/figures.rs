@@ -1,4 +1,5 @@
-//! The figures cdbo draws (track maps, learning curves, policies, speed along the lap), with
+//! The figures cdbo draws (track maps, learning curves, trade-off scatters, policies, speed
+//! along the lap), with
 //! plotters and a bundled DejaVu Sans font (no system font library needed). The file
 //! extension chooses PNG or SVG.
 
@@ -6,6 +7,7 @@ use std::path::Path;
 use std::sync::Once;
 
 use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 use crate::commands::CliResult;
@@ -76,18 +78,31 @@ impl LineChart {
     }
 }
 
+/// A chart over f64 × f64 on a drawing area.
+type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// A chart of the whole figure over x × y, the title on top and room for the axes' labels.
+fn titled<'a, DB: DrawingBackend>(
+    root: &'a DrawingArea<DB, Shift>,
+    title: &str,
+    x: std::ops::Range<f64>,
+    y: std::ops::Range<f64>,
+) -> Result<Chart<'a, DB>, DrawingAreaErrorKind<DB::ErrorType>> {
+    ChartBuilder::on(root)
+        .caption(title, ("sans-serif", 24))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .build_cartesian_2d(x, y)
+}
+
 impl Figure for LineChart {
     fn render<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> CliResult
     where
         DB::ErrorType: 'static,
     {
         let ((x0, x1), (y0, y1)) = self.ranges();
-        let mut chart = ChartBuilder::on(root)
-            .caption(&self.title, ("sans-serif", 24))
-            .margin(15)
-            .x_label_area_size(45)
-            .y_label_area_size(60)
-            .build_cartesian_2d(x0..x1, y0..y1)?;
+        let mut chart = titled(root, &self.title, x0..x1, y0..y1)?;
         chart
             .configure_mesh()
             .x_desc(&self.x_label)
@@ -181,6 +196,159 @@ impl Figure for Panels {
                 .background_style(WHITE.mix(0.8))
                 .draw()?;
         }
+        Ok(())
+    }
+}
+
+/// One group of a [`Scatter`]: its legend label, its colour, each member's (x, y), and their
+/// mean with its standard errors ((x, y), (x_se, y_se)).
+pub struct Cloud {
+    /// Legend label.
+    pub label: String,
+    /// Colour.
+    pub colour: RGBColor,
+    /// (x, y) of each member (each run).
+    pub points: Vec<(f64, f64)>,
+    /// Mean (x, y).
+    pub mean: (f64, f64),
+    /// Standard errors of the mean (x, y).
+    pub se: (f64, f64),
+}
+
+/// A scatter of groups: each member a faint dot, each group's mean a filled dot with error
+/// bars of ± one standard error on both axes; and vertical reference lines (a failure budget).
+/// The legend goes in the corner of the plot with the fewest dots, so that it hides none it
+/// can avoid.
+pub struct Scatter {
+    /// Title.
+    pub title: String,
+    /// Axis label.
+    pub x_label: String,
+    /// Axis label.
+    pub y_label: String,
+    /// The groups.
+    pub clouds: Vec<Cloud>,
+    /// Vertical lines: (legend label, x).
+    pub marks: Vec<(String, f64)>,
+}
+
+impl Scatter {
+    /// x from 0 (a count) to past the last dot, bar or mark; y around the dots and bars.
+    fn ranges(&self) -> ((f64, f64), (f64, f64)) {
+        let (mut x1, mut y0, mut y1) = (0.0f64, f64::MAX, f64::MIN);
+        for c in &self.clouds {
+            let (m, e) = (c.mean, c.se);
+            for (x, y) in c
+                .points
+                .iter()
+                .copied()
+                .chain([(m.0 + e.0, m.1 + e.1), (m.0, m.1 - e.1)])
+            {
+                (x1, y0, y1) = (x1.max(x), y0.min(y), y1.max(y));
+            }
+        }
+        for (_, x) in &self.marks {
+            x1 = x1.max(*x);
+        }
+        if y0 > y1 {
+            return ((0.0, 1.0), (0.0, 1.0));
+        }
+        let pad = 0.08 * (y1 - y0).max(1e-9);
+        ((0.0, 1.08 * x1.max(1.0)), (y0 - pad, y1 + pad))
+    }
+
+    /// The corner of the plot holding the fewest dots (means and members).
+    fn emptiest_corner(&self, (x0, x1): (f64, f64), (y0, y1): (f64, f64)) -> SeriesLabelPosition {
+        let (xm, ym) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+        let dots: Vec<(f64, f64)> = self
+            .clouds
+            .iter()
+            .flat_map(|c| c.points.iter().copied().chain([c.mean]))
+            .collect();
+        let count = |right: bool, top: bool| {
+            dots.iter()
+                .filter(|(x, y)| (*x >= xm) == right && (*y >= ym) == top)
+                .count()
+        };
+        [
+            (SeriesLabelPosition::UpperRight, count(true, true)),
+            (SeriesLabelPosition::LowerRight, count(true, false)),
+            (SeriesLabelPosition::UpperLeft, count(false, true)),
+            (SeriesLabelPosition::LowerLeft, count(false, false)),
+        ]
+        .into_iter()
+        .min_by_key(|c| c.1)
+        .map_or(SeriesLabelPosition::UpperRight, |c| c.0)
+    }
+}
+
+impl Figure for Scatter {
+    fn size(&self) -> (u32, u32) {
+        (900, 640)
+    }
+
+    fn render<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> CliResult
+    where
+        DB::ErrorType: 'static,
+    {
+        let ((x0, x1), (y0, y1)) = self.ranges();
+        let mut chart = titled(root, &self.title, x0..x1, y0..y1)?;
+        chart
+            .configure_mesh()
+            .x_desc(&self.x_label)
+            .y_desc(&self.y_label)
+            .x_label_formatter(&|x| format!("{x:.0}"))
+            .draw()?;
+        let grey = RGBColor(90, 90, 90);
+        for (label, x) in &self.marks {
+            chart
+                .draw_series(DashedLineSeries::new(
+                    [(*x, y0), (*x, y1)],
+                    8,
+                    5,
+                    grey.stroke_width(1),
+                ))?
+                .label(label)
+                .legend(move |(x, y)| {
+                    PathElement::new([(x, y), (x + 20, y)], grey.stroke_width(1))
+                });
+        }
+        for cloud in &self.clouds {
+            let c = cloud.colour;
+            chart.draw_series(
+                cloud
+                    .points
+                    .iter()
+                    .map(|&p| Circle::new(p, 4, c.mix(0.35).filled())),
+            )?;
+            let ((mx, my), (ex, ey)) = (cloud.mean, cloud.se);
+            chart.draw_series(std::iter::once(ErrorBar::new_horizontal(
+                my,
+                mx - ex,
+                mx,
+                mx + ex,
+                c.stroke_width(2),
+                10,
+            )))?;
+            chart.draw_series(std::iter::once(ErrorBar::new_vertical(
+                mx,
+                my - ey,
+                my,
+                my + ey,
+                c.stroke_width(2),
+                10,
+            )))?;
+            chart
+                .draw_series(std::iter::once(Circle::new((mx, my), 7, c.filled())))?
+                .label(&cloud.label)
+                .legend(move |(x, y)| Circle::new((x + 10, y), 6, c.filled()));
+        }
+        chart
+            .configure_series_labels()
+            .position(self.emptiest_corner((x0, x1), (y0, y1)))
+            .border_style(BLACK)
+            .background_style(WHITE.mix(0.85))
+            .draw()?;
         Ok(())
     }
 }

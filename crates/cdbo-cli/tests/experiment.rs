@@ -119,9 +119,31 @@ fn results_do_not_depend_on_jobs_and_shards_merge() {
         "curves_ridgeway.svg",
         "table1.md",
         "fig3a_policy_ridgeway.svg",
+        "tradeoff_ridgeway_6.png",
+        "tradeoff_ridgeway_6.svg",
     ] {
         assert!(dir.join("merged").join(f).is_file(), "{f}");
     }
+    // The budget line's best with no cap is the table's fastest method, by brute force over
+    // the table's rows: | ridgeway | 6 | METHOD | runs | MEAN ± SE | ….
+    let (method, best) = results
+        .lines()
+        .filter_map(|l| l.strip_prefix("| ridgeway | 6 | "))
+        .map(|l| {
+            let cols: Vec<&str> = l.split(" | ").collect();
+            (cols[0], cols[2].split(" ± ").next().unwrap())
+        })
+        .max_by(|a, b| a.1.parse::<f64>().unwrap().total_cmp(&b.1.parse().unwrap()))
+        .unwrap();
+    let line = results
+        .lines()
+        .find(|l| l.starts_with("- ridgeway 6: at most 10 % ("))
+        .expect("the panel's budget line");
+    assert!(
+        line.contains(&format!("no cap: {method} {best} ± ")),
+        "{line}"
+    );
+    assert!(results.contains("(tradeoff_ridgeway_6.png)"), "{results}");
 }
 
 /// Every run records the ceiling (the tracked limit profile's lap, as `cdbo ceiling`
@@ -360,4 +382,51 @@ fn a_grid_learning_a_line_races_as_race_does() {
     .unwrap();
     let err = String::from_utf8_lossy(&cdbo(&dir, &["experiment", "bad.toml"]).stderr).into_owned();
     assert!(err.contains("bad.toml") && err.contains("apex"), "{err}");
+}
+
+/// A grid's `steering = "tracker"` drives its runs and their ceiling as `cdbo race --steering
+/// tracker` does: the same best, ceiling and failed laps, and not those of the PI steering.
+#[test]
+fn a_grid_steers_with_the_tracker_as_race_does() {
+    let dir = fresh_dir("steering");
+    let grid = "laps = 8\nrepeats = 1\nmethods = [\"random\"]\nsteering = \"tracker\"\n\
+                [[tracks]]\ntrack = \"ridgeway\"\nkernels = [6]\n";
+    std::fs::write(dir.join("grid.toml"), grid).unwrap();
+    ok(&dir, &["experiment", "grid.toml", "--out", "g"]);
+    let run: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.join("g/runs/ridgeway-m6-random-r0.json")).unwrap(),
+    )
+    .unwrap();
+    let race = |steering: &str| -> serde_json::Value {
+        let args = [
+            "race",
+            "--kernels",
+            "6",
+            "--laps",
+            "8",
+            "--method",
+            "random",
+            "--knob",
+            "0.03",
+            "--seed",
+            "0",
+            "--steering",
+            steering,
+            "--json",
+            "--out",
+            steering,
+        ];
+        serde_json::from_str(&ok(&dir, &args)).unwrap()
+    };
+    let failed = run["laps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|l| !l["failure"].is_null())
+        .count();
+    let tracker = race("tracker");
+    assert_eq!(run["best_reward_mps"], tracker["best_reward_mps"]);
+    assert_eq!(run["ceiling_reward_mps"], tracker["ceiling_reward_mps"]);
+    assert_eq!(failed as u64, tracker["failed_laps"].as_u64().unwrap());
+    assert_ne!(run["ceiling_reward_mps"], race("pi")["ceiling_reward_mps"]);
 }

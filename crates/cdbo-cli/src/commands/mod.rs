@@ -23,8 +23,7 @@ use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 
 use cdbo::car::{Car, catalog as cars};
 use cdbo::data_path::DataPath;
-use cdbo::drive::steering::Steering;
-use cdbo::drive::tracker::PathTracker;
+use cdbo::drive::steering::{Steering, SteeringLaw};
 use cdbo::method::Method;
 use cdbo::track::{Ends, Track, builtin, catalog as tracks};
 use cdbo::venue::Venue;
@@ -75,9 +74,10 @@ impl SteeringChoice {
     /// The steering controller, with its documented gains.
     pub fn steering(self) -> Steering {
         match self {
-            SteeringChoice::Pi => Steering::default(),
-            SteeringChoice::Tracker => Steering::Tracker(PathTracker::new()),
+            SteeringChoice::Pi => SteeringLaw::Pi,
+            SteeringChoice::Tracker => SteeringLaw::Tracker,
         }
+        .steering()
     }
 }
 

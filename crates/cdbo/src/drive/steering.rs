@@ -62,6 +62,33 @@ impl Steering {
     }
 }
 
+/// A steering law by name, with its documented gains: what a grid's `steering = "tracker"`
+/// names (`cdbo race --steering` likewise).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SteeringLaw {
+    /// The paper's PI steering with look-ahead ([`PiSteering`], the default).
+    #[default]
+    Pi,
+    /// The path tracker ([`PathTracker`]).
+    Tracker,
+}
+
+impl SteeringLaw {
+    /// The controller, fresh.
+    pub fn steering(self) -> Steering {
+        match self {
+            SteeringLaw::Pi => Steering::default(),
+            SteeringLaw::Tracker => Steering::Tracker(PathTracker::new()),
+        }
+    }
+
+    /// Whether this is the default, the paper's PI steering.
+    pub fn is_pi(&self) -> bool {
+        *self == SteeringLaw::Pi
+    }
+}
+
 /// The PI steering controller: its gains and its memory.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PiSteering {

@@ -16,6 +16,7 @@
 //! `line = "learn"` (with `line_kernels = 20`, `line_start = "min-curvature"`) or `line =
 //! "min-curvature"` races every run on that line, as `cdbo race --line`; a grid without it
 //! races the centre line, the paper's.
+//! `steering = "tracker"` drives every run with the path tracker (default `"pi"`).
 //!
 //! Run r of every cell has seed r, so that the methods meet the same random numbers where
 //! they draw alike. The runs are listed in a fixed order; shard I of N takes every N-th run
@@ -24,6 +25,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::line::{BaseLine, LineKind, LineSetting};
+use crate::drive::steering::SteeringLaw;
 use crate::method::{Method, Spec};
 
 use crate::error::{Error, Result};
@@ -75,6 +77,10 @@ pub struct ExperimentConfig {
     /// Where a learned line starts, as `--line-start`: `centre` or `min-curvature`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub line_start: Option<BaseLine>,
+    /// How every run's car steers, the ceiling's lap included: `"pi"` (the paper's, the
+    /// default) or `"tracker"` (the path tracker, as `cdbo race --steering tracker`).
+    #[serde(default, skip_serializing_if = "SteeringLaw::is_pi")]
+    pub steering: SteeringLaw,
 }
 
 fn default_demo_speed() -> f64 {
@@ -142,6 +148,7 @@ impl ExperimentConfig {
                 line: LineKind::Centre,
                 line_kernels: None,
                 line_start: None,
+                steering: Default::default(),
             },
             "paper-plus" => ExperimentConfig {
                 methods: methods(&[
@@ -171,6 +178,7 @@ impl ExperimentConfig {
                 line: LineKind::Centre,
                 line_kernels: None,
                 line_start: None,
+                steering: Default::default(),
             },
             _ => return None,
         })

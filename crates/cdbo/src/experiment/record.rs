@@ -210,7 +210,8 @@ pub fn run_at(
     let venue = match grounds {
         Grounds::Simulator => Venue::simulator(track.clone(), car),
         Grounds::Torcs { game, car } => Venue::game(game, &spec.track, car)?,
-    };
+    }
+    .steered(grid.steering.steering());
     let outcome = race(&venue, &track, car, &config, progress)?;
     let ceiling_reward_mps = match venue {
         Venue::Simulator(sim) => Some(crate::ceiling::tracked_profile(&sim, &outcome.limit)?.1),
