@@ -391,14 +391,19 @@ pub fn speed_chart(
 }
 
 /// The track map coloured by a lap's speed.
-pub fn speed_map(path: &Path, track: &Track, lap: &LapResult) -> CliResult {
+pub fn speed_map(
+    path: &Path,
+    track: &Track,
+    lap: &LapResult,
+    line: Option<(&str, &[[f64; 2]])>,
+) -> CliResult {
     let speeds: Vec<(f64, f64)> = lap.trace.iter().map(|p| (p.distance_m, p.speed)).collect();
     draw(
         path,
         &TrackMap {
             track,
             speeds: Some(&speeds),
-            line: None,
+            line,
         },
     )
 }

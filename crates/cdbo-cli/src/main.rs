@@ -100,7 +100,7 @@ fn main() -> ExitCode {
         Command::Experiment(args) => commands::experiment::run_grid(&args, &data, cli.simulator),
         Command::Report(args) => commands::report::run(&args, &data),
         Command::Study(cmd) => commands::study::run(&cmd),
-        Command::Optimize(args) => commands::optimize::run(&args, cli.simulator),
+        Command::Optimize(args) => commands::optimize::run(&args, cli.simulator, &data),
         Command::ServeSim(args) => commands::serve_sim::run(&args, &data, cli.simulator),
         Command::Lap(args) => commands::lap::run(&args, &data, cli.simulator),
         Command::Limit(args) => commands::limit::run(&args, &data),

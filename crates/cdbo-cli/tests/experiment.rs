@@ -336,6 +336,54 @@ fn workers_fill_a_grid_in_an_sqlite_file() {
     assert!(!dir.join("none.db").exists());
 }
 
+/// A grid's `line` races every run as `cdbo race --line` does (the same best, bit for bit);
+/// the run record keeps the line's kernels and the joint weights, and the report names the
+/// line; a bad line is refused naming the file.
+#[test]
+fn a_grid_learning_a_line_races_as_race_does() {
+    let dir = fresh_dir("grid-line");
+    let grid = "laps = 6\nrepeats = 1\nmethods = [\"random\"]\nline = \"learn\"\nline_kernels = 4\n\n[[tracks]]\ntrack = \"ridgeway\"\nkernels = [6]\n";
+    std::fs::write(dir.join("grid.toml"), grid).unwrap();
+    ok(&dir, &["experiment", "grid.toml", "--out", "g"]);
+    let text = std::fs::read_to_string(dir.join("g/runs/ridgeway-m6-random-r0.json")).unwrap();
+    let record: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(record["line_kernels"], 4);
+    assert_eq!(record["best_weights"].as_array().unwrap().len(), 10);
+    let raced = ok(
+        &dir,
+        &[
+            "race",
+            "--json",
+            "--method",
+            "random",
+            "--kernels",
+            "6",
+            "--laps",
+            "6",
+            "--knob",
+            "0.03",
+            "--line",
+            "learn",
+            "--line-kernels",
+            "4",
+            "--out",
+            "r",
+        ],
+    );
+    let raced: serde_json::Value = serde_json::from_str(&raced).unwrap();
+    assert_eq!(record["best_reward_mps"], raced["best_reward_mps"]);
+    ok(&dir, &["report", "g", "--out", "rep"]);
+    let results = std::fs::read_to_string(dir.join("rep/results.md")).unwrap();
+    assert!(results.contains("learn-m4 (1 runs)"), "{results}");
+    std::fs::write(
+        dir.join("bad.toml"),
+        grid.replace("line_kernels = 4", "line_start = \"apex\""),
+    )
+    .unwrap();
+    let err = String::from_utf8_lossy(&cdbo(&dir, &["experiment", "bad.toml"]).stderr).into_owned();
+    assert!(err.contains("bad.toml") && err.contains("apex"), "{err}");
+}
+
 /// A grid's `steering = "tracker"` drives its runs and their ceiling as `cdbo race --steering
 /// tracker` does: the same best, ceiling and failed laps, and not those of the PI steering.
 #[test]

@@ -146,7 +146,7 @@ impl Dashboard {
     }
 
     fn map(&self, source: &Source, key: &str) -> std::result::Result<map::MapView, ApiError> {
-        let (track, weights, lengthscale) = match source.kind {
+        let (track, policy) = match source.kind {
             Kind::Study => {
                 let (config, trials) = self.store.study(source)?;
                 let track = config
@@ -165,7 +165,8 @@ impl Dashboard {
                     .ok_or_else(|| {
                         ApiError::Missing(format!("{}: no trial {key}", source.location))
                     })?;
-                (track, trial.weights, config.lengthscale)
+                let policy = config.policy(&trial.weights)?;
+                (track, policy)
             }
             Kind::Experiment => {
                 let run = self
@@ -176,18 +177,13 @@ impl Dashboard {
                     .ok_or_else(|| {
                         ApiError::Missing(format!("{}: no run {key}", source.location))
                     })?;
-                (run.spec.track, run.best_weights, run.lengthscale)
+                let policy = run.best_policy()?;
+                (run.spec.track, policy)
             }
         };
         let track = cdbo::track::catalog::find(&track, &self.data)?;
         let car = cdbo::car::catalog::find(&self.car, &self.data)?;
-        Ok(map::drive(
-            track,
-            &car,
-            key.to_owned(),
-            &weights,
-            lengthscale,
-        )?)
+        Ok(map::drive(track, &car, key.to_owned(), &policy)?)
     }
 }
 

@@ -144,11 +144,13 @@ pub fn study(config: &StudyConfig, trials: &[Trial]) -> Result<View> {
     for (what, trial) in [("best", best), ("latest", told.last())] {
         if let Some(t) = trial {
             let label = format!("{what}: trial {}, {:.2} m/s", t.id, t.reward.unwrap_or(0.0));
+            // The pedal's block: with a learned line, the weights are [w_a, w_d].
+            let pedal = config.policy(&t.weights)?.policy.pedal;
             policies.push(policy_view(
                 label,
                 t.id.to_string(),
-                &t.weights,
-                config.lengthscale,
+                &pedal.weights,
+                pedal.lengthscale,
             )?);
         }
     }
@@ -199,11 +201,12 @@ pub fn experiment(records: &[RunRecord], chosen: Option<&str>) -> Result<View> {
     for (what, run) in [("best run", best), ("chosen run", shown)] {
         if let Some(r) = run {
             let label = format!("{what}: {}, {:.2} m/s", r.spec.id(), r.best_reward_mps);
+            let pedal = r.best_policy()?.policy.pedal;
             policies.push(policy_view(
                 label,
                 r.spec.id(),
-                &r.best_weights,
-                r.lengthscale,
+                &pedal.weights,
+                pedal.lengthscale,
             )?);
         }
     }

@@ -66,6 +66,8 @@ fn study_config() -> StudyConfig {
         knob: None,
         max_failed_laps: None,
         warm_start: None,
+        line_kernels: None,
+        base_line: Default::default(),
     }
 }
 
@@ -112,6 +114,8 @@ fn run_record(method: &str, repeat: usize, rewards: &[f64]) -> RunRecord {
         best_reward_mps: best,
         best_weights: vec![0.1 * (repeat as f64 + 1.0); KERNELS],
         lengthscale: LENGTHSCALE,
+        line_kernels: None,
+        base_line: Default::default(),
         laps,
         wall_s: 1.0,
     }

@@ -38,5 +38,6 @@ fn _cdbo(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<race::PyRaceResult>()?;
     m.add_function(wrap_pyfunction!(sim::limit, m)?)?;
     m.add_function(wrap_pyfunction!(race::race, m)?)?;
+    m.add_function(wrap_pyfunction!(race::resolve_line, m)?)?;
     Ok(())
 }

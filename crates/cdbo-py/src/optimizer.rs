@@ -26,7 +26,9 @@ use crate::sim::PyLapResult;
 /// kernels' length-scale (`RaceEnv.lengthscale`; pattern search then pushes the policy's
 /// pedal) and `track_length` the lap's length in metres (`RaceEnv.track_length`; the push then
 /// repairs over road); `max_failed` caps the failed laps (once they have failed, only the best
-/// completed weights are asked again). With the defaults, the policy's length-scale and the lap's length, it
+/// completed weights are asked again); `pedal_kernels`, when w0 are [w_a, w_d] of a policy
+/// with a learned line (`RaceEnv(line="learn")`), is how many of them are the pedal's (the
+/// pattern search pushes and repairs those). With the defaults, the policy's length-scale and the lap's length, it
 /// is `cdbo race`'s optimiser (each knob at its tuned value), so the same seed asks the same
 /// weights.
 #[pyclass(name = "Optimizer", module = "cdbo")]
@@ -48,7 +50,7 @@ impl PyOptimizer {
 #[pymethods]
 impl PyOptimizer {
     #[new]
-    #[pyo3(signature = (method, w0, *, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, bounds = DEFAULT_BOX_RADIUS, sigma0 = None, knob = None, lengthscale = None, track_length = None, max_failed = None))]
+    #[pyo3(signature = (method, w0, *, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, bounds = DEFAULT_BOX_RADIUS, sigma0 = None, knob = None, lengthscale = None, track_length = None, max_failed = None, pedal_kernels = None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -62,6 +64,7 @@ impl PyOptimizer {
         lengthscale: Option<f64>,
         track_length: Option<f64>,
         max_failed: Option<usize>,
+        pedal_kernels: Option<usize>,
     ) -> PyResult<Self> {
         let w0 = vector(w0, "w0")?;
         let method: Method = method.parse().py()?;
@@ -81,6 +84,9 @@ impl PyOptimizer {
             }
             if let Some(max) = max_failed {
                 spec = spec.max_failed_laps(max);
+            }
+            if let Some(kernels) = pedal_kernels {
+                spec = spec.pedal_kernels(kernels);
             }
             track_length.map_or(Ok(spec), |length| spec.track_length(length))
         };

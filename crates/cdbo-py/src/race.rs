@@ -3,10 +3,41 @@
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
+use cdbo::experiment::line::{BaseLine, LineKind, LineSetting};
 use cdbo::experiment::race::{LapRecord, RaceConfig, RaceOutcome};
 
 use crate::convert::IntoPy;
 use crate::sim::{PyLapResult, PyLimit, PyPolicy, car_from, track_from};
+
+/// The line a race asks for, from its Python arguments: `line` is `centre`, `min-curvature`
+/// or `learn`, `line_start` `centre` or `min-curvature`.
+pub fn line_setting(
+    line: &str,
+    kernels: Option<usize>,
+    start: Option<&str>,
+) -> PyResult<LineSetting> {
+    Ok(LineSetting {
+        line: line.parse::<LineKind>().py()?,
+        kernels,
+        start: start.map(str::parse::<BaseLine>).transpose().py()?,
+    })
+}
+
+/// `(base_line, line_kernels)`: the line `cdbo.race(line=…)` races for `kernels` pedal kernels
+/// (`RaceEnv` holds the same): the base line's name, and a learned line's kernels or None.
+#[pyfunction]
+#[pyo3(signature = (kernels, line = "centre", line_kernels = None, line_start = None))]
+pub fn resolve_line(
+    kernels: usize,
+    line: &str,
+    line_kernels: Option<usize>,
+    line_start: Option<&str>,
+) -> PyResult<(&'static str, Option<usize>)> {
+    let (base, m) = line_setting(line, line_kernels, line_start)?
+        .resolve(kernels)
+        .py()?;
+    Ok((base.name(), m))
+}
 
 /// A lap record as a dict: lap, reward, best, lap_time, failure, x_fail, optimizer_s,
 /// simulator_s.
@@ -28,6 +59,7 @@ fn record<'py>(py: Python<'py>, r: &LapRecord) -> PyResult<Bound<'py, PyDict>> {
 #[pyclass(name = "RaceResult", module = "cdbo", frozen)]
 pub struct PyRaceResult {
     outcome: RaceOutcome,
+    base_line: BaseLine,
     demo: Py<PyLapResult>,
     limit: Py<PyLimit>,
 }
@@ -44,6 +76,30 @@ impl PyRaceResult {
         PyPolicy {
             policy: self.outcome.best.pedal.clone(),
         }
+    }
+
+    /// The best policy's learned line d(x) (a `Policy` whose raw sum wᵀφ(x) is the offset in
+    /// metres from `base_line`, before the road's bounds), or None without one.
+    #[getter]
+    fn best_line(&self) -> Option<PyPolicy> {
+        self.outcome
+            .best
+            .line
+            .clone()
+            .map(|policy| PyPolicy { policy })
+    }
+
+    /// The best policy's weights as the optimisers see them: [w_a, w_d] with a learned line
+    /// (`RaceEnv.step`'s action), the pedal's alone without.
+    #[getter]
+    fn best_weights<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray1<f64>> {
+        crate::convert::array(py, self.outcome.best.weights())
+    }
+
+    /// The line the laps held where the policy has none: `centre` or `min-curvature`.
+    #[getter]
+    fn base_line(&self) -> &'static str {
+        self.base_line.name()
     }
 
     #[getter]
@@ -83,12 +139,14 @@ impl PyRaceResult {
 }
 
 /// Learns a policy for a track exactly as `cdbo race` does (the same laps, bit for bit, for
-/// the same settings): drive the demonstration, fit w0, then `laps` laps of `method`.
+/// the same settings): drive the demonstration, fit w0, then `laps` laps of `method`, on the
+/// line `line` (`centre`, `min-curvature` or `learn`, with `line_kernels` and `line_start` as
+/// `cdbo race --line-kernels` and `--line-start`).
 /// `track` and `car` are objects or names; `knob` is the method's main knob (`cdbo race
 /// --knob`; None: its tuned value); `progress(record)` is called after every lap with the
 /// lap's record (a dict).
 #[pyfunction]
-#[pyo3(signature = (track = None, car = None, *, method = "cdbo", kernels = 30, laps = 300, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, demo_speed = 15.0, knob = None, max_failed = None, data_dir = None, progress = None))]
+#[pyo3(signature = (track = None, car = None, *, method = "cdbo", kernels = 30, laps = 300, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, demo_speed = 15.0, knob = None, max_failed = None, data_dir = None, progress = None, line = "centre", line_kernels = None, line_start = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn race(
     py: Python<'_>,
@@ -104,9 +162,15 @@ pub fn race(
     max_failed: Option<usize>,
     data_dir: Option<&Bound<'_, PyAny>>,
     progress: Option<Py<PyAny>>,
+    line: &str,
+    line_kernels: Option<usize>,
+    line_start: Option<&str>,
 ) -> PyResult<PyRaceResult> {
     let track = track_from(py, track, data_dir)?;
     let car = car_from(car, data_dir)?;
+    let (base_line, line_kernels) = line_setting(line, line_kernels, line_start)?
+        .resolve(kernels)
+        .py()?;
     let config = RaceConfig {
         method: method.parse::<cdbo::method::Method>().py()?,
         kernels,
@@ -116,9 +180,9 @@ pub fn race(
         demo_speed,
         knob,
         max_failed_laps: max_failed,
-        line_kernels: None,
+        line_kernels,
         warm_start: None,
-        base_line: Default::default(),
+        base_line,
     };
     let mut callback_error: Option<PyErr> = None;
     let outcome = py
@@ -147,6 +211,7 @@ pub fn race(
     )?;
     Ok(PyRaceResult {
         outcome,
+        base_line,
         demo,
         limit,
     })

@@ -7,10 +7,11 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyType};
 
 use cdbo::car::Car;
+use cdbo::experiment::line::BaseLine;
 use cdbo::limit::{Limit, limit_lap};
 use cdbo::optimizers::FailedLap;
-use cdbo::policy::RkhsPolicy;
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
+use cdbo::policy::{Policy, RkhsPolicy};
 use cdbo::sim::{LapResult, Simulator};
 use cdbo::track::Track;
 
@@ -379,48 +380,67 @@ impl PyLapResult {
     }
 }
 
-/// A track and a car, ready to run laps: `Simulator(track, car)`.
+/// A track and a car, ready to run laps: `Simulator(track, car)`; `line="min-curvature"` holds
+/// the minimum-curvature racing line (as `cdbo race --line min-curvature`), the demonstration's
+/// included.
 #[pyclass(name = "Simulator", module = "cdbo", frozen)]
 pub struct PySimulator {
     pub sim: Simulator,
+    /// The base line the simulator's laps hold (`line=`).
+    pub base: BaseLine,
 }
 
 #[pymethods]
 impl PySimulator {
     #[new]
-    #[pyo3(signature = (track = None, car = None, *, data_dir = None))]
+    #[pyo3(signature = (track = None, car = None, *, data_dir = None, line = "centre"))]
     fn new(
         py: Python<'_>,
         track: Option<&Bound<'_, PyAny>>,
         car: Option<&Bound<'_, PyAny>>,
         data_dir: Option<&Bound<'_, PyAny>>,
+        line: &str,
     ) -> PyResult<Self> {
         let track = track_from(py, track, data_dir)?;
         let car = car_from(car, data_dir)?;
-        Ok(PySimulator {
-            sim: Simulator::new(track, &car),
-        })
+        let base: BaseLine = line.parse().py()?;
+        let held = py.detach(|| base.line(&track, &car)).py()?;
+        let mut sim = Simulator::new(track, &car);
+        sim.config.line = held;
+        Ok(PySimulator { sim, base })
     }
 
-    /// One lap with `policy`; `trace=True` records every driver step.
-    #[pyo3(signature = (policy, *, trace = false))]
+    /// One lap with `policy`; `line`, a second `Policy`, is a learned line d(x): its raw sum
+    /// wᵀφ(x) (m, positive left) is the offset from the simulator's base line, clamped to the
+    /// road less half the car's width; `trace=True` records every driver step.
+    #[pyo3(signature = (policy, *, line = None, trace = false))]
     fn lap(
         &self,
         py: Python<'_>,
         policy: PyRef<'_, PyPolicy>,
+        line: Option<PyRef<'_, PyPolicy>>,
         trace: bool,
     ) -> PyResult<PyLapResult> {
-        let policy = policy.policy.clone();
+        let policy = Policy {
+            pedal: policy.policy.clone(),
+            line: line.map(|l| l.policy.clone()),
+        };
         let lap = py.detach(|| {
             if trace {
                 let mut sim = self.sim.clone();
                 sim.config.trace = true;
-                sim.lap(&mut policy.pedal())
+                sim.lap(&mut policy.driver())
             } else {
-                self.sim.lap(&mut policy.pedal())
+                self.sim.lap(&mut policy.driver())
             }
         });
         PyLapResult::new(py, lap, trace)
+    }
+
+    /// The line the laps hold where a policy has none: `centre` or `min-curvature`.
+    #[getter]
+    fn line(&self) -> &'static str {
+        self.base.name()
     }
 
     /// The demonstrator's lap at `speed` (m/s) and its (x, a) pairs as two arrays: what

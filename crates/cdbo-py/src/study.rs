@@ -104,6 +104,8 @@ impl PyStudy {
             knob,
             max_failed_laps: None,
             warm_start: None,
+            line_kernels: None,
+            base_line: Default::default(),
         };
         let study = py.detach(|| Study::create(&path, config)).py()?;
         Ok(PyStudy {

@@ -125,6 +125,14 @@ pub struct Info {
     pub length_m: f64,
     /// The quasi-steady-state limit's reward (m/s), the best any policy can do.
     pub limit_reward_mps: f64,
+    /// With a learned line: its kernels M_d, the last M_d weights (after the pedal's), and
+    /// their length-scale; absent: the weights are the pedal's.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub line: Option<crate::policy::Block>,
+    /// The line the car holds, from which a learned line's offsets are measured; absent: the
+    /// centre line.
+    #[serde(skip_serializing_if = "crate::experiment::line::BaseLine::is_centre")]
+    pub base_line: crate::experiment::line::BaseLine,
 }
 
 /// Where and why a lap failed, as replied.
@@ -343,6 +351,8 @@ mod tests {
                 track: "test".into(),
                 length_m: 1000.0,
                 limit_reward_mps: 40.0,
+                line: None,
+                base_line: Default::default(),
             },
             evaluator: Sign,
         }

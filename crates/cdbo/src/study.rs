@@ -30,8 +30,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 pub use crate::evaluator::Outcome;
+use crate::experiment::line::{BaseLine, RacedPolicy};
 use crate::method::{Method, Spec, resume};
 use crate::optimizers::{Optimizer, Saved};
+use crate::policy::{Block, PolicyShape};
 use claim::{Handout, Worker};
 use storage::{Dump, Storage, Told, Transaction};
 
@@ -85,13 +87,44 @@ pub struct StudyConfig {
     /// demonstration's fit or initial weights, and in studies made before it was recorded.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub warm_start: Option<String>,
+    /// Kernels of a learned line d(x) ([`crate::policy::actions`]) at the paper's length-scale
+    /// 1/(M_d − 1): the weights are then [w_a, w_d], w₀ and every trial, as `cdbo race --line
+    /// learn` races them; absent: the pedal only (and in studies made before it could be set).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub line_kernels: Option<usize>,
+    /// The line the car holds where the policy has none, and from which a learned line's
+    /// offsets are measured ([`BaseLine`]); absent: the centre line.
+    #[serde(default, skip_serializing_if = "BaseLine::is_centre")]
+    pub base_line: BaseLine,
 }
 
 impl StudyConfig {
-    /// The study's specification of its method, for the weights of its lap policy.
+    /// The shape of the study's policies: M pedal kernels of its length-scale and, with a
+    /// learned line, M_d line kernels at 1/(M_d − 1).
+    pub fn shape(&self) -> Result<PolicyShape> {
+        let pedal = PolicyShape::pedal(Block::new(self.kernels, self.lengthscale)?);
+        Ok(match self.line_kernels {
+            Some(m) => pedal.with_line(Block::paper(m)?),
+            None => pedal,
+        })
+    }
+
+    /// The policy a trial's weights are, with the study's base line ([`RacedPolicy`]).
+    pub fn policy(&self, weights: &[f64]) -> Result<RacedPolicy> {
+        Ok(RacedPolicy {
+            policy: self.shape()?.policy(weights)?,
+            base_line: self.base_line,
+        })
+    }
+
+    /// The study's specification of its method, for the weights of its lap policy (with a
+    /// learned line, the pedal's block first, as a race's).
     pub fn spec(&self) -> Result<Spec> {
         let mut spec =
             Spec::told(self.method, self.seed, self.beta, self.knob)?.policy(self.lengthscale)?;
+        if self.line_kernels.is_some() {
+            spec = spec.pedal_kernels(self.kernels);
+        }
         if let Some(max) = self.max_failed_laps {
             spec = spec.max_failed_laps(max);
         }
@@ -153,10 +186,11 @@ impl Study {
 
     /// Creates a study at `location`; refuses to overwrite one.
     pub fn create_at(location: &Location, config: StudyConfig) -> Result<Study> {
-        if config.w0.len() != config.kernels {
+        let dims = config.shape()?.dims();
+        if config.w0.len() != dims {
             return Err(Error::dimension(
-                "initial weights (one per kernel)",
-                config.kernels,
+                "initial weights (one per kernel, the line's after the pedal's)",
+                dims,
                 config.w0.len(),
             ));
         }
@@ -532,6 +566,8 @@ mod tests {
             knob: None,
             max_failed_laps: None,
             warm_start: None,
+            line_kernels: None,
+            base_line: Default::default(),
         }
     }
 

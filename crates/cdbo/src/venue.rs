@@ -14,7 +14,7 @@ use crate::evaluator::simulator::SimEvaluator;
 use crate::line::RacingLine;
 use crate::policy::{Policy, PolicyShape};
 use crate::sim::{LapConfig, LapResult, Simulator};
-use crate::torcs::evaluator::{TorcsPolicyEvaluator, drive, with_pedal, with_policy};
+use crate::torcs::evaluator::{TorcsEvaluator, drive, with_pedal, with_policy};
 use crate::torcs::{Game, GamePedal, LapRequest};
 use crate::track::Track;
 
@@ -140,7 +140,7 @@ impl Venue {
                 game,
                 request,
                 track,
-            } => Box::new(TorcsPolicyEvaluator {
+            } => Box::new(TorcsEvaluator {
                 game: game.clone(),
                 request: request.as_ref().clone(),
                 track: track.clone(),

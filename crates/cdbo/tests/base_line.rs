@@ -113,3 +113,58 @@ fn the_line_limit_read_on_the_centre_line_is_tracked() {
         "{reward} m/s, centre line {on_centre} m/s"
     );
 }
+
+/// The line a policy holds, as drawn ([`cdbo::sim::Simulator::held_line`]: `plot track
+/// --policy`, the race's map, the dashboard): a line far wider than the road (±30 m) is drawn
+/// within the road less half the car's width at every sample, on the centre line and from the
+/// minimum-curvature line, each point |d| from the centre line along its normal; where the
+/// bound does not bite, the offset is d₀(s) + d(s/L) exactly.
+#[test]
+fn a_learned_line_drawn_never_leaves_the_road_less_the_margin() {
+    use cdbo::policy::{Policy, RkhsPolicy};
+    let (track, car) = ridgeway();
+    let wide = Policy {
+        pedal: RkhsPolicy::new(vec![0.5; 6], 0.2).unwrap(),
+        line: Some(
+            RkhsPolicy::new(
+                vec![30.0, -30.0, 4.0, -30.0, 30.0, 0.5, -2.0, 1.0],
+                1.0 / 7.0,
+            )
+            .unwrap(),
+        ),
+    };
+    let mut sim = cdbo::sim::Simulator::new(track.clone(), &car);
+    for base in [BaseLine::Centre, BaseLine::MinCurvature] {
+        sim.config.line = base.line(&track, &car).unwrap();
+        let held = sim.held_line(|x| wide.line_offset(x));
+        assert_eq!(held.len(), track.samples.len());
+        let (mut clamped, mut free) = (0, 0);
+        for (p, c) in held.iter().zip(&track.samples) {
+            let room = 0.5 * c.width - 0.5 * car.width;
+            assert!(
+                p.offset.abs() <= room + 1e-12,
+                "{base:?}: d({:.0} m) = {:.3} m, room {room:.3} m",
+                p.s,
+                p.offset
+            );
+            let from_centre = (p.x - c.x).hypot(p.y - c.y);
+            assert!(
+                (from_centre - p.offset.abs()).abs() < 1e-9,
+                "{from_centre} {}",
+                p.offset
+            );
+            let d0 = sim.config.line.as_ref().map_or(0.0, |l| l.offset_at(p.s));
+            let wanted = d0 + wide.line_offset(p.s / track.length);
+            if wanted.abs() < room {
+                assert_eq!(p.offset, wanted);
+                free += 1;
+            } else {
+                clamped += 1;
+            }
+        }
+        assert!(
+            clamped > 100 && free > 100,
+            "{base:?}: {clamped} clamped, {free} free"
+        );
+    }
+}

@@ -669,6 +669,8 @@ fn a_study_told_the_laps_length_drives_the_races_laps() {
                 knob: None,
                 max_failed_laps: None,
                 warm_start: None,
+                line_kernels: None,
+                base_line: Default::default(),
             },
         )
         .unwrap();

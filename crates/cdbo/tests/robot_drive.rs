@@ -564,7 +564,10 @@ fn the_robots_line_is_the_rust_one_on_recorded_laps() {
         calls
             .borrow_mut()
             .check("the table", "line_table", &table_args, &[n], Agree::Exactly);
-        let exact = |s: f64| held_offset(track, half_car, base, &held, track.wrap(s));
+        let exact = |s: f64| {
+            let s = track.wrap(s);
+            held_offset(track, half_car, base, held.line(s / track.length), s)
+        };
         // The offset at s, and the path's point there, as the robot finds them: the C++
         // interpolation of the table, then the point along the left normal.
         // (The C++ is asked on the robot's path, the table's.)

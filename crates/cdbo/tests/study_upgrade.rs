@@ -29,6 +29,8 @@ fn config() -> StudyConfig {
         knob: None,
         max_failed_laps: None,
         warm_start: None,
+        line_kernels: None,
+        base_line: Default::default(),
     }
 }
 

@@ -19,7 +19,7 @@ pub struct CeilingArgs {
     /// The line the car holds: on the minimum-curvature line the profile tracked is that
     /// line's limit (read at the centre line's stations) and the shares are of that limit.
     #[arg(long, value_enum, default_value_t)]
-    line: super::race::FixedLine,
+    line: super::line::FixedLine,
     /// Print JSON.
     #[arg(long)]
     json: bool,

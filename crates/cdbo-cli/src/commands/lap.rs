@@ -9,6 +9,7 @@ use super::{CliResult, Setup, Simulator, print_json};
 use cdbo::data_path::DataPath;
 use cdbo::drive::demo::{DEFAULT_TARGET_SPEED, SpeedHold};
 use cdbo::drive::{ConstantPedal, Pedal};
+use cdbo::experiment::line::BaseLine;
 use cdbo::limit::limit_lap;
 use cdbo::policy::PolicyTable;
 use cdbo::sim::{Failure, LapResult};
@@ -26,7 +27,8 @@ pub struct LapArgs {
     #[arg(long, value_name = "A", allow_negative_numbers = true, value_parser = super::value::pedal)]
     throttle: Option<f64>,
     /// Drive a policy: a table of CSV rows `x,a`, or weights as JSON (`.json`, as written by
-    /// `cdbo race`, `cdbo policy fit` and `cdbo optimize`).
+    /// `cdbo race`, `cdbo policy fit` and `cdbo optimize`), or a race's folder (its
+    /// `best_policy.json`); a policy raced on a line (`race --line`) is driven on that line.
     #[arg(long, value_name = "FILE")]
     policy: Option<PathBuf>,
     /// How the car steers.
@@ -91,6 +93,8 @@ pub fn run(args: &LapArgs, data: &DataPath, simulator: Simulator) -> CliResult {
         return run_torcs(args, data);
     }
     let (track, car) = args.setup.load(data)?;
+    // A policy raced on a line is driven on it.
+    let mut base_line = BaseLine::Centre;
     let mut pedal: Box<dyn Pedal> = match (args.demo, args.throttle, &args.policy) {
         (_, Some(a), _) => {
             if !(-1.0..=1.0).contains(&a) {
@@ -98,8 +102,10 @@ pub fn run(args: &LapArgs, data: &DataPath, simulator: Simulator) -> CliResult {
             }
             Box::new(ConstantPedal(a))
         }
-        (_, _, Some(path)) if path.extension().is_some_and(|e| e == "json") => {
-            Box::new(super::policy::read_policy(path)?.driver())
+        (_, _, Some(path)) if path.is_dir() || path.extension().is_some_and(|e| e == "json") => {
+            let raced = super::policy::read_raced_policy(path)?;
+            base_line = raced.base_line;
+            Box::new(raced.policy.driver())
         }
         (_, _, Some(path)) => Box::new(PolicyTable::read_csv(path)?),
         (speed, _, _) => {
@@ -113,8 +119,10 @@ pub fn run(args: &LapArgs, data: &DataPath, simulator: Simulator) -> CliResult {
         }
     };
     let limit = limit_lap(&track, &car);
+    let line = base_line.line(&track, &car)?;
     let mut sim = cdbo::sim::Simulator::new(track, &car);
     sim.config.steering = args.steering.steering();
+    sim.config.line = line;
     sim.config.trace = args.trace.is_some() || args.plot.is_some();
     let lap = sim.lap(pedal.as_mut());
     if let Some(path) = &args.trace {
@@ -124,6 +132,8 @@ pub fn run(args: &LapArgs, data: &DataPath, simulator: Simulator) -> CliResult {
         crate::figures::lap_speed(path, &sim.track, &lap, &limit)?;
     }
     sim.config.trace = false;
+    // The ceiling is the centre line's, as `cdbo race` reports it.
+    sim.config.line = None;
     let (_, ceiling_mps) = cdbo::ceiling::tracked_profile(&sim, &limit)?;
     print_report(
         LapReport::new(
@@ -147,7 +157,8 @@ fn run_torcs(args: &LapArgs, data: &DataPath) -> CliResult {
                 .into(),
         );
     }
-    // A policy with a line holds it in the game as in cdbo's simulator.
+    // A policy with a line (or raced on a base line) holds it in the game as in cdbo's
+    // simulator.
     let mut policy = None;
     let pedal = match (args.demo, args.throttle, &args.policy) {
         (_, Some(a), _) => {
@@ -156,10 +167,10 @@ fn run_torcs(args: &LapArgs, data: &DataPath) -> CliResult {
             }
             GamePedal::Constant(a)
         }
-        (_, _, Some(path)) if path.extension().is_some_and(|e| e == "json") => {
-            let read = super::policy::read_policy(path)?;
-            let pedal = GamePedal::Rkhs(read.pedal.clone());
-            policy = Some(read);
+        (_, _, Some(path)) if path.is_dir() || path.extension().is_some_and(|e| e == "json") => {
+            let raced = super::policy::read_raced_policy(path)?;
+            let pedal = GamePedal::Rkhs(raced.policy.pedal.clone());
+            policy = Some(raced);
             pedal
         }
         (_, _, Some(path)) => GamePedal::Table(PolicyTable::read_csv(path)?.points().to_vec()),
@@ -178,8 +189,10 @@ fn run_torcs(args: &LapArgs, data: &DataPath) -> CliResult {
     let mut req = game.request(&args.setup.track, car_name, pedal)?;
     req.config.steering = args.steering.steering();
     let track = super::game_track(&args.setup.track, &game, data)?;
-    if let Some(policy) = policy.filter(|p| p.line.is_some()) {
-        req = cdbo::torcs::evaluator::with_policy(&req, &track, &policy);
+    // The policy's line on the base line it was raced on (none: the centre line, no table).
+    if let Some(raced) = policy {
+        req.config.line = raced.base_line.line(&track, &req.car)?;
+        req = cdbo::torcs::evaluator::with_policy(&req, &track, &raced.policy);
     }
     if let Some(path) = &args.trace {
         req.trace =

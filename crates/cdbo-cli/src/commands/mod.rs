@@ -6,6 +6,7 @@ pub mod dashboard;
 pub mod experiment;
 pub mod lap;
 pub mod limit;
+pub mod line;
 pub mod optimize;
 pub mod plot;
 pub mod policy;

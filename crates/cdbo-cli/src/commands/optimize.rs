@@ -3,12 +3,14 @@
 
 use std::io::Write;
 use std::path::PathBuf;
+use std::sync::Arc;
 use std::time::Duration;
 
 use clap::Args;
 
 use super::study::InitialPolicy;
 use super::{CliResult, Simulator};
+use cdbo::data_path::DataPath;
 use cdbo::evaluator::Evaluator;
 use cdbo::evaluator::command::CommandEvaluator;
 use cdbo::study::claim::{DEFAULT_LEASE, Worker};
@@ -53,7 +55,7 @@ pub struct OptimizeArgs {
     initial: InitialPolicy,
 }
 
-pub fn run(args: &OptimizeArgs, simulator: Simulator) -> CliResult {
+pub fn run(args: &OptimizeArgs, simulator: Simulator, data: &DataPath) -> CliResult {
     if let Some(w) = cdbo::method::cost::slow_study_warning(
         args.initial.method(),
         args.initial.kernels,
@@ -66,7 +68,8 @@ pub fn run(args: &OptimizeArgs, simulator: Simulator) -> CliResult {
         (Simulator::Torcs, Some(track)) => {
             let game = cdbo::torcs::Game::ready()?;
             let request = game.request(track, &args.car, GamePedal::Constant(0.0))?;
-            Some((game, request))
+            let track = super::game_track(track, &game, data)?;
+            Some((game, request, track))
         }
         (Simulator::Torcs, None) => {
             return Err("--simulator torcs optimize drives the game itself: name its --track (and --car), not an --evaluator".into());
@@ -108,21 +111,24 @@ pub fn run(args: &OptimizeArgs, simulator: Simulator) -> CliResult {
             args.laps
         );
     }
-    let lengthscale = study.config().lengthscale;
     let mut evaluator: Box<dyn Evaluator> = match (game, &args.evaluator) {
-        (Some((game, mut request)), _) => {
+        (Some((game, mut request, track)), _) => {
             request.timeout = Duration::from_secs_f64(args.timeout);
+            // The study's line on its base line, held as cdbo's simulator holds it.
+            request.config.line = study.config().base_line.line(&track, &request.car)?;
             Box::new(TorcsEvaluator {
                 game,
                 request,
-                lengthscale,
+                track: Arc::new(track),
+                shape: study.config().shape()?,
             })
         }
         (None, Some(template)) => Box::new(CommandEvaluator {
             template: template.clone(),
             timeout: Duration::from_secs_f64(args.timeout),
             files: policy_files(&location),
-            lengthscale,
+            shape: study.config().shape()?,
+            base_line: study.config().base_line,
         }),
         (None, None) => {
             return Err("give an --evaluator command or --track (with --simulator torcs)".into());

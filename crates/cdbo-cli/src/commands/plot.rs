@@ -1,14 +1,19 @@
 //! `cdbo plot track`: the track map, drawn by [`crate::figures`].
 
 use std::path::PathBuf;
+use std::sync::Arc;
 
 use clap::{Subcommand, ValueEnum};
 
 use super::{CliResult, load_track, value};
 use crate::figures::{TrackMap, draw, read_trace_speeds};
+use cdbo::car::Car;
 use cdbo::car::catalog as cars;
 use cdbo::data_path::DataPath;
+use cdbo::experiment::line::RacedPolicy;
 use cdbo::line::{LineOptions, RacingLine, SAFETY_MARGIN};
+use cdbo::sim::Simulator;
+use cdbo::track::Track;
 
 #[derive(Debug, Subcommand)]
 pub enum PlotCommand {
@@ -25,6 +30,11 @@ pub enum PlotCommand {
         /// Draw a racing line beside the centre line (in magenta).
         #[arg(long)]
         line: Option<Line>,
+        /// Draw the line a policy holds beside the centre line (in magenta): a policy file
+        /// (`best_policy.json`) or a race's folder; its base line plus its learned line d(x),
+        /// clamped to the road less half --car's width, as the simulator drives it.
+        #[arg(long, value_name = "POLICY.json|DIR", conflicts_with = "line")]
+        policy: Option<PathBuf>,
         /// The car whose width (plus --safety-margin each side) the racing line leaves to the
         /// road's edges.
         #[arg(long, default_value = cars::DEFAULT)]
@@ -48,6 +58,7 @@ pub fn run(cmd: &PlotCommand, data: &DataPath) -> CliResult {
         output,
         trace,
         line,
+        policy,
         car,
         safety_margin,
     } = cmd;
@@ -56,13 +67,20 @@ pub fn run(cmd: &PlotCommand, data: &DataPath) -> CliResult {
         Some(p) => Some(read_trace_speeds(p)?),
         None => None,
     };
-    let racing_line = match line {
-        Some(Line::MinCurvature) => {
+    let racing_line = match (line, policy) {
+        (Some(Line::MinCurvature), _) => {
             let car = cars::find(car, data)?;
             let options = LineOptions::for_car(&car, *safety_margin);
-            Some(RacingLine::minimum_curvature(&t, &options)?)
+            let line = RacingLine::minimum_curvature(&t, &options)?;
+            Some(("minimum-curvature line".to_owned(), line.points))
         }
-        None => None,
+        (None, Some(path)) => {
+            let raced = super::policy::read_raced_policy(path)?;
+            let car = cars::find(car, data)?;
+            let base = raced.base_line.line(&t, &car)?;
+            Some(policy_line(&t, &car, base, &raced))
+        }
+        (None, None) => None,
     };
     draw(
         output,
@@ -71,7 +89,30 @@ pub fn run(cmd: &PlotCommand, data: &DataPath) -> CliResult {
             speeds: speeds.as_deref(),
             line: racing_line
                 .as_ref()
-                .map(|l| ("minimum-curvature line", l.points.as_slice())),
+                .map(|(name, points)| (name.as_str(), points.as_slice())),
         },
     )
+}
+
+/// The line `raced` holds on `track` with `car` ([`Simulator::held_line`]), `base` its base
+/// line computed there, and the line's name.
+pub fn policy_line(
+    track: &Track,
+    car: &Car,
+    base: Option<Arc<RacingLine>>,
+    raced: &RacedPolicy,
+) -> (String, Vec<[f64; 2]>) {
+    let mut sim = Simulator::new(track.clone(), car);
+    sim.config.line = base;
+    let points = sim
+        .held_line(|x| raced.policy.line_offset(x))
+        .iter()
+        .map(|p| [p.x, p.y])
+        .collect();
+    let base = raced.base_line.name();
+    let name = match &raced.policy.line {
+        Some(_) => format!("learned line (from the {base} line)"),
+        None => format!("{base} line the policy holds"),
+    };
+    (name, points)
 }

@@ -6,6 +6,7 @@ use clap::Subcommand;
 
 use super::CliResult;
 use cdbo::bounded;
+use cdbo::experiment::line::RacedPolicy;
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 use cdbo::policy::{Policy, RkhsPolicy};
 
@@ -92,20 +93,33 @@ pub fn read_policy(path: &Path) -> Result<Policy, Box<dyn std::error::Error>> {
     Ok(Policy::from_json(&text, &path.display().to_string())?)
 }
 
-/// Reads a pedal-only policy for `user`, which drives the centre line.
-pub fn read_pedal_policy(
-    path: &Path,
-    user: &str,
-) -> Result<RkhsPolicy, Box<dyn std::error::Error>> {
-    let policy = read_policy(path)?;
-    match policy.pedal_only() {
-        Some(pedal) => Ok(pedal.clone()),
-        None => Err(format!(
-            "{}: a policy with a line d(x); {user} drives the pedal only, on the centre line",
-            path.display()
-        )
-        .into()),
+/// Reads a policy with the base line it was raced on ([`RacedPolicy`]): from a policy file, or
+/// a race's folder (its `best_policy.json`). A file that does not name its base line (written
+/// before it was stored) takes the one of the `summary.json` beside it, where a race wrote
+/// one; else it is on the centre line.
+pub fn read_raced_policy(path: &Path) -> Result<RacedPolicy, Box<dyn std::error::Error>> {
+    let file = if path.is_dir() {
+        path.join("best_policy.json")
+    } else {
+        path.to_owned()
+    };
+    let text = bounded::read_text(&file, &bounded::POLICY_FILE)?;
+    let mut raced = RacedPolicy::from_json(&text, &file.display().to_string())?;
+    let names_base = serde_json::from_str::<serde_json::Value>(&text)
+        .is_ok_and(|v| v.get("base_line").is_some());
+    let summary = file.with_file_name("summary.json");
+    if !names_base && summary.is_file() {
+        #[derive(serde::Deserialize)]
+        struct Raced {
+            #[serde(default)]
+            base_line: cdbo::experiment::line::BaseLine,
+        }
+        let text = bounded::read_text(&summary, &bounded::POLICY_FILE)?;
+        let raced_on: Raced = serde_json::from_str(&text)
+            .map_err(|e| format!("{}: not a race's summary: {e}", summary.display()))?;
+        raced.base_line = raced_on.base_line;
     }
+    Ok(raced)
 }
 
 /// Reads a demonstration's (x, a) pairs ([`cdbo::policy::demo`]).

@@ -10,6 +10,7 @@ use serde::Serialize;
 use super::policy::read_policy;
 use super::{CliResult, Setup, Simulator, from_flag, print_json};
 use cdbo::data_path::DataPath;
+use cdbo::experiment::line::RacedPolicy;
 use cdbo::experiment::race::{BaseLine, RaceConfig, RaceOutcome, check_warm_start, race};
 use cdbo::method::{KnobKind, Method};
 use cdbo::policy::Policy;
@@ -63,74 +64,14 @@ pub struct RaceArgs {
     /// How the car steers.
     #[arg(long, value_enum, default_value_t)]
     steering: super::SteeringChoice,
-    /// The line the car holds, the demonstration's included: the centre line, the
-    /// minimum-curvature racing line (fixed, as `cdbo limit` computes it), or a line d(x)
-    /// learned with the pedal (a second action on its own kernels, starting at --line-start).
-    #[arg(long, value_enum, default_value_t)]
-    line: Line,
-    /// Where a learned line starts, and what its offsets d(x) are measured from: the centre
-    /// line, or the minimum-curvature line d₀(s) (the car holds d₀(s) + d(x)). Only with
-    /// `--line learn`.
-    #[arg(long, value_enum, requires = "line")]
-    line_start: Option<FixedLine>,
-    /// Kernels of a learned line (default: --kernels).
-    #[arg(long, value_parser = super::value::kernels, requires = "line")]
-    line_kernels: Option<usize>,
+    #[command(flatten)]
+    line: super::line::LineArgs,
     /// Output folder (default: runs/race-TRACK-METHOD-mM-sSEED).
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
     /// Print the summary as JSON (no progress bar).
     #[arg(long)]
     json: bool,
-}
-
-/// The line the car holds (`--line`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
-enum Line {
-    /// The centre line.
-    #[default]
-    Centre,
-    /// The minimum-curvature racing line, fixed.
-    MinCurvature,
-    /// A line d(x) learned with the pedal.
-    Learn,
-}
-
-/// A fixed line: where a learned line starts (`race --line-start`), the line of `ceiling
-/// --line`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
-pub enum FixedLine {
-    /// The centre line: d₀ = 0.
-    #[default]
-    Centre,
-    /// The minimum-curvature racing line.
-    MinCurvature,
-}
-
-impl FixedLine {
-    /// The line as a race's base line.
-    pub fn base_line(self) -> BaseLine {
-        match self {
-            FixedLine::Centre => BaseLine::Centre,
-            FixedLine::MinCurvature => BaseLine::MinCurvature,
-        }
-    }
-}
-
-impl RaceArgs {
-    /// The race's base line ([`BaseLine`]): the fixed line's, or a learned line's start.
-    fn base_line(&self) -> Result<BaseLine, String> {
-        match (self.line, self.line_start) {
-            (Line::Learn, Some(start)) => Ok(start.base_line()),
-            (Line::MinCurvature, None) => Ok(BaseLine::MinCurvature),
-            (Line::Learn | Line::Centre, None) => Ok(BaseLine::Centre),
-            (line, Some(_)) => Err(format!(
-                "--line-start: only a learned line starts somewhere (--line learn), not --line {}",
-                clap::ValueEnum::to_possible_value(&line)
-                    .map_or(String::new(), |v| v.get_name().to_owned())
-            )),
-        }
-    }
 }
 
 #[derive(Debug, Serialize)]
@@ -188,6 +129,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     if let (Some(path), Some(policy)) = (&args.warm_start, &warm_start) {
         check_warm_start(policy, kernels).map_err(|e| format!("{}: {e}", path.display()))?;
     }
+    let (base_line, line_kernels) = args.line.resolve(kernels)?;
     let config = RaceConfig {
         method: args.method,
         kernels,
@@ -197,9 +139,9 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         demo_speed: args.demo_speed,
         knob: args.knob.or(args.sigma0),
         max_failed_laps: args.max_failed_laps,
-        line_kernels: (args.line == Line::Learn).then(|| args.line_kernels.unwrap_or(kernels)),
+        line_kernels,
         warm_start,
-        base_line: args.base_line()?,
+        base_line,
     };
     // A knob the method cannot take is refused before any lap is driven.
     config.spec()?;
@@ -256,7 +198,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     let mut ceiling_sim = cdbo::sim::Simulator::new(track.clone(), &car);
     ceiling_sim.config.steering = args.steering.steering();
     let (_, ceiling_mps) = cdbo::ceiling::tracked_profile(&ceiling_sim, &outcome.limit)?;
-    write_outputs(&out, &outcome)?;
+    write_outputs(&out, &outcome, config.base_line)?;
     // The speed plots re-drive the initial and best policies where the race was driven, on
     // its base line.
     let venue = match &outcome.line {
@@ -264,7 +206,16 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         None => venue,
     };
     let drive = |p: &Policy| venue.drive(p);
-    write_plots(&out, &track, &outcome, &drive)?;
+    // The map draws the line the best policy holds, where it is not the centre line.
+    let held = (outcome.line.is_some() || outcome.best.line.is_some()).then(|| {
+        let raced = RacedPolicy {
+            policy: outcome.best.clone(),
+            base_line: config.base_line,
+        };
+        super::plot::policy_line(&track, &car, outcome.line.clone(), &raced)
+    });
+    let held = held.as_ref().map(|(n, p)| (n.as_str(), p.as_slice()));
+    write_plots(&out, &track, &outcome, &drive, held)?;
     let best_lap = outcome
         .laps
         .iter()
@@ -356,7 +307,7 @@ fn slug(name: &str) -> String {
         .collect()
 }
 
-fn write_outputs(out: &Path, o: &RaceOutcome) -> CliResult {
+fn write_outputs(out: &Path, o: &RaceOutcome, base_line: BaseLine) -> CliResult {
     let mut laps = std::io::BufWriter::new(std::fs::File::create(out.join("laps.csv"))?);
     writeln!(
         laps,
@@ -386,8 +337,13 @@ fn write_outputs(out: &Path, o: &RaceOutcome) -> CliResult {
         )?;
     }
     laps.flush()?;
-    write_policy(out, "best_policy", &o.best)?;
-    write_policy(out, "initial_policy", &o.initial)?;
+    for (name, policy) in [("best_policy", &o.best), ("initial_policy", &o.initial)] {
+        let raced = RacedPolicy {
+            policy: policy.clone(),
+            base_line,
+        };
+        write_policy(out, name, &raced)?;
+    }
     Ok(())
 }
 
@@ -398,6 +354,7 @@ fn write_plots(
     track: &cdbo::track::Track,
     o: &RaceOutcome,
     drive: &dyn Fn(&Policy) -> Result<cdbo::sim::LapResult, cdbo::Error>,
+    line: Option<(&str, &[[f64; 2]])>,
 ) -> CliResult {
     use crate::figures::{LineChart, draw, speed_chart, speed_map};
     use plotters::style::{BLACK, BLUE, GREEN, RED};
@@ -454,17 +411,19 @@ fn write_plots(
         draw(&out.join(format!("learning_curve.{ext}")), &curve)?;
         draw(&out.join(format!("policy.{ext}")), &policies)?;
         draw(&out.join(format!("speed.{ext}")), &speeds)?;
-        speed_map(&out.join(format!("map.{ext}")), track, &best_lap)?;
+        speed_map(&out.join(format!("map.{ext}")), track, &best_lap, line)?;
     }
     Ok(())
 }
 
-/// The policy as JSON and as its (x, a) table, with the line's offset d (m) when it has one.
-fn write_policy(out: &Path, name: &str, p: &Policy) -> CliResult {
+/// The policy as JSON, with the base line it was raced on ([`RacedPolicy`]), and as its (x, a)
+/// table, with the line's offset d (m) when it has one.
+fn write_policy(out: &Path, name: &str, raced: &RacedPolicy) -> CliResult {
     std::fs::write(
         out.join(format!("{name}.json")),
-        serde_json::to_string_pretty(p)?,
+        serde_json::to_string_pretty(raced)?,
     )?;
+    let p = &raced.policy;
     let line = p.line.is_some();
     let mut csv = String::from(if line { "x,a,d\n" } else { "x,a\n" });
     for (x, a, d) in p.table(1001) {

@@ -155,13 +155,16 @@ pub fn run(args: &ReportArgs, data: &DataPath) -> CliResult {
         ));
         figures.extend(tradeoff_figures(&out, track, &tradeoffs)?);
         if let Some(best) = best_cdbo_run(&records, track) {
-            let sim = cdbo::sim::Simulator::new(load_track(track, data)?, &car);
+            let mut sim = cdbo::sim::Simulator::new(load_track(track, data)?, &car);
+            // Driven on the line the run was raced on, the demonstration's included.
+            sim.config.line = best.base_line.line(&sim.track, &car)?;
             let (_, demo) = sim.demonstrate(best.demo_speed);
             let names = best_policy_figures(&out, track, sim, &car, &demo, best)?;
             figures.push((
                 format!(
-                    "Best CDBO policy on {track} ({} kernels) against π(w₀)",
-                    best.spec.kernels
+                    "Best CDBO policy on {track} ({} kernels, line {}) against π(w₀)",
+                    best.spec.kernels,
+                    best.line().label()
                 ),
                 names.0,
             ));
@@ -361,10 +364,11 @@ fn best_policy_figures(
 ) -> Result<(String, String), Box<dyn std::error::Error>> {
     let limit = cdbo::limit::limit_lap(&sim.track, car);
     let initial = RkhsPolicy::fit(demo, best.spec.kernels, best.lengthscale, DEFAULT_RIDGE)?;
-    let best_policy = RkhsPolicy::new(best.best_weights.clone(), best.lengthscale)?;
+    let raced = best.best_policy()?;
+    let best_policy = &raced.policy.pedal;
     sim.config.trace = true;
     let initial_lap = sim.lap(&mut initial.pedal());
-    let best_lap = sim.lap(&mut best_policy.pedal());
+    let best_lap = sim.lap(&mut raced.policy.driver());
     let xs = || (0..=500).map(|i| i as f64 / 500.0);
     let policies = LineChart {
         title: format!("{track_name}: policies ({} kernels)", best.spec.kernels),
@@ -496,6 +500,19 @@ fn results_md(
         "{} runs; {:.0} s of run time in total, summed over the runs.",
         records.len(),
         wall
+    );
+    let mut lines = std::collections::BTreeMap::<String, usize>::new();
+    for r in records {
+        *lines.entry(r.line().label()).or_default() += 1;
+    }
+    let lines: Vec<String> = lines
+        .into_iter()
+        .map(|(line, n)| format!("{line} ({n} runs)"))
+        .collect();
+    let _ = writeln!(
+        s,
+        "The line the cars held (`line` in the grid, as `cdbo race --line`): {}.",
+        lines.join(", ")
     );
     for session in sessions.iter().filter(|s| s.runs > 0) {
         let _ = writeln!(

@@ -4,8 +4,10 @@ use std::path::{Path, PathBuf};
 
 use clap::{Args, Subcommand, ValueEnum};
 
-use super::policy::{read_demo, read_pedal_policy};
+use super::line::LineArgs;
+use super::policy::{read_demo, read_raced_policy};
 use super::{CliResult, from_flag, print_json};
+use cdbo::experiment::line::{LineSetting, RacedPolicy};
 use cdbo::method::Method;
 use cdbo::policy::RkhsPolicy;
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
@@ -83,6 +85,10 @@ pub struct InitialPolicy {
     /// again (default: no budget; the safe pattern search's own budget, 30).
     #[arg(long, value_name = "N")]
     max_failed_laps: Option<usize>,
+    /// The line, as `cdbo race --line` (with `--line learn`, w₀'s line is the base line, d = 0,
+    /// unless --weights gives one).
+    #[command(flatten)]
+    pub line: LineArgs,
 }
 
 impl InitialPolicy {
@@ -96,6 +102,8 @@ impl InitialPolicy {
         let lengthscale = self
             .lengthscale
             .unwrap_or_else(|| default_lengthscale(self.kernels));
+        let (base_line, line_kernels) = self.line.resolve(self.kernels)?;
+        let mut line_w0 = None;
         let (policy, file) = match (
             &self.demo,
             self.weights.as_ref().or(self.warm_start.as_ref()),
@@ -105,7 +113,35 @@ impl InitialPolicy {
                     .map_err(|e| format!("{}: {e}", demo.display()))?,
                 demo,
             ),
-            (None, Some(w)) => (read_pedal_policy(w, "a study")?, w),
+            (None, Some(w)) => {
+                let raced = read_raced_policy(w)?;
+                // A policy drives the line it was raced on; a warm start is a pedal-only
+                // policy, as a race's.
+                let study_line = LineSetting::of(base_line, line_kernels).label();
+                let policy_line = LineSetting::of(
+                    raced.base_line,
+                    raced.policy.line.as_ref().map(|l| l.kernels()),
+                )
+                .label();
+                let refused = if raced.base_line != base_line
+                    || (raced.policy.line.is_some() && line_kernels.is_none())
+                {
+                    Some(format!("the study's line is {study_line}"))
+                } else if self.warm_start.is_some() && line_kernels.is_some() {
+                    Some("a warm start is a pedal-only policy, not with --line learn".into())
+                } else {
+                    None
+                };
+                if let Some(why) = refused {
+                    return Err(format!(
+                        "{}: a policy raced on line {policy_line}; {why}",
+                        w.display()
+                    )
+                    .into());
+                }
+                line_w0 = raced.policy.line.map(|l| l.weights);
+                (raced.policy.pedal, w)
+            }
             (None, None) => {
                 return Err(
                     "give the initial policy: --demo demo.csv, --weights w0.json or --warm-start POLICY.json"
@@ -122,18 +158,33 @@ impl InitialPolicy {
             )
             .into());
         }
+        let mut w0 = policy.weights;
+        if let Some(m) = line_kernels {
+            let line = line_w0.unwrap_or_else(|| vec![0.0; m]);
+            if line.len() != m {
+                return Err(format!(
+                    "{}: the initial policy's line has {} kernels but the study's has {m}",
+                    file.display(),
+                    line.len()
+                )
+                .into());
+            }
+            w0.extend(line);
+        }
         Ok(StudyConfig {
             method: self.method(),
             kernels: self.kernels,
             lengthscale: policy.lengthscale,
             seed: self.seed.unwrap_or(0),
             beta: self.beta.unwrap_or(cdbo::acquisition::ucb::DEFAULT_BETA),
-            w0: policy.weights,
+            w0,
             track: None,
             track_length: self.track_length,
             knob: self.knob,
             max_failed_laps: self.max_failed_laps,
             warm_start: self.warm_start.as_ref().map(|p| p.display().to_string()),
+            line_kernels,
+            base_line,
         })
     }
 
@@ -193,6 +244,21 @@ impl InitialPolicy {
             self.warm_start.as_ref().map(|p| p.display().to_string()),
             stored.warm_start.clone(),
         )?;
+        if self.line.given() {
+            let given = self
+                .line
+                .resolve(self.kernels)
+                .map(|(base, kernels)| LineSetting::of(base, kernels))?;
+            let kept = LineSetting::of(stored.base_line, stored.line_kernels);
+            if given != kept {
+                return Err(format!(
+                    "{}: the study was created with {}, not {}; resume it with those flags (or leave them out), or start a new study elsewhere",
+                    study.display(),
+                    super::line::flags(&kept),
+                    super::line::flags(&given)
+                ));
+            }
+        }
         Ok(())
     }
 }
@@ -401,8 +467,22 @@ pub fn run(cmd: &StudyCommand) -> CliResult {
     }
 }
 
-fn policy_of(s: &Study, t: &Trial) -> Result<RkhsPolicy, cdbo::Error> {
-    RkhsPolicy::new(t.weights.clone(), s.config().lengthscale)
+fn policy_of(s: &Study, t: &Trial) -> Result<RacedPolicy, cdbo::Error> {
+    s.config().policy(&t.weights)
+}
+
+/// The policy's table as CSV: `x,a` rows, `x,a,d` with a line.
+fn table_csv(p: &RacedPolicy) -> String {
+    let line = p.policy.line.is_some();
+    let mut csv = String::from(if line { "x,a,d\n" } else { "x,a\n" });
+    for (x, a, d) in p.policy.table(cdbo::evaluator::command::TABLE_POINTS) {
+        csv += &if line {
+            format!("{x:.6},{a:.6},{d:.6}\n")
+        } else {
+            format!("{x:.6},{a:.6}\n")
+        };
+    }
+    csv
 }
 
 fn print_policy(s: &Study, t: &Trial, format: Format) -> CliResult {
@@ -418,10 +498,7 @@ fn print_policy(s: &Study, t: &Trial, format: Format) -> CliResult {
         }
         Format::Csv => {
             println!("# trial {}", t.id);
-            println!("x,a");
-            for (x, a) in policy.table(cdbo::evaluator::command::TABLE_POINTS) {
-                println!("{x:.6},{a:.6}");
-            }
+            print!("{}", table_csv(&policy));
         }
     }
     Ok(())
@@ -440,6 +517,7 @@ fn status(s: &Study, json: bool) -> CliResult {
         "kernels": c.kernels,
         "track_length_m": c.track_length,
         "knob": c.knob,
+        "line": LineSetting::of(c.base_line, c.line_kernels).label(),
         "told": told,
         "failed": failed,
         "pending_trial": pending,
@@ -451,10 +529,14 @@ fn status(s: &Study, json: bool) -> CliResult {
         return print_json(&v);
     }
     println!(
-        "{}: {} with {} kernels{}; {told} trials told ({failed} failed){}; best {}",
+        "{}: {} with {} kernels{}{}; {told} trials told ({failed} failed){}; best {}",
         s.path().display(),
         c.method,
         c.kernels,
+        match LineSetting::of(c.base_line, c.line_kernels) {
+            line if line == LineSetting::centre() => String::new(),
+            line => format!(" on line {}", line.label()),
+        },
         c.track_length
             .map_or(String::new(), |l| format!(" on a {l} m lap")),
         pending.map_or(String::new(), |p| format!(", trial {p} pending")),
@@ -496,11 +578,7 @@ fn export(s: &Study, out: &Path) -> CliResult {
             out.join("best_policy.json"),
             serde_json::to_string_pretty(&cdbo::evaluator::command::policy_json(&p))?,
         )?;
-        let mut csv = String::from("x,a\n");
-        for (x, a) in p.table(cdbo::evaluator::command::TABLE_POINTS) {
-            csv += &format!("{x:.6},{a:.6}\n");
-        }
-        std::fs::write(out.join("best_policy.csv"), csv)?;
+        std::fs::write(out.join("best_policy.csv"), table_csv(&p))?;
     }
     let (mut points, mut best, mut raw) = (Vec::new(), f64::NEG_INFINITY, Vec::new());
     for t in h.iter().filter(|t| t.reward.is_some()) {

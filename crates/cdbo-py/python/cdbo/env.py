@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._cdbo import DEFAULT_BOX_RADIUS, Optimizer, Policy, Simulator
+from ._cdbo import DEFAULT_BOX_RADIUS, Optimizer, Policy, Simulator, resolve_line
 
 try:
     import gymnasium as _gym
@@ -56,6 +56,13 @@ class RaceEnv(_Base):
     [w0 - bounds, w0 + bounds] the library's optimisers search; the weights are not clipped.
     ``w0``, ``lengthscale`` and ``track_length`` (m) are what ``cdbo.Optimizer`` is told to
     race as ``cdbo race`` does.
+
+    ``line`` is the line the car holds, as ``cdbo race --line``: ``"centre"`` (the paper),
+    ``"min-curvature"`` (the fixed racing line; the demonstration holds it too) or ``"learn"``:
+    the action is then [w_a, w_d], the pedal's ``kernels`` weights and a line d(x) on
+    ``line_kernels`` kernels (default ``kernels``) at length-scale ``line_lengthscale``, an
+    offset from ``line_start`` (``"centre"`` or ``"min-curvature"``); ``w0``'s line is 0.
+    ``base_line`` and ``line_kernels`` say what was resolved.
     """
 
     metadata = {"render_modes": []}
@@ -68,8 +75,14 @@ class RaceEnv(_Base):
         demo_speed: float = 15.0,
         bounds: float = DEFAULT_BOX_RADIUS,
         data_dir=None,
+        line: str = "centre",
+        line_kernels=None,
+        line_start=None,
     ):
-        self.simulator = Simulator(track, car, data_dir=data_dir)
+        self.base_line, self.line_kernels = resolve_line(
+            kernels, line=line, line_kernels=line_kernels, line_start=line_start
+        )
+        self.simulator = Simulator(track, car, data_dir=data_dir, line=self.base_line)
         demo, x, a = self.simulator.demonstrate(demo_speed)
         if not demo.completed:
             raise ValueError(
@@ -78,8 +91,12 @@ class RaceEnv(_Base):
             )
         self.demo = demo
         self.initial = Policy.fit(x, a, kernels)
-        self.w0 = self.initial.weights
+        self.kernels = kernels
         self.lengthscale = self.initial.lengthscale
+        m = self.line_kernels or 0
+        # The paper's length-scale 1/(M_d - 1), as the race's line block.
+        self.line_lengthscale = Policy(np.zeros(m)).lengthscale if m else None
+        self.w0 = np.concatenate([self.initial.weights, np.zeros(m)])
         self.track_length = self.simulator.track.length
         self.bounds = bounds
         self.action_space = _box(self.w0 - bounds, self.w0 + bounds)
@@ -88,12 +105,15 @@ class RaceEnv(_Base):
 
     def optimizer(self, method="cdbo", **options):
         """``cdbo.Optimizer(method, w0, ...)`` told what this race is: its start ``w0``, its
-        box, the policy's length-scale and the lap's length, as ``cdbo race`` tells it (the
+        box, the policy's length-scale, the lap's length and, with a learned line, how many
+        weights are the pedal's, as ``cdbo race`` tells it (the
         pattern search pushes the policy's pedal and repairs it over road with them).
         ``options`` are the Optimizer's own (``seed=``, ``knob=``, ``max_failed=``, ...)."""
         options.setdefault("bounds", self.bounds)
         options.setdefault("lengthscale", self.lengthscale)
         options.setdefault("track_length", self.track_length)
+        if self.line_kernels:
+            options.setdefault("pedal_kernels", self.kernels)
         return Optimizer(method, self.w0, **options)
 
     def reset(self, *, seed=None, options=None):
@@ -102,8 +122,12 @@ class RaceEnv(_Base):
         return np.zeros(1), {}
 
     def step(self, action):
-        policy = Policy(np.asarray(action, dtype=np.float64), self.lengthscale)
-        lap = self.simulator.lap(policy)
+        w = np.asarray(action, dtype=np.float64)
+        if w.shape != self.w0.shape:
+            raise ValueError(f"the action has {w.size} weights; this race's have {self.w0.size}")
+        policy = Policy(w[: self.kernels], self.lengthscale)
+        line = Policy(w[self.kernels :], self.line_lengthscale) if self.line_kernels else None
+        lap = self.simulator.lap(policy, line=line)
         self.last = lap
         info = {
             "completed": lap.completed,

@@ -20,7 +20,8 @@ use std::time::{Duration, Instant};
 use super::{Evaluator, Outcome};
 use crate::bounded;
 use crate::error::{Error, Result};
-use crate::policy::RkhsPolicy;
+use crate::experiment::line::{BaseLine, RacedPolicy};
+use crate::policy::PolicyShape;
 use crate::store::claim::process_exists;
 
 /// Points of the (x, a) table written with each policy.
@@ -36,8 +37,11 @@ pub struct CommandEvaluator {
     /// Where the policy files go: trial `id`'s is `FILES.trial-ID.pid-PID.json`
     /// ([`policy_file`]), written before the lap and removed after it.
     pub files: PathBuf,
-    /// The policy kernels' length-scale.
-    pub lengthscale: f64,
+    /// The policies' shape: the pedal's kernels and length-scale, and a learned line's.
+    pub shape: PolicyShape,
+    /// The line the car holds, written into each policy file ([`RacedPolicy`]) so that a lap
+    /// command such as `cdbo lap --policy {policy}` drives it.
+    pub base_line: BaseLine,
 }
 
 /// Where process `pid` writes trial `id`'s policy for the command: one file per trial and
@@ -46,13 +50,20 @@ pub fn policy_file(files: &Path, id: i64, pid: u32) -> PathBuf {
     PathBuf::from(format!("{}.trial-{id}.pid-{pid}.json", files.display()))
 }
 
-/// The policy file's content.
-pub fn policy_json(policy: &RkhsPolicy) -> serde_json::Value {
-    serde_json::json!({
-        "weights": policy.weights,
-        "lengthscale": policy.lengthscale,
-        "table": policy.table(TABLE_POINTS).iter().map(|(x, a)| [*x, *a]).collect::<Vec<_>>(),
-    })
+/// The policy file's content: the policy's own file (`weights`, `lengthscale`, and a learned
+/// line's `line` and a `base_line` other than the centre, [`RacedPolicy`]) and its `table` of
+/// [x, a] rows, [x, a, d] with a line (d before the road's bounds).
+pub fn policy_json(raced: &RacedPolicy) -> serde_json::Value {
+    let line = raced.policy.line.is_some();
+    let table: Vec<Vec<f64>> = raced
+        .policy
+        .table(TABLE_POINTS)
+        .into_iter()
+        .map(|(x, a, d)| if line { vec![x, a, d] } else { vec![x, a] })
+        .collect();
+    let mut v = serde_json::to_value(raced).unwrap_or_default();
+    v["table"] = table.into();
+    v
 }
 
 /// `'text'` for `sh`, with single quotes escaped.
@@ -169,7 +180,10 @@ impl Evaluator for CommandEvaluator {
 impl CommandEvaluator {
     /// Writes the policy with `weights` to `file`, runs the command on it, reads the outcome.
     fn drive(&self, file: &Path, weights: &[f64]) -> Result<Outcome> {
-        let policy = RkhsPolicy::new(weights.to_vec(), self.lengthscale)?;
+        let policy = RacedPolicy {
+            policy: self.shape.policy(weights)?,
+            base_line: self.base_line,
+        };
         let text = serde_json::to_string(&policy_json(&policy))
             .map_err(|e| Error::json(file.display().to_string(), e))?;
         std::fs::write(file, text).map_err(|e| Error::Io {
@@ -318,7 +332,8 @@ mod tests {
             template: "test -s {policy} && echo 3.25".into(),
             timeout: Duration::from_secs(5),
             files: dir.join("p"),
-            lengthscale: 0.5,
+            shape: PolicyShape::pedal(crate::policy::Block::new(2, 0.5).unwrap()),
+            base_line: BaseLine::Centre,
         };
         assert_eq!(e.evaluate(1, &[0.1, 0.2]).unwrap(), Outcome::Reward(3.25));
         // The lap's policy file is gone after it; a killed process's is removed, a live one's
@@ -355,7 +370,8 @@ mod tests {
             template: "yes".into(),
             timeout: Duration::from_secs(600),
             files: dir.join("p"),
-            lengthscale: 0.5,
+            shape: PolicyShape::pedal(crate::policy::Block::new(2, 0.5).unwrap()),
+            base_line: BaseLine::Centre,
         };
         for (template, which) in [("yes", "standard output"), ("yes >&2", "standard error")] {
             e.template = template.into();

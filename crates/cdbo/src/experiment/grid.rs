@@ -13,6 +13,9 @@
 //! kernels = [10, 50, 100]
 //! ```
 //!
+//! `line = "learn"` (with `line_kernels = 20`, `line_start = "min-curvature"`) or `line =
+//! "min-curvature"` races every run on that line, as `cdbo race --line`; a grid without it
+//! races the centre line, the paper's.
 //! `steering = "tracker"` drives every run with the path tracker (default `"pi"`).
 //!
 //! Run r of every cell has seed r, so that the methods meet the same random numbers where
@@ -21,6 +24,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::line::{BaseLine, LineKind, LineSetting};
 use crate::drive::steering::SteeringLaw;
 use crate::method::{Method, Spec};
 
@@ -63,6 +67,16 @@ pub struct ExperimentConfig {
         skip_serializing_if = "std::collections::BTreeMap::is_empty"
     )]
     pub knob: std::collections::BTreeMap<Method, f64>,
+    /// The line every run's car holds, as `cdbo race --line`: `centre` (the paper; the
+    /// default), `min-curvature` or `learn`.
+    #[serde(default, skip_serializing_if = "LineKind::is_centre")]
+    pub line: LineKind,
+    /// Kernels of a learned line (default: each panel's pedal kernels), as `--line-kernels`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub line_kernels: Option<usize>,
+    /// Where a learned line starts, as `--line-start`: `centre` or `min-curvature`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub line_start: Option<BaseLine>,
     /// How every run's car steers, the ceiling's lap included: `"pi"` (the paper's, the
     /// default) or `"tracker"` (the path tracker, as `cdbo race --steering tracker`).
     #[serde(default, skip_serializing_if = "SteeringLaw::is_pi")]
@@ -81,6 +95,15 @@ fn default_beta() -> f64 {
 pub const PRESETS: &[&str] = &["paper", "paper-plus", "quick"];
 
 impl ExperimentConfig {
+    /// The grid's line.
+    pub fn line(&self) -> LineSetting {
+        LineSetting {
+            line: self.line,
+            kernels: self.line_kernels,
+            start: self.line_start,
+        }
+    }
+
     /// The main knob `method` runs at in this grid: its entry in the `[knob]` table, else its
     /// published setting ([`Knob::published`](crate::method::Knob::published): σ₀ 0.03,
     /// TuRBO's 0.8, LineBO's whole line, REMBO's √d), so that a grid names every tuned value
@@ -122,6 +145,9 @@ impl ExperimentConfig {
                 methods: methods(&[]),
                 tracks: paper_tracks,
                 knob: Default::default(),
+                line: LineKind::Centre,
+                line_kernels: None,
+                line_start: None,
                 steering: Default::default(),
             },
             "paper-plus" => ExperimentConfig {
@@ -149,6 +175,9 @@ impl ExperimentConfig {
                     kernels: vec![10, 20],
                 }],
                 knob: Default::default(),
+                line: LineKind::Centre,
+                line_kernels: None,
+                line_start: None,
                 steering: Default::default(),
             },
             _ => return None,
@@ -232,6 +261,7 @@ impl ExperimentConfig {
             }
             Spec::race(m).knob(v)?;
         }
+        self.line().resolve(2)?;
         if !(self.demo_speed.is_finite() && self.demo_speed > 0.0) {
             return Err(Error::invalid_value(
                 "demo_speed",
@@ -397,6 +427,32 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("length"), "{e}");
+    }
+
+    /// A grid's line reads and writes as the flags name it; a grid without one is the centre
+    /// line's (every grid written before it), and a start without a learned line is refused.
+    #[test]
+    fn the_line_of_a_grid() {
+        let head = "laps = 3\nrepeats = 1\nmethods = [\"random\"]\ntracks = [{track = \"x\", kernels = [5]}]\n";
+        let old = ExperimentConfig::from_toml(head, "g").unwrap();
+        assert_eq!(old.line(), LineSetting::centre());
+        assert!(!toml::to_string(&old).unwrap().contains("line"));
+        let text =
+            format!("line = \"learn\"\nline_kernels = 4\nline_start = \"min-curvature\"\n{head}");
+        let grid = ExperimentConfig::from_toml(&text, "g").unwrap();
+        assert_eq!(
+            grid.line().resolve(5).unwrap(),
+            (BaseLine::MinCurvature, Some(4))
+        );
+        let saved = toml::to_string(&grid).unwrap();
+        assert_eq!(ExperimentConfig::from_toml(&saved, "g").unwrap(), grid);
+        let e = ExperimentConfig::from_toml(
+            &format!("line_start = \"min-curvature\"\n{head}"),
+            "g.toml",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("g.toml") && e.contains("line start"), "{e}");
     }
 
     #[test]

@@ -9,7 +9,7 @@ use crate::car::Car;
 use crate::error::{Error, Result};
 use crate::evaluator::{Evaluator, Outcome};
 use crate::limit::{Limit, limit_lap};
-use crate::line::{LineOptions, RacingLine, SAFETY_MARGIN};
+use crate::line::RacingLine;
 use crate::method::{Method, Spec};
 use crate::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 use crate::policy::{Block, Policy, PolicyShape, RkhsPolicy};
@@ -17,6 +17,8 @@ use crate::sim::{FailureReason, LapResult};
 use crate::study::run::{Event, InMemory, run};
 use crate::track::Track;
 use crate::venue::Venue;
+
+pub use super::line::BaseLine;
 
 /// Settings of a race.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -55,37 +57,6 @@ pub struct RaceConfig {
     /// which a learned line's offsets are measured (the car holds d₀(s) + d(s/L)).
     #[serde(default, skip_serializing_if = "BaseLine::is_centre")]
     pub base_line: BaseLine,
-}
-
-/// The line a race's car holds where its policy has none, part of the track as the driver's
-/// reference ([`crate::sim::LapConfig::line`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum BaseLine {
-    /// The centre line, d₀ = 0.
-    #[default]
-    Centre,
-    /// The minimum-curvature racing line ([`RacingLine::minimum_curvature`]) at half the car's
-    /// width plus [`SAFETY_MARGIN`] from the road's edges: |d₀(s)| ≤ w(s)/2 − w_car/2 − 0.5 m.
-    MinCurvature,
-}
-
-impl BaseLine {
-    /// Whether this is the centre line.
-    pub fn is_centre(&self) -> bool {
-        *self == BaseLine::Centre
-    }
-
-    /// The line on `track` for `car`; `None` for the centre line.
-    pub fn line(&self, track: &Track, car: &Car) -> Result<Option<Arc<RacingLine>>> {
-        Ok(match self {
-            BaseLine::Centre => None,
-            BaseLine::MinCurvature => Some(Arc::new(RacingLine::minimum_curvature(
-                track,
-                &LineOptions::for_car(car, SAFETY_MARGIN),
-            )?)),
-        })
-    }
 }
 
 impl RaceConfig {

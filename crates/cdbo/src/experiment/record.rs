@@ -8,10 +8,12 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::grid::{ExperimentConfig, RunSpec};
+use super::line::{BaseLine, LineSetting, RacedPolicy};
 use super::race::{LapRecord, RaceConfig, race};
 use crate::bounded;
 use crate::car::Car;
 use crate::error::{Error, Result};
+use crate::policy::{Block, PolicyShape};
 use crate::track::Track;
 use crate::venue::Venue;
 
@@ -43,8 +45,15 @@ pub struct RunRecord {
     pub best_reward_mps: f64,
     /// Best weights.
     pub best_weights: Vec<f64>,
-    /// The policy's kernel length-scale.
+    /// The policy's kernel length-scale (the pedal's).
     pub lengthscale: f64,
+    /// Kernels of the learned line, whose weights follow the pedal's in `best_weights` (at the
+    /// paper's length-scale); absent: the pedal only (and in records written before it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub line_kernels: Option<usize>,
+    /// The line the run's car held ([`BaseLine`]); absent: the centre line.
+    #[serde(default, skip_serializing_if = "BaseLine::is_centre")]
+    pub base_line: BaseLine,
     /// Every lap.
     pub laps: Vec<LapRecord>,
     /// Wall-clock seconds of the run.
@@ -52,6 +61,24 @@ pub struct RunRecord {
 }
 
 impl RunRecord {
+    /// The run's line, as the grid asked for it.
+    pub fn line(&self) -> LineSetting {
+        LineSetting::of(self.base_line, self.line_kernels)
+    }
+
+    /// The best policy, with the line it was raced on.
+    pub fn best_policy(&self) -> Result<RacedPolicy> {
+        let pedal = PolicyShape::pedal(Block::new(self.spec.kernels, self.lengthscale)?);
+        let shape = match self.line_kernels {
+            Some(m) => pedal.with_line(Block::paper(m)?),
+            None => pedal,
+        };
+        Ok(RacedPolicy {
+            policy: shape.policy(&self.best_weights)?,
+            base_line: self.base_line,
+        })
+    }
+
     /// Seconds the optimiser spent in total.
     pub fn optimizer_s(&self) -> f64 {
         self.laps.iter().map(|l| l.optimizer_s).sum()
@@ -165,6 +192,7 @@ pub fn run_at(
 ) -> Result<RunRecord> {
     let start = std::time::Instant::now();
     let method: crate::method::Method = spec.method.parse()?;
+    let (base_line, line_kernels) = grid.line().resolve(spec.kernels)?;
     let config = RaceConfig {
         method,
         kernels: spec.kernels,
@@ -174,9 +202,9 @@ pub fn run_at(
         demo_speed: grid.demo_speed,
         knob: Some(grid.knob_of(method)),
         max_failed_laps: None,
-        line_kernels: None,
+        line_kernels,
         warm_start: None,
-        base_line: Default::default(),
+        base_line,
     };
     let (track_name, length_m) = (track.name.clone(), track.length);
     let venue = match grounds {
@@ -202,6 +230,8 @@ pub fn run_at(
         best_reward_mps: outcome.best_reward_mps,
         best_weights: outcome.best.weights(),
         lengthscale: outcome.best.pedal.lengthscale,
+        line_kernels,
+        base_line,
         laps: outcome.laps,
         wall_s: start.elapsed().as_secs_f64(),
     })

@@ -194,25 +194,31 @@ fn facing_away(state: &State, frame: &Frame) -> bool {
     cy * frame.cos_heading + sy * frame.sin_heading < 0.0
 }
 
-/// The offset (m, positive left of the centre line) the car holds at station `s` ∈ [0, L) for
-/// the driver `pedal`: its line d(s/L) ([`Pedal::line`]) from the base line d₀(s) (`base`;
-/// none: the centre line), clamped to the road less half the car's width,
-/// clamp(d₀(s) + d(s/L), −b, b) with b = max(0, w(s)/2 − `half_car`). Both steerings hold the
-/// path this offset makes, in the simulator and (sampled, [`crate::torcs::line`]) in the game.
-pub fn held_offset(
-    track: &Track,
-    half_car: f64,
-    base: Option<&RacingLine>,
-    pedal: &dyn Pedal,
-    s: f64,
-) -> f64 {
+/// The offset (m, positive left of the centre line) the car holds at centre-line station `s`:
+/// the base line's d₀(s) (0 without one) plus the policy's d, clamped to the road less half the
+/// car's width, |d₀ + d| ≤ max(w(s)/2 − `half_car`, 0). One definition for the lap and for
+/// whatever draws the line a lap holds.
+#[inline]
+pub fn held_offset(track: &Track, half_car: f64, base: Option<&RacingLine>, d: f64, s: f64) -> f64 {
     let bound = (track.frame(track.index_at(s)).half_width - half_car).max(0.0);
-    let d = pedal.line(s / track.length);
     let d = match base {
         Some(base) => base.offset_at(s) + d,
         None => d,
     };
     d.clamp(-bound, bound)
+}
+
+/// A point of the line a lap holds ([`Simulator::held_line`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct HeldPoint {
+    /// Station on the centre line (m).
+    pub s: f64,
+    /// Offset from the centre line (m, positive left), within the road less half the car.
+    pub offset: f64,
+    /// Position (m).
+    pub x: f64,
+    /// Position (m).
+    pub y: f64,
 }
 
 /// A track and a car, ready to run laps.
@@ -234,6 +240,34 @@ impl Simulator {
             vehicle: Vehicle::new(car),
             config: LapConfig::default(),
         }
+    }
+
+    /// The line a policy with line `d(x)` holds, as its laps steer it ([`held_offset`]): at
+    /// every track sample sᵢ, the offset dᵢ (m, positive left) and the point cᵢ + dᵢ·nᵢ, nᵢ
+    /// the centre line's left normal (−sin θᵢ, cos θᵢ).
+    pub fn held_line(&self, d: impl Fn(f64) -> f64) -> Vec<HeldPoint> {
+        let track = &self.track;
+        let half_car = 0.5 * self.vehicle.car.width;
+        track
+            .samples
+            .iter()
+            .map(|p| {
+                let offset = held_offset(
+                    track,
+                    half_car,
+                    self.config.line.as_deref(),
+                    d(p.s / track.length),
+                    p.s,
+                );
+                let (sin, cos) = p.heading.sin_cos();
+                HeldPoint {
+                    s: p.s,
+                    offset,
+                    x: p.x - offset * sin,
+                    y: p.y + offset * cos,
+                }
+            })
+            .collect()
     }
 
     /// The time limit of a lap (s).
@@ -293,7 +327,15 @@ impl Simulator {
                     speed: state.speed(),
                     time: t,
                 }));
-                let line = |s: f64| held_offset(track, half_car, cfg.line.as_deref(), &*pedal, s);
+                let line = |s: f64| {
+                    held_offset(
+                        track,
+                        half_car,
+                        cfg.line.as_deref(),
+                        pedal.line(s / track.length),
+                        s,
+                    )
+                };
                 let steer = steering.update(track, &self.vehicle, &state, &proj, &line, driver_dt);
                 controls = Controls::new(steer, a.max(0.0), (-a).max(0.0));
                 self.vehicle.shift(&mut state, controls.throttle());

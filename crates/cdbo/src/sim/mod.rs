@@ -8,4 +8,6 @@ pub mod table;
 pub mod tyre;
 pub mod vehicle;
 
-pub use lap::{Failure, FailureReason, LapConfig, LapResult, Simulator, TracePoint};
+pub use lap::{
+    Failure, FailureReason, HeldPoint, LapConfig, LapResult, Simulator, TracePoint, held_offset,
+};

@@ -8,35 +8,15 @@ use super::{Game, GamePedal, LapRequest};
 use crate::drive::Pedal;
 use crate::error::Result;
 use crate::evaluator::{Evaluator, Outcome};
-use crate::policy::{Policy, PolicyShape, RkhsPolicy};
+use crate::policy::{Policy, PolicyShape};
 use crate::sim::lap::{Failure, FailureReason, LapResult};
 use crate::track::Track;
-
-/// Laps in TORCS with the paper's pedal-only RKHS policies of a fixed length-scale, on the
-/// request's line (the centre line unless `request.line` gives one).
-#[derive(Debug, Clone)]
-pub struct TorcsEvaluator {
-    /// The set-up game.
-    pub game: Game,
-    /// The lap to drive; its pedal is replaced by each policy.
-    pub request: LapRequest,
-    /// The policy kernels' length-scale.
-    pub lengthscale: f64,
-}
-
-impl Evaluator for TorcsEvaluator {
-    fn evaluate(&mut self, _trial: i64, weights: &[f64]) -> Result<Outcome> {
-        let policy = RkhsPolicy::new(weights.to_vec(), self.lengthscale)?;
-        self.request.pedal = GamePedal::Rkhs(policy);
-        lap_outcome(&self.game, &self.request)
-    }
-}
 
 /// Laps in TORCS with policies of a fixed shape: the pedal and, if the shape has one, the
 /// line, held from the request's base line `config.line` as the simulator holds it
 /// ([`with_policy`]).
 #[derive(Debug, Clone)]
-pub struct TorcsPolicyEvaluator {
+pub struct TorcsEvaluator {
     /// The set-up game.
     pub game: Game,
     /// The lap to drive (its base line in `config.line`); its pedal and line are each
@@ -48,7 +28,7 @@ pub struct TorcsPolicyEvaluator {
     pub shape: PolicyShape,
 }
 
-impl Evaluator for TorcsPolicyEvaluator {
+impl Evaluator for TorcsEvaluator {
     fn evaluate(&mut self, _trial: i64, weights: &[f64]) -> Result<Outcome> {
         let policy = self.shape.policy(weights)?;
         lap_outcome(

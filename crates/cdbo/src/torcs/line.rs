@@ -48,7 +48,7 @@ impl LineTable {
         let offsets = (0..n)
             .map(|j| {
                 let s = j as f64 * track.length / n as f64;
-                held_offset(track, half_car, base, pedal, s)
+                held_offset(track, half_car, base, pedal.line(s / track.length), s)
             })
             .collect();
         LineTable {
@@ -90,7 +90,7 @@ mod tests {
         let table = LineTable::held(&track, half_car, None, &driver);
         let n = table.offsets.len();
         assert_eq!(n, (track.length / SPACING).ceil() as usize);
-        let exact = |s: f64| held_offset(&track, half_car, None, &driver, s);
+        let exact = |s: f64| held_offset(&track, half_car, None, driver.line(s / track.length), s);
         for (j, &d) in table.offsets.iter().enumerate() {
             let s = j as f64 * track.length / n as f64;
             assert_eq!(d.to_bits(), exact(s).to_bits(), "s = {s}");

@@ -1,0 +1,57 @@
+"""The line from Python: `cdbo.race(line=...)` and `RaceEnv(line=...)` race what `cdbo race
+--line` races, bit for bit."""
+
+import json
+
+import numpy as np
+import pytest
+
+import cdbo
+
+LINE = dict(line="learn", line_kernels=8, line_start="min-curvature")
+FLAGS = ("--line", "learn", "--line-kernels", 8, "--line-start", "min-curvature")
+
+
+def test_a_learned_line_is_the_clis_and_the_envs_race(cli, tmp_path):
+    laps = 30
+    args = ("--method", "pattern-search", "--kernels", 12, "--laps", laps, "--seed", 1)
+    summary = json.loads(cli("race", "--json", *args, *FLAGS, "--out", tmp_path))
+    result = cdbo.race("ridgeway", method="pattern-search", kernels=12, laps=laps, seed=1, **LINE)
+    assert result.best_reward == summary["best_reward_mps"]
+    assert result.base_line == "min-curvature" == summary["base_line"]
+    assert result.best_line.kernels == 8 and result.best.kernels == 12
+    assert np.array_equal(
+        result.best_weights, np.concatenate([result.best.weights, result.best_line.weights])
+    )
+    # A loop over the environment and the optimiser asks and drives the same laps.
+    env = cdbo.RaceEnv("ridgeway", kernels=12, **LINE)
+    assert (env.base_line, env.line_kernels) == ("min-curvature", 8)
+    assert env.w0.shape == (20,) and not env.w0[12:].any()
+    opt = env.optimizer("pattern-search", seed=1)
+    rewards = []
+    for _ in range(laps):
+        w = opt.ask()
+        lap = env.lap(w)
+        opt.tell(w, lap)
+        rewards.append(float(lap))
+    assert rewards == [lap["reward"] for lap in result.laps]
+    # The best policy's lap again, on the line it was raced on.
+    sim = cdbo.Simulator("ridgeway", line="min-curvature")
+    assert sim.lap(result.best, line=result.best_line).reward == result.best_reward
+    assert cdbo.Simulator("ridgeway").lap(result.best, line=result.best_line).reward != (
+        result.best_reward
+    )
+
+
+def test_a_fixed_line_and_bad_lines():
+    env = cdbo.RaceEnv("ridgeway", kernels=10, line="min-curvature")
+    assert (env.base_line, env.line_kernels) == ("min-curvature", None)
+    assert env.w0.shape == (10,)
+    centre = cdbo.RaceEnv("ridgeway", kernels=10)
+    assert env.lap(env.w0).reward != centre.lap(centre.w0).reward
+    with pytest.raises(ValueError, match="line"):
+        cdbo.RaceEnv("ridgeway", kernels=10, line="apex")
+    with pytest.raises(ValueError, match="line start"):
+        cdbo.race("ridgeway", kernels=10, laps=2, line_start="min-curvature")
+    with pytest.raises(ValueError, match="weights"):
+        env.step(np.zeros(12))
