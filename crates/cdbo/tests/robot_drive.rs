@@ -29,7 +29,7 @@ use cdbo::car::Car;
 use cdbo::drive::demo::{self, SpeedHold};
 use cdbo::drive::steering::{self, PiSteering, Steering};
 use cdbo::drive::tracker::{self, PathTracker, TrackerCar, TrackerInput};
-use cdbo::drive::{Observation, Pedal, pedal_command, pi_control};
+use cdbo::drive::{Observation, Pedal, geometry, pedal_command, pi_control};
 use cdbo::experiment::race::BaseLine;
 use cdbo::policy::actions::PolicyDriver;
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
@@ -294,7 +294,7 @@ fn the_robots_decisions_are_the_rust_ones_on_recorded_laps() {
             calls.check(&at, "lookahead", &args, &[d], Agree::Exactly);
             let (tx, ty) = track.point_at(proj.s + d);
             let (dx, dy) = (tx - p.pos_x, ty - p.pos_y);
-            let e = steering::bearing(dx, dy, (sin, cos));
+            let e = geometry::bearing(dx, dy, (sin, cos));
             calls.check(&at, "bearing", &[dx, dy, sin, cos], &[e], Agree::Exactly);
             let before = steer_integral;
             let (wheelbase, lock) = (car.wheelbase, car.steer_lock);
@@ -440,7 +440,7 @@ fn the_robots_tracker_is_the_rust_one_on_a_recorded_lap() {
                 track.point_at(proj.s + tracker::PATH_STEP),
             );
             let (dx, dy) = (ahead.0 - behind.0, ahead.1 - behind.1);
-            let bearing = steering::bearing(dx, dy, (sin, cos));
+            let bearing = geometry::bearing(dx, dy, (sin, cos));
             calls.check(
                 &at,
                 "bearing",
@@ -618,7 +618,7 @@ fn the_robots_line_is_the_rust_one_on_recorded_laps() {
                             path(proj.s + tracker::PATH_STEP).1,
                         );
                         let (dx, dy) = (ahead.0 - behind.0, ahead.1 - behind.1);
-                        let bearing = steering::bearing(dx, dy, (sin, cos));
+                        let bearing = geometry::bearing(dx, dy, (sin, cos));
                         let sf = proj.s + t.feedforward_time * v;
                         let points = [-tracker::PATH_STEP, 0.0, tracker::PATH_STEP]
                             .map(|ds| path(sf + ds).1);
@@ -651,7 +651,7 @@ fn the_robots_line_is_the_rust_one_on_recorded_laps() {
                     Steering::Pi(pi) => {
                         let la = pi.lookahead(p.speed);
                         let (tx, ty) = path(proj.s + la).1;
-                        let e = steering::bearing(tx - p.pos_x, ty - p.pos_y, (sin, cos));
+                        let e = geometry::bearing(tx - p.pos_x, ty - p.pos_y, (sin, cos));
                         let integral = if from_table {
                             &mut table_integral
                         } else {

@@ -28,7 +28,6 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use super::Car;
-use crate::data_path::DataPath;
 use crate::error::{Error, Result};
 
 /// Scales over a car's uncertain parameters; 1 leaves the car as its file gives it.
@@ -203,16 +202,17 @@ fn one_line(e: &toml::de::Error) -> String {
         .join(" ")
 }
 
-/// Reads a calibrated car file: its base (found as `--car` finds a car) with its scales.
-pub fn read(path: &Path, data: &DataPath) -> Result<Car> {
+/// Reads a calibrated car file: its base, found by `find_base` (as `--car` finds a car,
+/// [`super::catalog::find`]), with its scales.
+pub fn read(path: &Path, find_base: &dyn Fn(&str) -> Result<Car>) -> Result<Car> {
     let text = crate::bounded::read_text(path, &crate::bounded::CAR_FILE)?;
     let file = path.display().to_string();
     let c = Calibration::parse(&text, &file)?;
     // A relative file path as base is read beside the calibration.
     let beside = path.parent().map(|d| d.join(&c.base));
     let base = match beside.filter(|p| p.is_file()) {
-        Some(p) => super::catalog::find(&p.display().to_string(), data),
-        None => super::catalog::find(&c.base, data),
+        Some(p) => find_base(&p.display().to_string()),
+        None => find_base(&c.base),
     }
     .map_err(|e| Error::parse(&file, "base", e.to_string()))?;
     let mut car = c.scales.apply(&base);

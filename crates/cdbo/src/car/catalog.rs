@@ -21,7 +21,7 @@ pub fn find(spec: &str, data: &DataPath) -> Result<Car> {
     }
     let path = Path::new(spec);
     if path.extension().is_some_and(|e| e == "toml") {
-        return super::calibration::read(path, data);
+        return super::calibration::read(path, &|base| find(base, data));
     }
     if path.extension().is_some_and(|e| e == "xml") || path.is_file() {
         return super::torcs::read(path, None);

@@ -6,6 +6,7 @@
 //! the environment's [`steering::Steering`] controller, which holds that line.
 
 pub mod demo;
+pub mod geometry;
 pub mod steering;
 pub mod tracker;
 

@@ -16,6 +16,7 @@
 //! TORCS robot's `torcs-robot/drive.hpp`, which finds its target on the game's track, can be
 //! checked against them (`tests/robot_drive.rs`).
 
+use super::geometry::bearing;
 use super::pi_control;
 use super::tracker::PathTracker;
 use crate::sim::vehicle::{State, Vehicle};
@@ -151,14 +152,6 @@ impl PiSteering {
     pub fn lookahead(&self, speed: f64) -> f64 {
         (self.lookahead_time * speed).max(self.lookahead_min)
     }
-}
-
-/// The angle (rad, in (−π, π]) from a heading (cos ψ, sin ψ), given as `yaw_sin_cos`
-/// = (sin ψ, cos ψ), to the vector (dx, dy): atan2(cos ψ·dy − sin ψ·dx, cos ψ·dx + sin ψ·dy).
-#[inline]
-pub fn bearing(dx: f64, dy: f64, yaw_sin_cos: (f64, f64)) -> f64 {
-    let (sy, cy) = yaw_sin_cos;
-    (cy * dy - sy * dx).atan2(cy * dx + sy * dy)
 }
 
 /// The PI law on the bearing e (rad) of a target d metres ahead: δ = [`pi_control`] with

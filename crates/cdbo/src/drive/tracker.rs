@@ -32,7 +32,7 @@
 //! κ/(1 − κe) and would need e·[κ² + (2/x_p²)·(1 + x_p·κ²·(m·a·v²/(L·C_r) − b))] = 0). The test
 //! `the_tracker_holds_an_offset_on_a_circle` checks this steady state on the simulator's car.
 
-use super::steering::bearing;
+use super::geometry::bearing;
 use crate::car::Car;
 use crate::sim::vehicle::{State, Vehicle};
 use crate::track::{Projection, Track};
