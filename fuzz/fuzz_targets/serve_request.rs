@@ -65,6 +65,8 @@ fuzz_target!(|data: &[u8]| {
         track: "fuzz".into(),
         length_m: 1000.0,
         limit_reward_mps: 40.0,
+        line: None,
+        base_line: Default::default(),
     };
     let mut out = Vec::new();
     Server { info, evaluator: Checked }.serve(data, &mut out).unwrap();
