@@ -62,8 +62,8 @@ impl Venue {
     /// This venue with the car holding `line` where a policy has none (a policy's line is
     /// then an offset from it, [`crate::sim::LapConfig::line`]), in the simulator and in the
     /// game alike (there the robot is handed the line, [`crate::torcs::line`]).
-    pub fn on_line(self, line: Arc<RacingLine>) -> Result<Venue> {
-        Ok(self.configured(|config| config.line = Some(line)))
+    pub fn on_line(self, line: Arc<RacingLine>) -> Venue {
+        self.configured(|config| config.line = Some(line))
     }
 
     /// This venue with its laps' settings changed by `change`.

@@ -32,8 +32,7 @@ fn the_min_curvature_start_line_lies_within_the_road() {
     let steering = cdbo::drive::steering::Steering::Tracker(Default::default());
     let venue = Venue::simulator(track.clone(), &car)
         .steered(steering)
-        .on_line(line.clone())
-        .unwrap();
+        .on_line(line.clone());
     let (demo, _) = venue.demonstrate(15.0).unwrap();
     assert!(demo.completed);
     let n = demo.trace.len() as f64;

@@ -202,7 +202,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     // The speed plots re-drive the initial and best policies where the race was driven, on
     // its base line.
     let venue = match &outcome.line {
-        Some(line) => venue.on_line(line.clone())?,
+        Some(line) => venue.on_line(line.clone()),
         None => venue,
     };
     let drive = |p: &Policy| venue.drive(p);

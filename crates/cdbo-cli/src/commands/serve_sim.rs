@@ -38,7 +38,7 @@ pub fn run(args: &ServeSimArgs, data: &DataPath, simulator: Simulator) -> CliRes
     let (base_line, line_kernels) = args.line.resolve(args.kernels)?;
     let (venue, track, car) = super::venue(&args.setup, data, simulator)?;
     let venue = match base_line.line(&track, &car)? {
-        Some(line) => venue.on_line(line)?,
+        Some(line) => venue.on_line(line),
         None => venue,
     };
     let limit = cdbo::limit::limit_lap(&track, &car);

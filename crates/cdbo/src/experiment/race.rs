@@ -189,7 +189,7 @@ pub fn race(
     let on_line;
     let venue = match &line {
         Some(l) => {
-            on_line = venue.clone().on_line(l.clone())?;
+            on_line = venue.clone().on_line(l.clone());
             &on_line
         }
         None => venue,
