@@ -47,7 +47,7 @@
  *   downshift_margin F           hysteresis of the down-shift
  *   shift_time S                 (s) no new shift decision during a shift
  *   driven F R                   weights of the front and rear axle's spin in the drive speed
- *   aid_slip F R                 slip at which ABS / traction control start easing, per axle
+ *   aid_slip F R                 slip at which ABS starts easing, per axle
  *   off_track_margin M           (m) beyond half the width
  *   time_limit S                 (s)
  */
@@ -377,11 +377,15 @@ double launch_clutch(tCarElt *car, double throttle, double dt) {
     return drive::launch_clutch(lap.gear, throttle, dt, lap.launch_time, c);
 }
 
+/// Slip speed of an axle, omega R - v (m/s).
+double axle_slip_speed(tCarElt *car, int axle) {
+    double r = 0.5 * (car->_wheelRadius(2 * axle) + car->_wheelRadius(2 * axle + 1));
+    return axle_omega(car, axle) * r - car->_speed_x;
+}
+
 /// Longitudinal slip of an axle, (omega R - v) / max(|v|, v0).
 double axle_slip(tCarElt *car, int axle) {
-    double v = car->_speed_x;
-    double r = 0.5 * (car->_wheelRadius(2 * axle) + car->_wheelRadius(2 * axle + 1));
-    return (axle_omega(car, axle) * r - v) / std::fmax(std::fabs(v), kSlipSpeedFloor);
+    return axle_slip_speed(car, axle) / std::fmax(std::fabs(car->_speed_x), kSlipSpeedFloor);
 }
 
 void json_string(FILE *f, const std::string &s) {
@@ -528,13 +532,11 @@ void drive(int, tCarElt *car, tSituation *s) {
     double delta = lap.cfg.tracker ? tracker_steer(car, speed) : steer(car, speed, dt);
     choose_gear(car, std::fmax(a, 0.0), dt);
 
-    // Traction control and ABS, as cdbo's vehicle applies them (sim/vehicle.rs).
-    double throttle = std::fmax(a, 0.0), brake = std::fmax(-a, 0.0);
+    // Traction control on the driven axle's slip speed, at the driver's steps
+    // (torcs/traction.rs); ABS as cdbo's vehicle applies it (sim/vehicle.rs).
+    double brake = std::fmax(-a, 0.0);
     int k = lap.cfg.driven[1] > 0.0 ? 1 : 0;
-    double spin = axle_slip(car, k);
-    double thr = lap.cfg.aid_slip[k];
-    // Not while pulling away: there the game's clutch slips and its wheels spin up at once.
-    if (thr > 0.0 && spin > thr && speed > kSlipSpeedFloor) throttle *= clamp(2.0 - spin / thr, 0.0, 1.0);
+    double throttle = drive::traction_throttle(std::fmax(a, 0.0), axle_slip_speed(car, k));
     for (int axle = 0; axle < 2 && brake > 0.0; axle++) {
         double slide = -axle_slip(car, axle);
         double th = lap.cfg.aid_slip[axle];

@@ -9,7 +9,7 @@
  *
  * Everything the robot (cdbo.cpp) decides from numbers it has gathered: the pedal (the policy
  * pi(x), the demonstrator's speed hold), the line it holds, the steering laws (the PI law and
- * the path tracker), the gearbox and the launch clutch.
+ * the path tracker), the gearbox, the launch clutch and the traction control.
  * No TORCS header is needed: cdbo.cpp reads the game's car and track and calls these, and
  * crates/cdbo/tests/robot_drive.rs compiles this header alone into a harness
  * (tests/harness.cpp) and checks each function against its Rust definition, named on each,
@@ -281,6 +281,20 @@ inline double launch_clutch(std::size_t gear, double throttle, double dt, double
     double wheel_speed_at_red = std::fabs(car.wheel_radius * red / car.first_ratio);
     double rolling = (kLaunchSpeed + std::fmax(0.0, car.speed_x)) / wheel_speed_at_red;
     return std::fmin(ramp, std::fmax(0.0, 1.0 - rolling * 2.0 * above_half / red));
+}
+
+// ---- Traction control ----------------------------------------------------------------------
+
+/// (m/s) the driven wheels' slip speed past which the throttle eases (torcs/traction.rs).
+constexpr double kTractionSlip = 2.0;
+/// (m/s) the slip speed past kTractionSlip that takes the whole throttle away.
+constexpr double kTractionRange = 10.0;
+
+/// The throttle after traction control (torcs/traction.rs traction_throttle), for the driven
+/// wheels' slip speed s = w R - vx: a - min(a, max(0, s - kTractionSlip) / kTractionRange).
+inline double traction_throttle(double throttle, double slip_speed) {
+    double excess = std::fmax(slip_speed - kTractionSlip, 0.0);
+    return throttle - std::fmin(throttle, excess / kTractionRange);
 }
 
 }  // namespace drive

@@ -175,6 +175,11 @@ const std::map<std::string, Case> kCases = {
          double c = drive::launch_clutch(gear, throttle, dt, launch_time, car);
          return std::vector<double>{c, launch_time};
      }},
+    {"traction_throttle",  // THROTTLE SLIP_SPEED -> a
+     [](Args &a) {
+         double throttle = a.num();
+         return std::vector<double>{drive::traction_throttle(throttle, a.num())};
+     }},
 };
 
 }  // namespace

@@ -6,7 +6,7 @@
 //! The calls replay states recorded from two laps of cdbo's simulator on the default track
 //! (the 15 m/s demonstration, and a policy learned by `cdbo race`): at every driver step the
 //! policy's action (RKHS and table), the speed hold, the steering's look-ahead, bearing and
-//! PI law, the gearbox and the launch clutch, each given the state the Rust controller had
+//! PI law, the gearbox, the launch clutch and the traction control, each given the state the Rust controller had
 //! (integrals, gear, time left in a shift), and the answers must equal the Rust definitions
 //! bit for bit (within 1e-12 of the simulator's O(1) form of the RKHS policy). Skips with a
 //! message where `g++` is missing.
@@ -40,6 +40,7 @@ use cdbo::sim::{Simulator, TracePoint};
 use cdbo::torcs::lap::cornering_tables;
 use cdbo::torcs::launch::{LaunchCar, launch_clutch};
 use cdbo::torcs::line::LineTable;
+use cdbo::torcs::traction::traction_throttle;
 use cdbo::torcs::{ROBOT_CXXFLAGS, ROBOT_HEADER, ROBOT_HEADER_NAME};
 use cdbo::track::builtin::DEFAULT;
 use common::builtin;
@@ -231,13 +232,13 @@ fn the_robots_decisions_are_the_rust_ones_on_recorded_laps() {
         .collect::<Vec<f64>>();
     let steer = PiSteering::new();
     let dt = sim.config.dt * sim.config.driver_every as f64;
-    let (mut upshifts, mut downshifts, mut top_gear, mut slipping) = (0, 0, 0, 0);
+    let (mut upshifts, mut downshifts, mut top_gear, mut slipping, mut easing) = (0, 0, 0, 0, 0);
     for (lap, trace) in [("demonstration", &demo), ("learned policy", &fast)] {
         let (mut hold, mut hold_integral) = (SpeedHold::new(15.0), 0.0);
         let (mut steer_integral, mut hint) = (0.0, 0);
         let (mut gearbox, mut launch_time) = (Gearbox::new(), 0.0);
         let mut last_t = trace[0].t;
-        for p in trace.iter() {
+        for (i, p) in trace.iter().enumerate() {
             let at = format!("{lap} at t = {} s", p.t);
             // The policies at the recorded lap fraction: the direct sum bit for bit, the
             // simulator's O(1) form within 1e-12.
@@ -353,6 +354,19 @@ fn the_robots_decisions_are_the_rust_ones_on_recorded_laps() {
                 &[c, launch_time],
                 Agree::Exactly,
             );
+
+            // Traction control on the recorded throttle, at slip speeds from −2 to 12 m/s
+            // (the simulator's trace records none), 0.5 m/s apart step by step.
+            let slip = -2.0 + 0.5 * (i % 29) as f64;
+            let eased = traction_throttle(throttle, slip);
+            easing += usize::from(eased < throttle && eased > 0.0);
+            calls.check(
+                &at,
+                "traction_throttle",
+                &[throttle, slip],
+                &[eased],
+                Agree::Exactly,
+            );
         }
     }
     // The states span the decisions: every gear both ways, a slipping clutch, a fast lap.
@@ -362,6 +376,7 @@ fn the_robots_decisions_are_the_rust_ones_on_recorded_laps() {
         "{upshifts} up, {downshifts} down"
     );
     assert!(slipping >= 10, "{slipping} steps with the clutch slipping");
+    assert!(easing >= 100, "{easing} steps with the throttle eased");
     let fastest = fast.iter().map(|p| p.speed).fold(0.0, f64::max);
     assert!(fastest > 25.0, "{fastest} m/s");
 

@@ -97,6 +97,13 @@ impl Drop for LapDir {
     }
 }
 
+/// How far behind the start line (m) the shipped robots stand when they are timed: a hair, so
+/// the game's first lap is a standing lap on every track. With the grid on the line (0 m), on
+/// Aalborg the car stands just past it and the game's first lap is a standing lap plus a flying
+/// one (berniw2: 152.19 s; 78.15 s from 0.1 m behind, 78.25 s from 1 m, 78.32 s from 5 m).
+/// cdbo's own robot stands on the line and times one track length itself.
+pub const ROBOT_GRID_BEHIND: f64 = 0.1;
+
 /// The robot's `drivers/cdbo/cdbo.xml`: one driver of `car`, whose settings are `settings`.
 pub fn robot_xml(car: &str, settings: &str) -> String {
     format!(
@@ -123,9 +130,16 @@ pub fn robot_xml(car: &str, settings: &str) -> String {
     )
 }
 
-/// A one-car quick race of `laps` laps on `track` (in `category`): driver `idx` of `robot` on
-/// the start line.
-fn race_xml(track: &str, category: &str, robot: &str, idx: usize, laps: usize) -> String {
+/// A one-car quick race of `laps` laps on `track` (in `category`): driver `idx` of `robot`
+/// standing `behind` metres behind the start line.
+fn race_xml(
+    track: &str,
+    category: &str,
+    robot: &str,
+    idx: usize,
+    laps: usize,
+    behind: f64,
+) -> String {
     format!(
         r#"<?xml version="1.0" encoding="UTF-8"?>
 <!DOCTYPE params SYSTEM "params.dtd">
@@ -151,7 +165,7 @@ fn race_xml(track: &str, category: &str, robot: &str, idx: usize, laps: usize) -
     <attstr name="restart" val="yes"/>
     <section name="Starting Grid">
       <attnum name="rows" val="1"/>
-      <attnum name="distance to start" val="0"/>
+      <attnum name="distance to start" val="{behind}"/>
       <attnum name="distance between columns" val="0"/>
       <attnum name="offset within a column" val="0"/>
       <attnum name="initial speed" val="0"/>
@@ -357,7 +371,7 @@ impl Game {
             ),
             (
                 dir.0.join("race.xml"),
-                race_xml(&req.track, &category, ROBOT, 0, 2),
+                race_xml(&req.track, &category, ROBOT, 0, 2, 0.0),
             ),
         ];
         for (path, text) in &files {
@@ -470,8 +484,9 @@ impl Game {
     }
 
     /// A built-in robot (`bt`, `berniw`, ...) driving `car` on `track` for two laps from the
-    /// same standing start: (the first lap's time, the best lap's time) in seconds; no best
-    /// lap where the game records none (0: the robot did not finish its second lap).
+    /// same standing start, [`ROBOT_GRID_BEHIND`] behind the start line: (the first lap's
+    /// time, the best lap's time) in seconds; no best lap where the game records none (0: the
+    /// robot did not finish its second lap).
     pub fn robot_laps(&self, robot: &str, track: &str, car: &str) -> Result<(f64, Option<f64>)> {
         let category = self.install.track_category(track)?;
         self.install.check_car(car)?;
@@ -509,7 +524,14 @@ impl Game {
             })
             .collect::<Vec<_>>()
             .join("\n");
-        let race = race_xml(track, &category, robot, first_driver(&original), 2);
+        let race = race_xml(
+            track,
+            &category,
+            robot,
+            first_driver(&original),
+            2,
+            ROBOT_GRID_BEHIND,
+        );
         let files = [
             (robot_dir.join(format!("{robot}.xml")), ours),
             (dir.0.join("race.xml"), race),
