@@ -151,3 +151,35 @@ fn serve_sim_and_lap_drive_a_policy_on_its_line() {
     let again = json(&ok(&dir, &["lap", "--policy", "r/old.json", "--json"]));
     assert_eq!(again["reward_mps"], lapped["reward_mps"]);
 }
+
+/// `cdbo ceiling --line min-curvature --json` tracks the line's limit and names the centre
+/// line's beside it, the limits `cdbo limit --json` prints for both; on the centre line no
+/// second limit is written.
+#[test]
+fn the_ceiling_on_the_line_names_both_limits() {
+    let dir = fresh_dir("ceiling-line");
+    let limit = json(&ok(&dir, &["limit", "--json"]));
+    let on_line = json(&ok(
+        &dir,
+        &[
+            "ceiling",
+            "--kernels",
+            "6",
+            "--steering",
+            "tracker",
+            "--line",
+            "min-curvature",
+            "--json",
+        ],
+    ));
+    assert_eq!(on_line["centre_line_limit_mps"], limit["reward_mps"]);
+    assert_eq!(
+        on_line["limit_mps"],
+        limit["min_curvature_line"]["reward_mps"]
+    );
+    let tracked = on_line["tracked_mps"].as_f64().unwrap();
+    assert!(tracked > 0.0 && tracked < on_line["limit_mps"].as_f64().unwrap());
+    let centre = json(&ok(&dir, &["ceiling", "--kernels", "6", "--json"]));
+    assert_eq!(centre["limit_mps"], limit["reward_mps"]);
+    assert!(centre.get("centre_line_limit_mps").is_none(), "{centre}");
+}

@@ -25,6 +25,15 @@ pub struct CeilingArgs {
     json: bool,
 }
 
+/// `--json`: the ceiling, and the centre line's limit when it was measured on another line.
+#[derive(serde::Serialize)]
+struct CeilingReport<'a> {
+    #[serde(flatten)]
+    ceiling: &'a cdbo::ceiling::Ceiling,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    centre_line_limit_mps: Option<f64>,
+}
+
 pub fn run(args: &CeilingArgs, data: &DataPath) -> CliResult {
     if args.kernels < 2 {
         return Err(format!("--kernels {}: a policy needs at least 2", args.kernels).into());
@@ -41,13 +50,26 @@ pub fn run(args: &CeilingArgs, data: &DataPath) -> CliResult {
     } else {
         "centre-line"
     };
+    // Every "% of the limit" elsewhere is of the centre line's: said beside the line's own.
+    let centre_mps = line
+        .as_ref()
+        .map(|_| cdbo::limit::limit_lap(&track, &car).reward_mps);
     let mut sim = cdbo::sim::Simulator::new(track, &car);
     sim.config.steering = args.steering.steering();
     sim.config.line = line;
     let c = ceiling_with(&sim, &limit, args.kernels)?;
     if args.json {
-        return print_json(&c);
+        return print_json(&CeilingReport {
+            ceiling: &c,
+            centre_line_limit_mps: centre_mps,
+        });
     }
+    let of_centre = centre_mps.map_or(String::new(), |v| {
+        format!(
+            ", {:.1} % of the centre-line limit {v:.2} m/s",
+            100.0 * c.tracked_mps / v
+        )
+    });
     let pct = |v: f64| 100.0 * v / c.limit_mps;
     let policy = if c.policy.is_some() {
         format!(
@@ -60,7 +82,7 @@ pub fn run(args: &CeilingArgs, data: &DataPath) -> CliResult {
         format!("none completes within {} laps", cdbo::ceiling::REPAIR_LAPS)
     };
     println!(
-        "{} on {}: {which} limit {:.2} m/s; tracking {:.3} x the limit's speed profile {:.2} m/s ({:.1} % of the {which} limit); {}-kernel policy fitted to its pedal, repaired where it fails: {}",
+        "{} on {}: {which} limit {:.2} m/s; tracking {:.3} x the limit's speed profile {:.2} m/s ({:.1} % of the {which} limit{of_centre}); {}-kernel policy fitted to its pedal, repaired where it fails: {}",
         car.name,
         name,
         c.limit_mps,
