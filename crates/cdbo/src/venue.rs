@@ -66,6 +66,13 @@ impl Venue {
         self.configured(|config| config.line = Some(line))
     }
 
+    /// This venue with a lap failing once the car's centre is `margin` metres past the road's
+    /// edge ([`LapConfig::off_track_margin`]; negative: inside the road), in the simulator and
+    /// the game alike.
+    pub fn off_track_at(self, margin: f64) -> Venue {
+        self.configured(|config| config.off_track_margin = margin)
+    }
+
     /// This venue with its laps' settings changed by `change`.
     fn configured(self, change: impl FnOnce(&mut LapConfig)) -> Venue {
         match self {

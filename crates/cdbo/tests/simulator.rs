@@ -184,6 +184,38 @@ fn coasting_decelerates_by_drag_rolling_resistance_and_the_engine_brake() {
     assert!(s.vy.abs() < 1e-9 && s.yaw.abs() < 1e-12);
 }
 
+/// Over a crest whose vertical curvature exceeds g/v² the road no longer carries the car: full
+/// brakes from 30 m/s take nothing off but the drag, v(t) = v₀/(1 + k·v₀·t) with k = D(v)/(m·v²)
+/// (the rolling resistance goes with the load); on the flat the same brakes take about 0.85 g.
+#[test]
+fn over_a_sharp_enough_crest_the_tyres_carry_nothing() {
+    let track = straight(1000.0);
+    let car = Car::spirit_300();
+    let vehicle = Vehicle::new(&car);
+    let (v0, seconds, dt): (f64, f64, f64) = (30.0, 0.1, 0.002);
+    let brake = |vertical_curvature: f64| {
+        let mut frame = *track.frame(0);
+        frame.vertical_curvature = vertical_curvature;
+        let mut s = vehicle.at_rest(0.0, 0.0, 0.0);
+        s.vx = v0;
+        s.omega = [v0 / car.front_tyre.radius, v0 / car.rear_tyre.radius];
+        let c = Controls::new(0.0, 0.0, 1.0);
+        for _ in 0..(seconds / dt).round() as usize {
+            vehicle.step(&mut s, &c, &frame, dt);
+        }
+        s.vx
+    };
+    let airborne = brake(-2.0 * G / (v0 * v0));
+    let k = car.drag(v0) / (car.mass * v0 * v0);
+    let drag_only = v0 / (1.0 + k * v0 * seconds);
+    assert!(
+        (airborne - drag_only).abs() < 1e-3,
+        "{airborne} vs {drag_only}"
+    );
+    let flat = brake(0.0);
+    assert!(v0 - flat > 0.8 * G * seconds, "{flat}");
+}
+
 #[test]
 fn braking_never_beats_the_friction_limit() {
     // Full brakes from 30 m/s: the stopping distance is at least v²/(2·μ_peak·g) (ABS on).

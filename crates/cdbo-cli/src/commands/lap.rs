@@ -34,6 +34,10 @@ pub struct LapArgs {
     /// How the car steers.
     #[arg(long, value_enum, default_value_t)]
     steering: super::SteeringChoice,
+    /// Where the lap leaves the road: once the car's centre is this far past the road's edge
+    /// (m; 1, the game's rule; negative: inside the road, as `race --off-track-margin`).
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true, value_parser = super::value::off_track_margin)]
+    off_track_margin: f64,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -122,6 +126,7 @@ pub fn run(args: &LapArgs, data: &DataPath, simulator: Simulator) -> CliResult {
     let line = base_line.line(&track, &car)?;
     let mut sim = cdbo::sim::Simulator::new(track, &car);
     sim.config.steering = args.steering.steering();
+    sim.config.off_track_margin = args.off_track_margin;
     sim.config.line = line;
     sim.config.trace = args.trace.is_some() || args.plot.is_some();
     let lap = sim.lap(pedal.as_mut());
@@ -188,6 +193,7 @@ fn run_torcs(args: &LapArgs, data: &DataPath) -> CliResult {
     let car_name = Simulator::Torcs.car(&args.setup.car);
     let mut req = game.request(&args.setup.track, car_name, pedal)?;
     req.config.steering = args.steering.steering();
+    req.config.off_track_margin = args.off_track_margin;
     let track = super::game_track(&args.setup.track, &game, data)?;
     // The policy's line on the base line it was raced on (none: the centre line, no table).
     if let Some(raced) = policy {

@@ -256,6 +256,15 @@ pub mod value {
             Err("must be at least 0".into())
         }
     }
+    /// Where a lap leaves the road: metres past the road's edge, within [−3, 5].
+    pub fn off_track_margin(text: &str) -> Result<f64, String> {
+        let v = number(text)?;
+        if (-3.0..=5.0).contains(&v) {
+            Ok(v)
+        } else {
+            Err("must be within [-3, 5] m past the road's edge (negative: inside it)".into())
+        }
+    }
     /// A pedal command in [−1, 1].
     pub fn pedal(text: &str) -> Result<f64, String> {
         let v = number(text)?;

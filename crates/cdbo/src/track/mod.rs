@@ -101,7 +101,17 @@ pub struct Frame {
     pub sin_banking: f64,
     /// cos of the banking.
     pub cos_banking: f64,
+    /// Vertical curvature κ_v = dφ/ds of the pitch φ = atan(grade) (1/m): negative over a
+    /// crest, positive in a dip; the pitch's change over [`VERTICAL_WINDOW_M`] of road.
+    pub vertical_curvature: f64,
 }
+
+/// The length of road (m) over which a frame's vertical curvature is measured: a car's
+/// wheelbase or two. The heights of TORCS's tracks are linear on sub-segments of a few metres
+/// (their `profil steps`), so the pitch is piecewise constant; its changes are spread over
+/// this window rather than felt as kinks, as a car's suspension and tyres spread them
+/// (measured: windows of 2 to 30 m place the game's failures alike).
+pub const VERTICAL_WINDOW_M: f64 = 6.0;
 
 impl Frame {
     fn of(c: &Sample) -> Frame {
@@ -122,6 +132,7 @@ impl Frame {
             cos_pitch,
             sin_banking,
             cos_banking,
+            vertical_curvature: 0.0,
         }
     }
 }
@@ -147,8 +158,15 @@ impl Track {
         samples: Vec<Sample>,
         warnings: Vec<String>,
     ) -> Track {
-        let frames = samples.iter().map(Frame::of).collect();
         let ds = length / samples.len() as f64;
+        let mut frames: Vec<Frame> = samples.iter().map(Frame::of).collect();
+        // κ_v(sᵢ) = (φ(sᵢ + h) − φ(sᵢ − h)) / 2h around the lap, 2h ≈ VERTICAL_WINDOW_M.
+        let n = samples.len();
+        let h = ((0.5 * VERTICAL_WINDOW_M / ds).round() as usize).clamp(1, (n / 2).max(1));
+        for (i, f) in frames.iter_mut().enumerate() {
+            let pitch = |j: usize| samples[j % n].grade.atan();
+            f.vertical_curvature = (pitch(i + h) - pitch(i + n - h)) / (2 * h) as f64 / ds;
+        }
         Track {
             name: name.to_owned(),
             source: source.to_owned(),
@@ -504,6 +522,41 @@ mod tests {
             ..Piece::flat(std::f64::consts::TAU * radius, 1.0 / radius)
         };
         Track::from_pieces("circle", "test", &[p], vec![])
+    }
+
+    /// A circle whose height is z(s) = A·cos(2πs/L), built of 10 cm pieces each linear in z: the
+    /// frames' vertical curvature is dφ/ds = z''/(1 + z'²), φ = atan z', within 2 % of its
+    /// largest value, negative over the crest (s = 0) and positive in the dip (s = L/2).
+    #[test]
+    fn the_vertical_curvature_is_the_pitchs_rate_of_change() {
+        let (radius, amplitude) = (100.0, 5.0);
+        let length = std::f64::consts::TAU * radius;
+        let n = (10.0 * length).round() as usize;
+        let ds = length / n as f64;
+        let z = |s: f64| amplitude * (std::f64::consts::TAU * s / length).cos();
+        let pieces: Vec<Piece> = (0..n)
+            .map(|i| Piece {
+                z0: z(i as f64 * ds),
+                z1: z((i + 1) as f64 * ds),
+                width: 10.0,
+                ..Piece::flat(ds, 1.0 / radius)
+            })
+            .collect();
+        let t = Track::from_pieces("hills", "test", &pieces, vec![]);
+        let w = std::f64::consts::TAU / length;
+        let largest = amplitude * w * w;
+        for i in 0..t.len() {
+            let s = t.sample(i).s;
+            let (dz, ddz) = (-amplitude * w * (w * s).sin(), -largest * (w * s).cos());
+            let expected = ddz / (1.0 + dz * dz);
+            let got = t.frame(i).vertical_curvature;
+            assert!(
+                (got - expected).abs() < 0.02 * largest,
+                "s = {s}: {got} vs {expected}"
+            );
+        }
+        assert!(t.frame(0).vertical_curvature < -0.98 * largest);
+        assert!(t.frame(t.len() / 2).vertical_curvature > 0.98 * largest);
     }
 
     #[test]
