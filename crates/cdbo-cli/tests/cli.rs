@@ -393,6 +393,52 @@ fn a_race_with_a_learned_line_writes_and_drives_it() {
     let _ = std::fs::remove_dir_all(&out);
 }
 
+/// A race's summary says how it drove (simulator, steering, off-track margin), and its best
+/// policy's file drives its lap again with the steering it was raced with, where the PI
+/// drives another lap.
+#[test]
+fn a_race_records_how_it_drove_and_its_policy_replays_so() {
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("cdbo-cli-race-steered-{}", std::process::id()));
+    let v = json(&[
+        "race",
+        "--laps",
+        "20",
+        "--kernels",
+        "20",
+        "--steering",
+        "tracker",
+        "--off-track-margin",
+        "0.5",
+        "--method",
+        "pattern-search",
+        "--json",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(v["steering"].as_str(), Some("tracker"));
+    assert_eq!(v["off_track_margin_m"].as_f64(), Some(0.5));
+    assert_eq!(v["simulator"].as_str(), Some("cdbo"));
+    let best = v["best_reward_mps"].as_f64().unwrap();
+    assert!(best > 30.0, "{best}");
+    let policy = out.join("best_policy.json");
+    let text = std::fs::read_to_string(&policy).unwrap();
+    assert!(text.contains("\"steering\": \"tracker\""), "{text}");
+    let policy = policy.to_str().unwrap();
+    let again = json(&[
+        "lap",
+        "--policy",
+        policy,
+        "--off-track-margin",
+        "0.5",
+        "--json",
+    ]);
+    assert_eq!(again["reward_mps"].as_f64(), Some(best));
+    let pi = json(&["lap", "--policy", policy, "--steering", "pi", "--json"]);
+    assert_ne!(pi["reward_mps"].as_f64(), Some(best));
+    let _ = std::fs::remove_dir_all(&out);
+}
+
 /// `--line min-curvature` races on the racing line and says so; `--line-start` is refused
 /// without `--line learn`.
 #[test]

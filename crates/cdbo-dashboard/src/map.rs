@@ -41,13 +41,14 @@ pub struct MapView {
     pub line_y: Vec<f64>,
 }
 
-/// Drives `policy` once on `track` with `car`, on the line it was raced on, and returns its
-/// path and speed, and the line it holds (as the simulator clamps it,
+/// Drives `policy` once on `track` with `car`, on the line and with the steering it was raced
+/// with, and returns its path and speed, and the line it holds (as the simulator clamps it,
 /// [`Simulator::held_line`]) where that is not the centre line.
 pub fn drive(track: Track, car: &Car, key: String, raced: &RacedPolicy) -> Result<MapView> {
     let line = raced.base_line.line(&track, car)?;
     let mut sim = Simulator::new(track, car);
     sim.config.line = line;
+    sim.config.steering = raced.steering.steering();
     sim.config.trace = true;
     let lap = sim.lap(&mut raced.policy.driver());
     let every = lap.trace.len().div_ceil(MAP_POINTS).max(1);
@@ -93,6 +94,7 @@ mod tests {
         let paper = RacedPolicy {
             policy: Policy::from(pedal.clone()),
             base_line: BaseLine::Centre,
+            steering: Default::default(),
         };
         let learned = RacedPolicy {
             policy: Policy {

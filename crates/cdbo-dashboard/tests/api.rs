@@ -116,6 +116,7 @@ fn run_record(method: &str, repeat: usize, rewards: &[f64]) -> RunRecord {
         lengthscale: LENGTHSCALE,
         line_kernels: None,
         base_line: Default::default(),
+        steering: Default::default(),
         laps,
         wall_s: 1.0,
     }

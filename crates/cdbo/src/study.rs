@@ -28,6 +28,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use crate::drive::steering::SteeringLaw;
 use crate::error::{Error, Result};
 pub use crate::evaluator::Outcome;
 use crate::experiment::line::{BaseLine, RacedPolicy};
@@ -114,6 +115,7 @@ impl StudyConfig {
         Ok(RacedPolicy {
             policy: self.shape()?.policy(weights)?,
             base_line: self.base_line,
+            steering: SteeringLaw::Pi,
         })
     }
 

@@ -8,6 +8,7 @@ use serde::Serialize;
 use super::{CliResult, Setup, Simulator, print_json};
 use cdbo::data_path::DataPath;
 use cdbo::drive::demo::{DEFAULT_TARGET_SPEED, SpeedHold};
+use cdbo::drive::steering::SteeringLaw;
 use cdbo::drive::{ConstantPedal, Pedal};
 use cdbo::experiment::line::BaseLine;
 use cdbo::limit::limit_lap;
@@ -28,12 +29,13 @@ pub struct LapArgs {
     throttle: Option<f64>,
     /// Drive a policy: a table of CSV rows `x,a`, or weights as JSON (`.json`, as written by
     /// `cdbo race`, `cdbo policy fit` and `cdbo optimize`), or a race's folder (its
-    /// `best_policy.json`); a policy raced on a line (`race --line`) is driven on that line.
+    /// `best_policy.json`); a policy is driven on the line and with the steering it was raced
+    /// with (`race --line`, `--steering`).
     #[arg(long, value_name = "FILE")]
     policy: Option<PathBuf>,
-    /// How the car steers.
-    #[arg(long, value_enum, default_value_t)]
-    steering: super::SteeringChoice,
+    /// How the car steers (default: as the policy file says it was raced, else the PI).
+    #[arg(long, value_enum)]
+    steering: Option<super::SteeringChoice>,
     /// Where the lap leaves the road: once the car's centre is this far past the road's edge
     /// (m; 1, the game's rule; negative: inside the road, as `race --off-track-margin`).
     #[arg(long, default_value_t = 1.0, allow_negative_numbers = true, value_parser = super::value::off_track_margin)]
@@ -97,8 +99,9 @@ pub fn run(args: &LapArgs, data: &DataPath, simulator: Simulator) -> CliResult {
         return run_torcs(args, data);
     }
     let (track, car) = args.setup.load(data)?;
-    // A policy raced on a line is driven on it.
+    // A policy raced on a line, or with a steering, is driven so.
     let mut base_line = BaseLine::Centre;
+    let mut steering = SteeringLaw::Pi;
     let mut pedal: Box<dyn Pedal> = match (args.demo, args.throttle, &args.policy) {
         (_, Some(a), _) => {
             if !(-1.0..=1.0).contains(&a) {
@@ -108,7 +111,7 @@ pub fn run(args: &LapArgs, data: &DataPath, simulator: Simulator) -> CliResult {
         }
         (_, _, Some(path)) if path.is_dir() || path.extension().is_some_and(|e| e == "json") => {
             let raced = super::policy::read_raced_policy(path)?;
-            base_line = raced.base_line;
+            (base_line, steering) = (raced.base_line, raced.steering);
             Box::new(raced.policy.driver())
         }
         (_, _, Some(path)) => Box::new(PolicyTable::read_csv(path)?),
@@ -125,7 +128,7 @@ pub fn run(args: &LapArgs, data: &DataPath, simulator: Simulator) -> CliResult {
     let limit = limit_lap(&track, &car);
     let line = base_line.line(&track, &car)?;
     let mut sim = cdbo::sim::Simulator::new(track, &car);
-    sim.config.steering = args.steering.steering();
+    sim.config.steering = args.steering.map_or(steering, |s| s.law()).steering();
     sim.config.off_track_margin = args.off_track_margin;
     sim.config.line = line;
     sim.config.trace = args.trace.is_some() || args.plot.is_some();
@@ -192,7 +195,12 @@ fn run_torcs(args: &LapArgs, data: &DataPath) -> CliResult {
     let game = Game::ready()?;
     let car_name = Simulator::Torcs.car(&args.setup.car);
     let mut req = game.request(&args.setup.track, car_name, pedal)?;
-    req.config.steering = args.steering.steering();
+    let steering = args
+        .steering
+        .map(|s| s.law())
+        .or(policy.as_ref().map(|p| p.steering))
+        .unwrap_or_default();
+    req.config.steering = steering.steering();
     req.config.off_track_margin = args.off_track_margin;
     let track = super::game_track(&args.setup.track, &game, data)?;
     // The policy's line on the base line it was raced on (none: the centre line, no table).
@@ -209,7 +217,7 @@ fn run_torcs(args: &LapArgs, data: &DataPath) -> CliResult {
         .map_err(|reason| format!("TORCS drove no lap: {reason}"))?;
     let limit = limit_lap(&track, &req.car);
     let mut ours = cdbo::sim::Simulator::new(track.clone(), &req.car);
-    ours.config.steering = args.steering.steering();
+    ours.config.steering = steering.steering();
     let (_, ceiling_mps) = cdbo::ceiling::tracked_profile(&ours, &limit)?;
     print_report(
         LapReport::new(&track.name, car_name, &lap, &limit, ceiling_mps, "torcs"),

@@ -57,6 +57,14 @@ impl Simulator {
             _ => spec,
         }
     }
+
+    /// Its name, as `--simulator` takes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Simulator::Cdbo => "cdbo",
+            Simulator::Torcs => "torcs",
+        }
+    }
 }
 
 /// How the car steers (`--steering`).
@@ -71,13 +79,17 @@ pub enum SteeringChoice {
 }
 
 impl SteeringChoice {
-    /// The steering controller, with its documented gains.
-    pub fn steering(self) -> Steering {
+    /// The steering law it names.
+    pub fn law(self) -> SteeringLaw {
         match self {
             SteeringChoice::Pi => SteeringLaw::Pi,
             SteeringChoice::Tracker => SteeringLaw::Tracker,
         }
-        .steering()
+    }
+
+    /// The steering controller, with its documented gains.
+    pub fn steering(self) -> Steering {
+        self.law().steering()
     }
 }
 

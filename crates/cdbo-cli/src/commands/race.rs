@@ -10,6 +10,7 @@ use serde::Serialize;
 use super::policy::read_policy;
 use super::{CliResult, Setup, Simulator, from_flag, print_json};
 use cdbo::data_path::DataPath;
+use cdbo::drive::steering::SteeringLaw;
 use cdbo::experiment::line::RacedPolicy;
 use cdbo::experiment::race::{BaseLine, RaceConfig, RaceOutcome, check_warm_start, race};
 use cdbo::method::{KnobKind, Method};
@@ -86,6 +87,17 @@ pub struct RaceArgs {
 struct Summary {
     method: Method,
     track: String,
+    /// The car, as `--car` named it (the game's car name in TORCS).
+    car: String,
+    /// Where the laps were driven: `cdbo` or `torcs`.
+    simulator: &'static str,
+    /// The steering the car drove with.
+    steering: SteeringLaw,
+    /// Where a lap left the road: the car's centre this far past the road's edge (m).
+    off_track_margin_m: f64,
+    /// The failed laps allowed (`--max-failed-laps`), if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    max_failed_laps: Option<usize>,
     kernels: usize,
     #[serde(skip_serializing_if = "Option::is_none")]
     line_kernels: Option<usize>,
@@ -161,6 +173,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         .steered(args.steering.steering())
         .off_track_at(args.off_track_margin);
     let track_name = track.name.clone();
+    let car_name = simulator.car(&args.setup.car).to_owned();
     let out = args.out.clone().unwrap_or_else(|| {
         PathBuf::from("runs").join(format!(
             "race-{}-{}-m{}{}{}-s{}",
@@ -208,7 +221,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     let mut ceiling_sim = cdbo::sim::Simulator::new(track.clone(), &car);
     ceiling_sim.config.steering = args.steering.steering();
     let (_, ceiling_mps) = cdbo::ceiling::tracked_profile(&ceiling_sim, &outcome.limit)?;
-    write_outputs(&out, &outcome, config.base_line)?;
+    write_outputs(&out, &outcome, config.base_line, args.steering.law())?;
     // The speed plots re-drive the initial and best policies where the race was driven, on
     // its base line.
     let venue = match &outcome.line {
@@ -221,6 +234,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         let raced = RacedPolicy {
             policy: outcome.best.clone(),
             base_line: config.base_line,
+            steering: args.steering.law(),
         };
         super::plot::policy_line(&track, &car, outcome.line.clone(), &raced)
     });
@@ -234,6 +248,11 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     let summary = Summary {
         method: args.method,
         track: track_name,
+        car: car_name,
+        simulator: simulator.name(),
+        steering: args.steering.law(),
+        off_track_margin_m: args.off_track_margin,
+        max_failed_laps: args.max_failed_laps,
         kernels,
         line_kernels: config.line_kernels,
         base_line: config.base_line,
@@ -317,7 +336,13 @@ fn slug(name: &str) -> String {
         .collect()
 }
 
-fn write_outputs(out: &Path, o: &RaceOutcome, base_line: BaseLine) -> CliResult {
+/// The laps as CSV and the best and initial policies, each with how it was driven.
+fn write_outputs(
+    out: &Path,
+    o: &RaceOutcome,
+    base_line: BaseLine,
+    steering: SteeringLaw,
+) -> CliResult {
     let mut laps = std::io::BufWriter::new(std::fs::File::create(out.join("laps.csv"))?);
     writeln!(
         laps,
@@ -351,6 +376,7 @@ fn write_outputs(out: &Path, o: &RaceOutcome, base_line: BaseLine) -> CliResult 
         let raced = RacedPolicy {
             policy: policy.clone(),
             base_line,
+            steering,
         };
         write_policy(out, name, &raced)?;
     }

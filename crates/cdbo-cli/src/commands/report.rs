@@ -156,8 +156,10 @@ pub fn run(args: &ReportArgs, data: &DataPath) -> CliResult {
         figures.extend(tradeoff_figures(&out, track, &tradeoffs)?);
         if let Some(best) = best_cdbo_run(&records, track) {
             let mut sim = cdbo::sim::Simulator::new(load_track(track, data)?, &car);
-            // Driven on the line the run was raced on, the demonstration's included.
+            // Driven on the line and with the steering the run was raced with, the
+            // demonstration's included.
             sim.config.line = best.base_line.line(&sim.track, &car)?;
+            sim.config.steering = best.steering.steering();
             let (_, demo) = sim.demonstrate(best.demo_speed);
             let names = best_policy_figures(&out, track, sim, &car, &demo, best)?;
             figures.push((

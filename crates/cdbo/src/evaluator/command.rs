@@ -19,6 +19,7 @@ use std::time::{Duration, Instant};
 
 use super::{Evaluator, Outcome};
 use crate::bounded;
+use crate::drive::steering::SteeringLaw;
 use crate::error::{Error, Result};
 use crate::experiment::line::{BaseLine, RacedPolicy};
 use crate::policy::PolicyShape;
@@ -183,6 +184,7 @@ impl CommandEvaluator {
         let policy = RacedPolicy {
             policy: self.shape.policy(weights)?,
             base_line: self.base_line,
+            steering: SteeringLaw::Pi,
         };
         let text = serde_json::to_string(&policy_json(&policy))
             .map_err(|e| Error::json(file.display().to_string(), e))?;

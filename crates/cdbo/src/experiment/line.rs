@@ -9,6 +9,7 @@ use std::sync::Arc;
 use serde::{Deserialize, Serialize};
 
 use crate::car::Car;
+use crate::drive::steering::SteeringLaw;
 use crate::error::{Error, Result};
 use crate::line::{LineOptions, RacingLine, SAFETY_MARGIN};
 use crate::policy::Policy;
@@ -191,10 +192,11 @@ impl LineSetting {
     }
 }
 
-/// A policy as a race writes it (`best_policy.json`): the policy's own file ([`Policy`]) and,
-/// when the race held a line other than the centre line, `"base_line": "min-curvature"`, so
-/// that a lap drives it again on that line. A file without it (every file written before it
-/// was stored) is on the centre line.
+/// A policy as a race writes it (`best_policy.json`): the policy's own file ([`Policy`]) and
+/// how the race drove it, so that a lap drives it again the same way: when the race held a
+/// line other than the centre line, `"base_line": "min-curvature"`; when it steered with other
+/// than the paper's PI, `"steering": "tracker"`. A file without them (every file written
+/// before they were stored) is on the centre line with the PI steering.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RacedPolicy {
     /// The policy.
@@ -203,6 +205,9 @@ pub struct RacedPolicy {
     /// The line its offsets are measured from.
     #[serde(default, skip_serializing_if = "BaseLine::is_centre")]
     pub base_line: BaseLine,
+    /// The steering it was raced with.
+    #[serde(default, skip_serializing_if = "SteeringLaw::is_pi")]
+    pub steering: SteeringLaw,
 }
 
 impl RacedPolicy {
@@ -213,11 +218,19 @@ impl RacedPolicy {
             #[serde(default)]
             base_line: BaseLine,
         }
+        #[derive(Deserialize)]
+        struct Steered {
+            #[serde(default)]
+            steering: SteeringLaw,
+        }
         let base: Base = serde_json::from_str(text)
             .map_err(|e| Error::parse(file, "base_line", format!("not a base line: {e}")))?;
+        let steered: Steered = serde_json::from_str(text)
+            .map_err(|e| Error::parse(file, "steering", format!("not a steering law: {e}")))?;
         Ok(RacedPolicy {
             policy: Policy::from_json(text, file)?,
             base_line: base.base_line,
+            steering: steered.steering,
         })
     }
 }
@@ -283,23 +296,28 @@ mod tests {
         );
     }
 
-    /// A policy file keeps its base line; one written before it (or on the centre line) reads
-    /// as the centre line and writes as the paper's file.
+    /// A policy file keeps its base line and steering; one written before them (or on the
+    /// centre line with the PI) reads as the centre line with the PI and writes as the
+    /// paper's file.
     #[test]
-    fn a_policy_file_carries_its_base_line() {
+    fn a_policy_file_carries_its_base_line_and_steering() {
         let pedal = RkhsPolicy::new(vec![0.25, -1.5, 0.75], 0.5).unwrap();
         let raced = RacedPolicy {
             policy: Policy::from(pedal.clone()),
             base_line: BaseLine::MinCurvature,
+            steering: SteeringLaw::Tracker,
         };
         let text = serde_json::to_string(&raced).unwrap();
         assert!(text.contains("\"base_line\":\"min-curvature\""), "{text}");
+        assert!(text.contains("\"steering\":\"tracker\""), "{text}");
         assert_eq!(RacedPolicy::from_json(&text, "p.json").unwrap(), raced);
         let old = serde_json::to_string(&pedal).unwrap();
         let read = RacedPolicy::from_json(&old, "p.json").unwrap();
         assert_eq!(read.base_line, BaseLine::Centre);
+        assert_eq!(read.steering, SteeringLaw::Pi);
         let centre = RacedPolicy {
             base_line: BaseLine::Centre,
+            steering: SteeringLaw::Pi,
             ..raced
         };
         assert_eq!(serde_json::to_string(&centre).unwrap(), old);
@@ -310,5 +328,15 @@ mod tests {
         .unwrap_err()
         .to_string();
         assert!(e.contains("p.json") && e.contains("apex"), "{e}");
+        let e = RacedPolicy::from_json(
+            r#"{"lengthscale": 0.5, "weights": [0, 1], "steering": "stanley"}"#,
+            "p.json",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("p.json") && e.contains("steering") && e.contains("stanley"),
+            "{e}"
+        );
     }
 }

@@ -12,6 +12,7 @@ use super::line::{BaseLine, LineSetting, RacedPolicy};
 use super::race::{LapRecord, RaceConfig, race};
 use crate::bounded;
 use crate::car::Car;
+use crate::drive::steering::SteeringLaw;
 use crate::error::{Error, Result};
 use crate::policy::{Block, PolicyShape};
 use crate::track::Track;
@@ -54,6 +55,9 @@ pub struct RunRecord {
     /// The line the run's car held ([`BaseLine`]); absent: the centre line.
     #[serde(default, skip_serializing_if = "BaseLine::is_centre")]
     pub base_line: BaseLine,
+    /// The steering the run's car drove with; absent: the paper's PI.
+    #[serde(default, skip_serializing_if = "SteeringLaw::is_pi")]
+    pub steering: SteeringLaw,
     /// Every lap.
     pub laps: Vec<LapRecord>,
     /// Wall-clock seconds of the run.
@@ -76,6 +80,7 @@ impl RunRecord {
         Ok(RacedPolicy {
             policy: shape.policy(&self.best_weights)?,
             base_line: self.base_line,
+            steering: self.steering,
         })
     }
 
@@ -232,6 +237,7 @@ pub fn run_at(
         lengthscale: outcome.best.pedal.lengthscale,
         line_kernels,
         base_line,
+        steering: grid.steering,
         laps: outcome.laps,
         wall_s: start.elapsed().as_secs_f64(),
     })
