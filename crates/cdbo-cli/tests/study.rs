@@ -403,3 +403,68 @@ fn serve_sim_answers_json_lines() {
     assert_eq!(ask(&format!(r#"{{"weights": {w0}}}"#)), lap);
     assert!(service.finish().success());
 }
+
+/// A study started from a policy raced with the path tracker steers with it: it takes the
+/// steering from w₀'s file, writes it into each lap's policy file, and `cdbo lap --policy
+/// {policy}` drives its first trial, w₀, to the race's best lap bit for bit (with the PI the
+/// same weights spin). Another steering is refused when the study is created or resumed.
+#[test]
+fn a_study_steers_as_its_initial_policy_was_raced() {
+    let dir = common::fresh_dir("study-steering");
+    let race = [
+        "race",
+        "--json",
+        "--out",
+        "r",
+        "--kernels",
+        "20",
+        "--laps",
+        "20",
+        "--steering",
+        "tracker",
+        "--method",
+        "pattern-search",
+    ];
+    let summary: serde_json::Value = serde_json::from_str(&ok(&dir, &race)).unwrap();
+    let best = summary["best_reward_mps"].as_f64().unwrap();
+    assert!(best > 30.0, "{best}");
+    let pi = ok(
+        &dir,
+        &["lap", "--policy", "r", "--steering", "pi", "--json"],
+    );
+    let pi: serde_json::Value = serde_json::from_str(&pi).unwrap();
+    assert_eq!(pi["completed"], false);
+    let study = [
+        "--storage",
+        "s.db",
+        "--kernels",
+        "20",
+        "--method",
+        "pattern-search",
+    ];
+    let mut create = vec!["study", "create", "s", "--weights", "r/best_policy.json"];
+    create.extend(study);
+    common::refused(
+        &dir,
+        &[&create[..], &["--steering", "pi"]].concat(),
+        &["best_policy.json", "--steering tracker"],
+    );
+    ok(&dir, &create);
+    let evaluator = EVALUATOR.replace("{cdbo}", CDBO);
+    let mut optimize = vec!["optimize", "--evaluator", &evaluator, "--laps", "1"];
+    optimize.extend(study);
+    ok(&dir, &optimize);
+    let first = &history(&dir, "s", "s.db")[0];
+    assert_eq!(
+        first["reward"].as_f64().map(f64::to_bits),
+        Some(best.to_bits())
+    );
+    let status = ok(
+        &dir,
+        &["study", "status", "s", "--storage", "s.db", "--json"],
+    );
+    let status: serde_json::Value = serde_json::from_str(&status).unwrap();
+    assert_eq!(status["steering"], "tracker");
+    optimize.extend(["--steering", "pi"]);
+    common::refused(&dir, &optimize, &["s.db", "--steering tracker", "not pi"]);
+}

@@ -68,6 +68,7 @@ fn study_config() -> StudyConfig {
         warm_start: None,
         line_kernels: None,
         base_line: Default::default(),
+        steering: Default::default(),
     }
 }
 

@@ -3,8 +3,10 @@
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
+use cdbo::drive::steering::SteeringLaw;
 use cdbo::experiment::line::{BaseLine, LineKind, LineSetting};
 use cdbo::experiment::race::{LapRecord, RaceConfig, RaceOutcome};
+use cdbo::sim::lap::checked_off_track_margin;
 
 use crate::convert::IntoPy;
 use crate::sim::{PyLapResult, PyLimit, PyPolicy, car_from, track_from};
@@ -141,12 +143,13 @@ impl PyRaceResult {
 /// Learns a policy for a track exactly as `cdbo race` does (the same laps, bit for bit, for
 /// the same settings): drive the demonstration, fit w0, then `laps` laps of `method`, on the
 /// line `line` (`centre`, `min-curvature` or `learn`, with `line_kernels` and `line_start` as
-/// `cdbo race --line-kernels` and `--line-start`).
+/// `cdbo race --line-kernels` and `--line-start`), steered by `steering` (`pi` or `tracker`),
+/// its laps failing `off_track_margin` m past the road's edge (as `--off-track-margin`).
 /// `track` and `car` are objects or names; `knob` is the method's main knob (`cdbo race
 /// --knob`; None: its tuned value); `progress(record)` is called after every lap with the
 /// lap's record (a dict).
 #[pyfunction]
-#[pyo3(signature = (track = None, car = None, *, method = "cdbo", kernels = 30, laps = 300, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, demo_speed = 15.0, knob = None, max_failed = None, data_dir = None, progress = None, line = "centre", line_kernels = None, line_start = None))]
+#[pyo3(signature = (track = None, car = None, *, method = "cdbo", kernels = 30, laps = 300, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, demo_speed = 15.0, knob = None, max_failed = None, data_dir = None, progress = None, line = "centre", line_kernels = None, line_start = None, steering = "pi", off_track_margin = 1.0))]
 #[allow(clippy::too_many_arguments)]
 pub fn race(
     py: Python<'_>,
@@ -165,9 +168,13 @@ pub fn race(
     line: &str,
     line_kernels: Option<usize>,
     line_start: Option<&str>,
+    steering: &str,
+    off_track_margin: f64,
 ) -> PyResult<PyRaceResult> {
     let track = track_from(py, track, data_dir)?;
     let car = car_from(car, data_dir)?;
+    let steering: SteeringLaw = steering.parse().py()?;
+    let off_track_margin = checked_off_track_margin(off_track_margin).py()?;
     let (base_line, line_kernels) = line_setting(line, line_kernels, line_start)?
         .resolve(kernels)
         .py()?;
@@ -187,7 +194,9 @@ pub fn race(
     let mut callback_error: Option<PyErr> = None;
     let outcome = py
         .detach(|| {
-            let venue = cdbo::venue::Venue::simulator(track.clone(), &car);
+            let venue = cdbo::venue::Venue::simulator(track.clone(), &car)
+                .steered(steering.steering())
+                .off_track_at(off_track_margin);
             cdbo::experiment::race::race(&venue, &track, &car, &config, |r| {
                 if let (Some(cb), None) = (&progress, &callback_error) {
                     Python::attach(|py| {

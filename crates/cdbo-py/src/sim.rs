@@ -7,11 +7,13 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyType};
 
 use cdbo::car::Car;
+use cdbo::drive::steering::SteeringLaw;
 use cdbo::experiment::line::BaseLine;
 use cdbo::limit::{Limit, limit_lap};
 use cdbo::optimizers::FailedLap;
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 use cdbo::policy::{Policy, RkhsPolicy};
+use cdbo::sim::lap::checked_off_track_margin;
 use cdbo::sim::{LapResult, Simulator};
 use cdbo::track::Track;
 
@@ -382,7 +384,9 @@ impl PyLapResult {
 
 /// A track and a car, ready to run laps: `Simulator(track, car)`; `line="min-curvature"` holds
 /// the minimum-curvature racing line (as `cdbo race --line min-curvature`), the demonstration's
-/// included.
+/// included; `steering="tracker"` steers with the path tracker (as `--steering tracker`);
+/// `off_track_margin` is where a lap leaves the road (m past its edge, as
+/// `--off-track-margin`; 1, the game's rule).
 #[pyclass(name = "Simulator", module = "cdbo", frozen)]
 pub struct PySimulator {
     pub sim: Simulator,
@@ -393,20 +397,26 @@ pub struct PySimulator {
 #[pymethods]
 impl PySimulator {
     #[new]
-    #[pyo3(signature = (track = None, car = None, *, data_dir = None, line = "centre"))]
+    #[pyo3(signature = (track = None, car = None, *, data_dir = None, line = "centre", steering = "pi", off_track_margin = 1.0))]
     fn new(
         py: Python<'_>,
         track: Option<&Bound<'_, PyAny>>,
         car: Option<&Bound<'_, PyAny>>,
         data_dir: Option<&Bound<'_, PyAny>>,
         line: &str,
+        steering: &str,
+        off_track_margin: f64,
     ) -> PyResult<Self> {
         let track = track_from(py, track, data_dir)?;
         let car = car_from(car, data_dir)?;
         let base: BaseLine = line.parse().py()?;
+        let steering: SteeringLaw = steering.parse().py()?;
+        let off_track_margin = checked_off_track_margin(off_track_margin).py()?;
         let held = py.detach(|| base.line(&track, &car)).py()?;
         let mut sim = Simulator::new(track, &car);
         sim.config.line = held;
+        sim.config.steering = steering.steering();
+        sim.config.off_track_margin = off_track_margin;
         Ok(PySimulator { sim, base })
     }
 

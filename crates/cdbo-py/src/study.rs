@@ -106,6 +106,7 @@ impl PyStudy {
             warm_start: None,
             line_kernels: None,
             base_line: Default::default(),
+            steering: Default::default(),
         };
         let study = py.detach(|| Study::create(&path, config)).py()?;
         Ok(PyStudy {

@@ -55,3 +55,31 @@ def test_a_fixed_line_and_bad_lines():
         cdbo.race("ridgeway", kernels=10, laps=2, line_start="min-curvature")
     with pytest.raises(ValueError, match="weights"):
         env.step(np.zeros(12))
+
+
+def test_steering_and_the_off_track_margin_are_the_clis(cli, tmp_path):
+    """`steering=` and `off_track_margin=` race what `cdbo race --steering --off-track-margin`
+    races, bit for bit, in `cdbo.race` and a `RaceEnv` loop; bad values are refused."""
+    laps = 20
+    args = ("--method", "pattern-search", "--kernels", 20, "--laps", laps)
+    flags = ("--steering", "tracker", "--off-track-margin", -0.5)
+    summary = json.loads(cli("race", "--json", *args, *flags, "--out", tmp_path))
+    how = dict(steering="tracker", off_track_margin=-0.5)
+    result = cdbo.race("ridgeway", method="pattern-search", kernels=20, laps=laps, **how)
+    assert result.best_reward == summary["best_reward_mps"] > 0
+    assert result.best_reward != cdbo.race(
+        "ridgeway", method="pattern-search", kernels=20, laps=laps, steering="tracker"
+    ).best_reward
+    env = cdbo.RaceEnv("ridgeway", kernels=20, **how)
+    opt = env.optimizer("pattern-search")
+    rewards = []
+    for _ in range(laps):
+        w = opt.ask()
+        lap = env.lap(w)
+        opt.tell(w, lap)
+        rewards.append(float(lap))
+    assert rewards == [lap["reward"] for lap in result.laps]
+    with pytest.raises(ValueError, match="steering"):
+        cdbo.RaceEnv("ridgeway", kernels=10, steering="stanley")
+    with pytest.raises(ValueError, match="off-track margin"):
+        cdbo.race("ridgeway", kernels=10, laps=2, off_track_margin=9.0)

@@ -97,6 +97,10 @@ pub struct StudyConfig {
     /// offsets are measured ([`BaseLine`]); absent: the centre line.
     #[serde(default, skip_serializing_if = "BaseLine::is_centre")]
     pub base_line: BaseLine,
+    /// The steering the car drives with, written into each lap's policy file
+    /// ([`RacedPolicy`]) and used in the game; absent: the paper's PI.
+    #[serde(default, skip_serializing_if = "SteeringLaw::is_pi")]
+    pub steering: SteeringLaw,
 }
 
 impl StudyConfig {
@@ -115,7 +119,7 @@ impl StudyConfig {
         Ok(RacedPolicy {
             policy: self.shape()?.policy(weights)?,
             base_line: self.base_line,
-            steering: SteeringLaw::Pi,
+            steering: self.steering,
         })
     }
 
@@ -570,6 +574,7 @@ mod tests {
             warm_start: None,
             line_kernels: None,
             base_line: Default::default(),
+            steering: Default::default(),
         }
     }
 

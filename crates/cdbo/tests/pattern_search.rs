@@ -671,6 +671,7 @@ fn a_study_told_the_laps_length_drives_the_races_laps() {
                 warm_start: None,
                 line_kernels: None,
                 base_line: Default::default(),
+                steering: Default::default(),
             },
         )
         .unwrap();

@@ -31,6 +31,7 @@ fn config() -> StudyConfig {
         warm_start: None,
         line_kernels: None,
         base_line: Default::default(),
+        steering: Default::default(),
     }
 }
 

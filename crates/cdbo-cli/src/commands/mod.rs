@@ -271,7 +271,7 @@ pub mod value {
     /// Where a lap leaves the road: metres past the road's edge, within [−3, 5].
     pub fn off_track_margin(text: &str) -> Result<f64, String> {
         let v = number(text)?;
-        if (-3.0..=5.0).contains(&v) {
+        if cdbo::sim::lap::OFF_TRACK_MARGINS.contains(&v) {
             Ok(v)
         } else {
             Err("must be within [-3, 5] m past the road's edge (negative: inside it)".into())

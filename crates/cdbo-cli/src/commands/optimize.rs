@@ -116,6 +116,7 @@ pub fn run(args: &OptimizeArgs, simulator: Simulator, data: &DataPath) -> CliRes
             request.timeout = Duration::from_secs_f64(args.timeout);
             // The study's line on its base line, held as cdbo's simulator holds it.
             request.config.line = study.config().base_line.line(&track, &request.car)?;
+            request.config.steering = study.config().steering.steering();
             Box::new(TorcsEvaluator {
                 game,
                 request,
@@ -129,6 +130,7 @@ pub fn run(args: &OptimizeArgs, simulator: Simulator, data: &DataPath) -> CliRes
             files: policy_files(&location),
             shape: study.config().shape()?,
             base_line: study.config().base_line,
+            steering: study.config().steering,
         }),
         (None, None) => {
             return Err("give an --evaluator command or --track (with --simulator torcs)".into());

@@ -89,6 +89,11 @@ pub struct InitialPolicy {
     /// unless --weights gives one).
     #[command(flatten)]
     pub line: LineArgs,
+    /// How the car steers: written into each lap's policy file (`cdbo lap --policy {policy}`
+    /// drives with it) and used in the game (default: the --weights or --warm-start policy's,
+    /// else the paper's PI).
+    #[arg(long, value_enum)]
+    steering: Option<super::SteeringChoice>,
 }
 
 impl InitialPolicy {
@@ -104,6 +109,7 @@ impl InitialPolicy {
             .unwrap_or_else(|| default_lengthscale(self.kernels));
         let (base_line, line_kernels) = self.line.resolve(self.kernels)?;
         let mut line_w0 = None;
+        let mut steering = self.steering.map(|s| s.law());
         let (policy, file) = match (
             &self.demo,
             self.weights.as_ref().or(self.warm_start.as_ref()),
@@ -139,6 +145,16 @@ impl InitialPolicy {
                     )
                     .into());
                 }
+                if steering.is_some_and(|s| s != raced.steering) {
+                    return Err(format!(
+                        "{}: a policy raced with --steering {}; the study's is {}",
+                        w.display(),
+                        raced.steering.name(),
+                        steering.unwrap_or_default().name()
+                    )
+                    .into());
+                }
+                steering = Some(raced.steering);
                 line_w0 = raced.policy.line.map(|l| l.weights);
                 (raced.policy.pedal, w)
             }
@@ -185,6 +201,7 @@ impl InitialPolicy {
             warm_start: self.warm_start.as_ref().map(|p| p.display().to_string()),
             line_kernels,
             base_line,
+            steering: steering.unwrap_or_default(),
         })
     }
 
@@ -238,6 +255,11 @@ impl InitialPolicy {
             "--max-failed-laps",
             self.max_failed_laps.map(|n| n.to_string()),
             stored.max_failed_laps.map(|n| n.to_string()),
+        )?;
+        optional(
+            "--steering",
+            self.steering.map(|s| s.law().name().to_owned()),
+            Some(stored.steering.name().to_owned()),
         )?;
         optional(
             "--warm-start",
@@ -518,6 +540,7 @@ fn status(s: &Study, json: bool) -> CliResult {
         "track_length_m": c.track_length,
         "knob": c.knob,
         "line": LineSetting::of(c.base_line, c.line_kernels).label(),
+        "steering": c.steering.name(),
         "told": told,
         "failed": failed,
         "pending_trial": pending,
@@ -529,13 +552,18 @@ fn status(s: &Study, json: bool) -> CliResult {
         return print_json(&v);
     }
     println!(
-        "{}: {} with {} kernels{}{}; {told} trials told ({failed} failed){}; best {}",
+        "{}: {} with {} kernels{}{}{}; {told} trials told ({failed} failed){}; best {}",
         s.path().display(),
         c.method,
         c.kernels,
         match LineSetting::of(c.base_line, c.line_kernels) {
             line if line == LineSetting::centre() => String::new(),
             line => format!(" on line {}", line.label()),
+        },
+        if c.steering.is_pi() {
+            String::new()
+        } else {
+            format!(" steered by the {}", c.steering.name())
         },
         c.track_length
             .map_or(String::new(), |l| format!(" on a {l} m lap")),

@@ -63,6 +63,11 @@ class RaceEnv(_Base):
     ``line_kernels`` kernels (default ``kernels``) at length-scale ``line_lengthscale``, an
     offset from ``line_start`` (``"centre"`` or ``"min-curvature"``); ``w0``'s line is 0.
     ``base_line`` and ``line_kernels`` say what was resolved.
+
+    ``steering`` is how the car steers, as ``cdbo race --steering``: ``"pi"`` (the paper's)
+    or ``"tracker"`` (the path tracker); ``off_track_margin`` is where a lap leaves the road,
+    as ``--off-track-margin``: the car's centre that many metres past its edge (1, the
+    game's rule; negative: inside the road).
     """
 
     metadata = {"render_modes": []}
@@ -78,11 +83,20 @@ class RaceEnv(_Base):
         line: str = "centre",
         line_kernels=None,
         line_start=None,
+        steering: str = "pi",
+        off_track_margin: float = 1.0,
     ):
         self.base_line, self.line_kernels = resolve_line(
             kernels, line=line, line_kernels=line_kernels, line_start=line_start
         )
-        self.simulator = Simulator(track, car, data_dir=data_dir, line=self.base_line)
+        self.simulator = Simulator(
+            track,
+            car,
+            data_dir=data_dir,
+            line=self.base_line,
+            steering=steering,
+            off_track_margin=off_track_margin,
+        )
         demo, x, a = self.simulator.demonstrate(demo_speed)
         if not demo.completed:
             raise ValueError(

@@ -88,6 +88,31 @@ impl SteeringLaw {
     pub fn is_pi(&self) -> bool {
         *self == SteeringLaw::Pi
     }
+
+    /// Its name, as `--steering` and a grid's `steering` take it: `pi` or `tracker`
+    /// (and [`str::parse`]).
+    pub fn name(&self) -> &'static str {
+        match self {
+            SteeringLaw::Pi => "pi",
+            SteeringLaw::Tracker => "tracker",
+        }
+    }
+}
+
+impl std::str::FromStr for SteeringLaw {
+    type Err = crate::error::Error;
+    fn from_str(s: &str) -> crate::error::Result<SteeringLaw> {
+        [SteeringLaw::Pi, SteeringLaw::Tracker]
+            .into_iter()
+            .find(|law| law.name() == s)
+            .ok_or_else(|| {
+                crate::error::Error::invalid_value(
+                    "the steering",
+                    format!("{s:?}"),
+                    "pi or tracker",
+                )
+            })
+    }
 }
 
 /// The PI steering controller: its gains and its memory.

@@ -43,6 +43,8 @@ pub struct CommandEvaluator {
     /// The line the car holds, written into each policy file ([`RacedPolicy`]) so that a lap
     /// command such as `cdbo lap --policy {policy}` drives it.
     pub base_line: BaseLine,
+    /// The steering, written into each policy file likewise.
+    pub steering: SteeringLaw,
 }
 
 /// Where process `pid` writes trial `id`'s policy for the command: one file per trial and
@@ -184,7 +186,7 @@ impl CommandEvaluator {
         let policy = RacedPolicy {
             policy: self.shape.policy(weights)?,
             base_line: self.base_line,
-            steering: SteeringLaw::Pi,
+            steering: self.steering,
         };
         let text = serde_json::to_string(&policy_json(&policy))
             .map_err(|e| Error::json(file.display().to_string(), e))?;
@@ -336,6 +338,7 @@ mod tests {
             files: dir.join("p"),
             shape: PolicyShape::pedal(crate::policy::Block::new(2, 0.5).unwrap()),
             base_line: BaseLine::Centre,
+            steering: SteeringLaw::Pi,
         };
         assert_eq!(e.evaluate(1, &[0.1, 0.2]).unwrap(), Outcome::Reward(3.25));
         // The lap's policy file is gone after it; a killed process's is removed, a live one's
@@ -374,6 +377,7 @@ mod tests {
             files: dir.join("p"),
             shape: PolicyShape::pedal(crate::policy::Block::new(2, 0.5).unwrap()),
             base_line: BaseLine::Centre,
+            steering: SteeringLaw::Pi,
         };
         for (template, which) in [("yes", "standard output"), ("yes >&2", "standard error")] {
             e.template = template.into();

@@ -16,7 +16,8 @@
 //! `line = "learn"` (with `line_kernels = 20`, `line_start = "min-curvature"`) or `line =
 //! "min-curvature"` races every run on that line, as `cdbo race --line`; a grid without it
 //! races the centre line, the paper's.
-//! `steering = "tracker"` drives every run with the path tracker (default `"pi"`).
+//! `steering = "tracker"` drives every run with the path tracker (default `"pi"`);
+//! `off_track_margin = -1.0` fails its laps 1 m inside the road's edge (default 1 m past it).
 //!
 //! Run r of every cell has seed r, so that the methods meet the same random numbers where
 //! they draw alike. The runs are listed in a fixed order; shard I of N takes every N-th run
@@ -27,6 +28,7 @@ use serde::{Deserialize, Serialize};
 use super::line::{BaseLine, LineKind, LineSetting};
 use crate::drive::steering::SteeringLaw;
 use crate::method::{Method, Spec};
+use crate::sim::lap::{LapConfig, checked_off_track_margin};
 
 use crate::error::{Error, Result};
 
@@ -81,6 +83,22 @@ pub struct ExperimentConfig {
     /// default) or `"tracker"` (the path tracker, as `cdbo race --steering tracker`).
     #[serde(default, skip_serializing_if = "SteeringLaw::is_pi")]
     pub steering: SteeringLaw,
+    /// Where every run's laps leave the road, as `cdbo race --off-track-margin`: the car's
+    /// centre this far past the road's edge (m; default 1, the game's rule; negative: inside
+    /// the road, for a policy learned with a margin in hand).
+    #[serde(
+        default = "default_off_track_margin",
+        skip_serializing_if = "is_default_off_track_margin"
+    )]
+    pub off_track_margin: f64,
+}
+
+fn default_off_track_margin() -> f64 {
+    LapConfig::default().off_track_margin
+}
+
+fn is_default_off_track_margin(margin: &f64) -> bool {
+    *margin == default_off_track_margin()
 }
 
 fn default_demo_speed() -> f64 {
@@ -149,6 +167,7 @@ impl ExperimentConfig {
                 line_kernels: None,
                 line_start: None,
                 steering: Default::default(),
+                off_track_margin: default_off_track_margin(),
             },
             "paper-plus" => ExperimentConfig {
                 methods: methods(&[
@@ -179,6 +198,7 @@ impl ExperimentConfig {
                 line_kernels: None,
                 line_start: None,
                 steering: Default::default(),
+                off_track_margin: default_off_track_margin(),
             },
             _ => return None,
         })
@@ -214,6 +234,7 @@ impl ExperimentConfig {
     pub fn check(&self) -> Result<()> {
         crate::sizes::LAPS.checked(self.laps)?;
         crate::sizes::REPEATS.checked(self.repeats)?;
+        checked_off_track_margin(self.off_track_margin)?;
         if self.methods.is_empty() || self.tracks.is_empty() {
             return Err(Error::too_small(
                 "methods and tracks",

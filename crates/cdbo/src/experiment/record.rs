@@ -216,7 +216,8 @@ pub fn run_at(
         Grounds::Simulator => Venue::simulator(track.clone(), car),
         Grounds::Torcs { game, car } => Venue::game(game, &spec.track, car, track.clone())?,
     }
-    .steered(grid.steering.steering());
+    .steered(grid.steering.steering())
+    .off_track_at(grid.off_track_margin);
     let outcome = race(&venue, &track, car, &config, progress)?;
     let ceiling_reward_mps = match venue {
         Venue::Simulator(sim) => Some(crate::ceiling::tracked_profile(&sim, &outcome.limit)?.1),

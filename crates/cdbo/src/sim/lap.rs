@@ -166,6 +166,23 @@ pub struct LapConfig {
     pub line: Option<Arc<RacingLine>>,
 }
 
+/// The off-track margins a lap takes (m, [`LapConfig::off_track_margin`]): from 3 m inside the
+/// road's edge to 5 m past it.
+pub const OFF_TRACK_MARGINS: std::ops::RangeInclusive<f64> = -3.0..=5.0;
+
+/// `margin` if it is within [`OFF_TRACK_MARGINS`], else an error naming it.
+pub fn checked_off_track_margin(margin: f64) -> crate::error::Result<f64> {
+    if OFF_TRACK_MARGINS.contains(&margin) {
+        Ok(margin)
+    } else {
+        Err(crate::error::Error::invalid_value(
+            "the off-track margin (m)",
+            margin,
+            "within [-3, 5] m past the road's edge (negative: inside it)",
+        ))
+    }
+}
+
 impl Default for LapConfig {
     fn default() -> Self {
         LapConfig {
