@@ -5,6 +5,10 @@
 //!    profile scaled by k, previewed over the next τ seconds:
 //!    a = clamp(K_p·(max(k·min_{s ≤ s′ ≤ s + v·τ} v_lim(s′), v_min) − v), −1, 1), where the
 //!    floor v_min lets the car leave the standing start (the profile begins at 0).
+//!    The profile is the *crest-aware* limit's ([`profile`], [`LimitOptions::CRESTS`]): the
+//!    crest-blind one asks for speeds at which the car takes off over a crest, so its largest
+//!    k measured the crests, not the drive stack. Every share of "the limit" stays of the
+//!    crest-blind [`limit_lap`](crate::limit::limit_lap) ([`Ceiling::limit_mps`]).
 //!    The largest k whose lap completes is found by bisection (completion is not strictly
 //!    monotone in k; the bisection keeps a completed k as its lower end, so the result is a
 //!    completed lap).
@@ -37,13 +41,16 @@
 
 use serde::Serialize;
 
+use crate::car::Car;
 use crate::drive::{Observation, Pedal};
 use crate::error::{Error, Result};
 use crate::learner::repair::PedalRepair;
-use crate::limit::Limit;
+use crate::limit::{Limit, LimitOptions};
+use crate::line::RacingLine;
 use crate::policy::RkhsPolicy;
 use crate::policy::rkhs::DEFAULT_RIDGE;
 use crate::sim::Simulator;
+use crate::track::Track;
 
 /// Proportional gain of the profile tracker (per m/s): full pedal at 1 m/s off the target.
 pub const TRACKER_GAIN: f64 = 1.0;
@@ -56,6 +63,19 @@ pub const TRACKER_FLOOR_MPS: f64 = 10.0;
 pub const BISECTION_STEPS: usize = 14;
 /// Laps of fitted policies driven at most (the first fit and its repairs).
 pub const REPAIR_LAPS: usize = 150;
+
+/// The speed profile the ceiling tracks for `car` on `track`: the crest-aware QSS limit
+/// ([`LimitOptions::CRESTS`]) on the centre line, or, where the car holds `line`, that line's
+/// read at the centre line's stations
+/// ([`line_limit_on_centre_with`](crate::limit::line_limit_on_centre_with)).
+pub fn profile(track: &Track, car: &Car, line: Option<&RacingLine>) -> Limit {
+    match line {
+        Some(line) => {
+            crate::limit::line_limit_on_centre_with(track, line, car, LimitOptions::CRESTS)
+        }
+        None => crate::limit::limit_lap_with(track, car, LimitOptions::CRESTS),
+    }
+}
 
 /// A speed controller following k times the limit's speed profile.
 #[derive(Debug, Clone)]
@@ -102,8 +122,10 @@ impl Pedal for ProfileTracker<'_> {
 /// least-squares fit of a bang-bang pedal, not an optimum).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Ceiling {
-    /// The physical limit's reward (m/s).
+    /// The physical limit's reward (m/s): the yardstick of the shares, crest-blind.
     pub limit_mps: f64,
+    /// The reward of the limit whose profile was tracked (m/s), crest-aware ([`profile`]).
+    pub profile_mps: f64,
     /// The largest completed profile scale k.
     pub k: f64,
     /// The reward of the tracked profile's lap (m/s).
@@ -119,8 +141,8 @@ pub struct Ceiling {
     pub repairs: usize,
 }
 
-/// The largest scale k of the limit's speed profile whose tracked lap completes, and that
-/// lap's reward (m/s): step 1 of the ceiling.
+/// The largest scale k of `limit`'s speed profile whose tracked lap completes, and that
+/// lap's reward (m/s): step 1 of the ceiling, whose profile is [`profile`]'s.
 pub fn tracked_profile(sim: &Simulator, limit: &Limit) -> Result<(f64, f64)> {
     let (mut lo, mut hi) = (0.0, 1.0);
     let mut lo_reward = 0.0;
@@ -142,17 +164,23 @@ pub fn tracked_profile(sim: &Simulator, limit: &Limit) -> Result<(f64, f64)> {
     Ok((lo, lo_reward))
 }
 
-/// The ceiling of `kernels`-kernel policies in `sim` (its track, car and steering), whose
-/// limit lap is `limit`.
-pub fn ceiling_with(sim: &Simulator, limit: &Limit, kernels: usize) -> Result<Ceiling> {
-    let (k, tracked_mps) = tracked_profile(sim, limit)?;
+/// The ceiling of `kernels`-kernel policies in `sim` (its track, car and steering) tracking
+/// `profile`'s speeds ([`profile`]), its shares of `limit`'s reward (the crest-blind limit).
+pub fn ceiling_with(
+    sim: &Simulator,
+    limit: &Limit,
+    profile: &Limit,
+    kernels: usize,
+) -> Result<Ceiling> {
+    let (k, tracked_mps) = tracked_profile(sim, profile)?;
     let mut traced = sim.clone();
     traced.config.trace = true;
-    let tracked = traced.lap(&mut ProfileTracker::new(limit, sim.track.length, k));
+    let tracked = traced.lap(&mut ProfileTracker::new(profile, sim.track.length, k));
     let mut targets: Vec<(f64, f64)> = tracked.trace.iter().map(|p| (p.x, p.pedal)).collect();
     let mut repair = PedalRepair::new(kernels);
     let mut ceiling = Ceiling {
         limit_mps: limit.reward_mps,
+        profile_mps: profile.reward_mps,
         k,
         tracked_mps,
         kernels,
@@ -212,7 +240,7 @@ mod tests {
     #[test]
     fn the_repaired_fit_completes_where_the_plain_fit_fails() {
         let (sim, limit) = ridgeway();
-        let c = ceiling_with(&sim, &limit, 30).unwrap();
+        let c = ceiling_with(&sim, &limit, &limit, 30).unwrap();
         assert!(c.repairs > 0, "the plain fit completed");
         let policy = c.policy.clone().expect("no repaired fit completed");
         let lap = sim.lap(&mut policy.pedal());

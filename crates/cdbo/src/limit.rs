@@ -2,17 +2,28 @@
 //!
 //! At every station sᵢ of the centre line (curvature κᵢ, grade φᵢ, banking βᵢ, road friction
 //! μ_rᵢ) the car is treated as a point mass m with the axles' grip
-//! F_max(v) = Σ_axles F_z·μ·μ_r·λ(F_z/2), F_z = static load + downforce 0.645·Cl·A·v².
+//! F_max(v) = Σ_axles F_z·μ·μ_r·λ(F_z/2), F_z = n(v)·static load + downforce 0.645·Cl·A·v²,
+//! where n(v) = 1 for [`limit_lap`] (flat, crest-blind: the yardstick every "% of the limit"
+//! uses) and, with [`LimitOptions::crests`] ([`limit_lap_with`]), the road's push per unit of
+//! the car's weight as the simulator's vehicle feels it
+//! ([`Vehicle::step`](crate::sim::vehicle::Vehicle::step)):
+//! n(v) = cos φ·cos β + v²·κ_v/g, κ_v the road's vertical curvature
+//! ([`Frame::vertical_curvature`](crate::track::Frame::vertical_curvature), negative over a
+//! crest), each axle's load kept ≥ 0 as the vehicle keeps it.
 //!
-//! 1. **Cornering cap**: the largest v with m·(v²|κ| − g·sin β·sgn κ) ≤ F_max(v) (bisection).
+//! 1. **Cornering cap**: the largest v with m·(v²|κ| − g·sin β·sgn κ) ≤ F_max(v) (bisection);
+//!    with the crests also on the road: the total load m·g·n(v) + 0.645·Cl·A·v² > 0, so over
+//!    a crest (κ_v < 0) whose unloading outgrows the downforce
+//!    v² < m·g·cos φ·cos β / (−m·κ_v − 0.645·Cl·A), and on a straight crest without downforce
+//!    v < √(g·cos φ·cos β/−κ_v), the speed at which the car takes off.
 //! 2. **Forward pass** from a standing start, v₀ = 0:
 //!    v²ᵢ₊₁ = min(cap²ᵢ₊₁, v²ᵢ + 2·Δs·a⁺), with the acceleration
-//!    a⁺ = min(F_engine(v), F_traction)·e/m − F_drag/m − c_rr·g − g·sin φ, where F_engine is the
+//!    a⁺ = min(F_engine(v), F_traction)·e/m − F_drag/m − c_rr·g·n − g·sin φ, where F_engine is the
 //!    best gear's wheel force T_e(ω)·gᵢg_f/R below the limiter, F_traction the driven axle's
 //!    grip (with longitudinal load transfer), and e = √(1 − (a_lat/a_lat,max)²) the friction
-//!    ellipse.
+//!    ellipse; F_traction and F_max under the loads F_z above (n(v) at the station's speed).
 //! 3. **Backward pass** from the finish: v²ᵢ = min(v²ᵢ, v²ᵢ₊₁ + 2·Δs·a⁻), with the deceleration
-//!    a⁻ = min(F_max·e, F_brakes)/m + F_drag/m + c_rr·g + g·sin φ.
+//!    a⁻ = min(F_max·e, F_brakes)/m + F_drag/m + c_rr·g·n + g·sin φ.
 //! 4. T = Σ 2Δs/(vᵢ + vᵢ₊₁).
 //!
 //! It ignores rotating inertia, gear-shift time and the driver's reaction, and grants both
@@ -21,6 +32,10 @@
 //! [`line_limit`] drives the same QSS lap along a racing line ([`crate::line`]), on the line's
 //! own curvature and arc length; its speed is the *centre line's* length over its lap time, so
 //! that it compares with [`limit_lap`]'s, the reference every "% of the limit" uses.
+//!
+//! The crest-aware limit is the profile [the ceiling](crate::ceiling) tracks (a profile the
+//! car cannot hold over a crest says nothing about the drive stack); the crest-blind
+//! [`limit_lap`] stays the yardstick, compared across sessions.
 
 use serde::Serialize;
 
@@ -63,11 +78,38 @@ pub struct LineLimit {
     pub iterations: usize,
 }
 
+/// What the QSS model knows of the road besides its plan, curvature, grade and banking.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct LimitOptions {
+    /// The road's crests and dips load the car: the static loads scale by
+    /// n(v) = cos φ·cos β + v²·κ_v/g, as in the simulator, and the car must not take off
+    /// (module documentation). Off: n = 1, [`limit_lap`]'s crest-blind yardstick.
+    pub crests: bool,
+}
+
+impl LimitOptions {
+    /// The crest-blind model of [`limit_lap`].
+    pub const FLAT: LimitOptions = LimitOptions { crests: false };
+    /// The crest-aware model.
+    pub const CRESTS: LimitOptions = LimitOptions { crests: true };
+}
+
 /// The QSS limit lap of `car` along `line`, a racing line on `track`: [`limit_lap`] on
 /// [`RacingLine::path`], its reward the centre line's length over the lap time.
 pub fn line_limit(track: &Track, line: &RacingLine, car: &Car) -> LineLimit {
+    line_limit_with(track, line, car, LimitOptions::FLAT)
+}
+
+/// [`line_limit`] under `options` ([`limit_lap_with`] on the line's path, whose heights and
+/// so whose crests are the road's under the line).
+pub fn line_limit_with(
+    track: &Track,
+    line: &RacingLine,
+    car: &Car,
+    options: LimitOptions,
+) -> LineLimit {
     let path = line.path(track);
-    let mut limit = limit_lap(&path, car);
+    let mut limit = limit_lap_with(&path, car, options);
     limit.reward_mps = track.length / limit.lap_time_s;
     limit.track_length = track.length;
     LineLimit {
@@ -86,7 +128,17 @@ pub fn line_limit(track: &Track, line: &RacingLine, car: &Car) -> LineLimit {
 /// length from p₀ at which the line crosses s (u_j = Σ_{i<j} |p_{i+1} − p_i|, h = L/N the
 /// stations' spacing, j = ⌊s/h⌋).
 pub fn line_limit_on_centre(track: &Track, line: &RacingLine, car: &Car) -> Limit {
-    let along = line_limit(track, line, car).limit;
+    line_limit_on_centre_with(track, line, car, LimitOptions::FLAT)
+}
+
+/// [`line_limit_on_centre`] under `options`.
+pub fn line_limit_on_centre_with(
+    track: &Track,
+    line: &RacingLine,
+    car: &Car,
+    options: LimitOptions,
+) -> Limit {
+    let along = line_limit_with(track, line, car, options).limit;
     let path = line.path(track);
     let n = line.points.len();
     let mut u = Vec::with_capacity(n + 1);
@@ -108,8 +160,15 @@ pub fn line_limit_on_centre(track: &Track, line: &RacingLine, car: &Car) -> Limi
     Limit { speed, ..along }
 }
 
-/// Computes the QSS limit lap of `car` on `track`.
+/// Computes the QSS limit lap of `car` on `track`, crest-blind: the yardstick.
 pub fn limit_lap(track: &Track, car: &Car) -> Limit {
+    limit_lap_with(track, car, LimitOptions::FLAT)
+}
+
+/// Computes the QSS limit lap of `car` on `track` under `options`; with
+/// [`LimitOptions::FLAT`] bit for bit [`limit_lap`], and on a road without grade, banking
+/// or vertical curvature so is [`LimitOptions::CRESTS`] (n = 1 exactly).
+pub fn limit_lap_with(track: &Track, car: &Car, options: LimitOptions) -> Limit {
     let n = track.len();
     let ds = track.ds;
     let m = car.mass;
@@ -121,9 +180,26 @@ pub fn limit_lap(track: &Track, car: &Car) -> Limit {
     let static_load = [m * G * b / l, m * G * a / l];
     let rolling = 0.5 * (car.front_tyre.rolling_resistance + car.rear_tyre.rolling_resistance);
     let grip = |axle: usize, fz: f64, friction: f64| tyres[axle].axle_max_force(fz, friction);
-    let total_grip = |v: f64, friction: f64| {
+    // n(v) at station i: the road's push per unit of the car's weight (module documentation).
+    let normal = |i: usize, v: f64| {
+        if options.crests {
+            let f = track.frame(i);
+            f.cos_pitch * f.cos_banking + v * v * f.vertical_curvature / G
+        } else {
+            1.0
+        }
+    };
+    // The axles' loads at speed v under the road's push n, each kept ≥ 0 as the vehicle's.
+    let loads = |v: f64, n: f64| {
         let d = car.downforce(v);
-        grip(0, static_load[0] + d[0], friction) + grip(1, static_load[1] + d[1], friction)
+        [
+            (static_load[0] * n + d[0]).max(0.0),
+            (static_load[1] * n + d[1]).max(0.0),
+        ]
+    };
+    let total_grip = |v: f64, n: f64, friction: f64| {
+        let fz = loads(v, n);
+        grip(0, fz[0], friction) + grip(1, fz[1], friction)
     };
     let driven_radius = match car.drive {
         Drive::Front => car.front_tyre.radius,
@@ -143,21 +219,22 @@ pub fn limit_lap(track: &Track, car: &Car) -> Limit {
             })
             .fold(0.0, f64::max)
     };
-    let traction = |v: f64, friction: f64| {
-        let d = car.downforce(v);
+    let traction = |v: f64, n: f64, friction: f64| {
+        let fz = loads(v, n);
         let h = car.cg_height;
         // Driven-axle grip with the load it gains while accelerating at F/m: F = μ(F_z0 + F·h/L)
-        // ⇒ F = μF_z0 / (1 − μh/L) (rear), F = μF_z0 / (1 + μh/L) (front).
+        // ⇒ F = μF_z0 / (1 − μh/L) (rear), F = μF_z0 / (1 + μh/L) (front); none off the road.
         match car.drive {
-            Drive::Rear => {
-                let mu = grip(1, static_load[1] + d[1], friction) / (static_load[1] + d[1]);
-                mu * (static_load[1] + d[1]) / (1.0 - mu * h / l).max(0.1)
+            Drive::Rear if fz[1] > 0.0 => {
+                let mu = grip(1, fz[1], friction) / fz[1];
+                mu * fz[1] / (1.0 - mu * h / l).max(0.1)
             }
-            Drive::Front => {
-                let mu = grip(0, static_load[0] + d[0], friction) / (static_load[0] + d[0]);
-                mu * (static_load[0] + d[0]) / (1.0 + mu * h / l)
+            Drive::Front if fz[0] > 0.0 => {
+                let mu = grip(0, fz[0], friction) / fz[0];
+                mu * fz[0] / (1.0 + mu * h / l)
             }
-            Drive::All => total_grip(v, friction),
+            Drive::All => total_grip(v, n, friction),
+            _ => 0.0,
         }
     };
     let brake_force = 2.0
@@ -166,13 +243,19 @@ pub fn limit_lap(track: &Track, car: &Car) -> Limit {
     let v_max = car.rev_limiter / (car.gears.last().copied().unwrap_or(1.0) * car.final_drive)
         * driven_radius;
 
-    // 1. Cornering cap.
+    // 1. Cornering cap; the car keeps its wheels on the road (a total load > 0).
     let cap: Vec<f64> = (0..=n)
         .map(|i| {
             let c = track.sample(i);
             let need =
                 |v: f64| v * v * c.curvature.abs() - G * c.banking.sin() * c.curvature.signum();
-            let ok = |v: f64| m * need(v) <= total_grip(v, c.friction);
+            let ok = |v: f64| {
+                let nv = normal(i, v);
+                let d = car.downforce(v);
+                // The point mass's load, before either axle's is kept ≥ 0.
+                let load = (static_load[0] + static_load[1]) * nv + d[0] + d[1];
+                load > 0.0 && m * need(v) <= total_grip(v, nv, c.friction)
+            };
             if ok(v_max) {
                 return v_max;
             }
@@ -187,7 +270,7 @@ pub fn limit_lap(track: &Track, car: &Car) -> Limit {
     let ellipse = |v: f64, i: usize| {
         let c = track.sample(i);
         let lat = m * v * v * c.curvature.abs();
-        let max = total_grip(v, c.friction);
+        let max = total_grip(v, normal(i, v), c.friction);
         (1.0 - (lat / max).powi(2)).max(0.0).sqrt()
     };
 
@@ -196,10 +279,11 @@ pub fn limit_lap(track: &Track, car: &Car) -> Limit {
     for i in 0..n {
         let c = track.sample(i);
         let vi = v[i];
-        let push = engine_force(vi).min(traction(vi, c.friction) * ellipse(vi, i));
+        let ni = normal(i, vi);
+        let push = engine_force(vi).min(traction(vi, ni, c.friction) * ellipse(vi, i));
         let acc = push / m
             - car.drag(vi) / m
-            - c.rolling_resistance.unwrap_or(rolling) * car.scales.rolling * G
+            - c.rolling_resistance.unwrap_or(rolling) * car.scales.rolling * G * ni.max(0.0)
             - G * c.grade;
         let next = (vi * vi + 2.0 * ds * acc).max(0.0).sqrt();
         v[i + 1] = next.min(cap[i + 1]);
@@ -208,10 +292,11 @@ pub fn limit_lap(track: &Track, car: &Car) -> Limit {
     for i in (0..n).rev() {
         let c = track.sample(i);
         let vn = v[i + 1];
-        let stop = (total_grip(vn, c.friction) * ellipse(vn, i)).min(brake_force);
+        let ni = normal(i, vn);
+        let stop = (total_grip(vn, ni, c.friction) * ellipse(vn, i)).min(brake_force);
         let dec = stop / m
             + car.drag(vn) / m
-            + c.rolling_resistance.unwrap_or(rolling) * car.scales.rolling * G
+            + c.rolling_resistance.unwrap_or(rolling) * car.scales.rolling * G * ni.max(0.0)
             + G * c.grade;
         let allowed = (vn * vn + 2.0 * ds * dec.max(0.0)).sqrt();
         v[i] = v[i].min(allowed);
@@ -264,6 +349,100 @@ mod tests {
         );
         assert_eq!(lim.track_length, t.length);
         assert!((lim.reward_mps * lim.lap_time_s - std::f64::consts::TAU * r).abs() < 1e-9);
+    }
+
+    /// A straight: a 500 m level run-up, then a crest of constant vertical curvature
+    /// −1/100 m over which the pitch falls from 0 to −0.2 rad (10 cm pieces linear in z), then
+    /// 200 m down at that pitch.
+    fn straight_crest() -> Track {
+        let (kv, crest) = (-0.01, 20.0);
+        let pieces_n = (crest / 0.1) as usize;
+        let d = crest / pieces_n as f64;
+        let mut pieces = vec![Piece::flat(500.0, 0.0)];
+        let mut z = 0.0;
+        for j in 0..pieces_n {
+            let z1 = z + d * (kv * (j as f64 + 0.5) * d).tan();
+            pieces.push(Piece {
+                z0: z,
+                z1,
+                ..Piece::flat(d, 0.0)
+            });
+            z = z1;
+        }
+        let grade = (kv * crest).tan();
+        pieces.push(Piece {
+            z0: z,
+            z1: z + 200.0 * grade,
+            ..Piece::flat(200.0, 0.0)
+        });
+        Track::from_pieces("crest", "test", &pieces, vec![])
+    }
+
+    /// On level, unbanked roads the crest-aware limit is the crest-blind one bit for bit
+    /// (n = 1 exactly).
+    #[test]
+    fn without_crests_the_crest_aware_limit_is_the_limit() {
+        let car = Car::spirit_300();
+        let r = 100.0;
+        let circle = Track::from_pieces(
+            "circle",
+            "test",
+            &[Piece::flat(std::f64::consts::TAU * r, 1.0 / r)],
+            vec![],
+        );
+        for t in [straight(400.0), circle] {
+            assert_eq!(
+                limit_lap_with(&t, &car, LimitOptions::CRESTS),
+                limit_lap(&t, &car)
+            );
+        }
+    }
+
+    /// Over a straight crest the crest-blind limit runs the run-up's speed over the top, where
+    /// the car would take off; the crest-aware limit is slower, and keeps every station's
+    /// speed below the closed-form take-off speed
+    /// v² = m·g·cos φ·cos β / (−m·κ_v − 0.645·Cl·A) (the total load m·g·n(v) + downforce
+    /// vanishing), reaching it (within 1 %) where it binds.
+    #[test]
+    fn the_car_keeps_its_wheels_on_a_crest() {
+        let car = Car::spirit_300();
+        let t = straight_crest();
+        let (blind, aware) = (
+            limit_lap(&t, &car),
+            limit_lap_with(&t, &car, LimitOptions::CRESTS),
+        );
+        assert!(
+            aware.lap_time_s > blind.lap_time_s,
+            "{} s against {} s",
+            aware.lap_time_s,
+            blind.lap_time_s
+        );
+        let d = car.downforce(1.0);
+        let take_off = |i: usize| {
+            let f = t.frame(i);
+            let lift = -car.mass * f.vertical_curvature - (d[0] + d[1]);
+            (lift > 0.0).then(|| (car.mass * G * f.cos_pitch * f.cos_banking / lift).sqrt())
+        };
+        let crest: Vec<(usize, f64)> = (0..t.len())
+            .filter_map(|i| take_off(i).map(|v| (i, v)))
+            .collect();
+        assert!(!crest.is_empty());
+        let (mut closest, mut blind_over) = (0.0f64, 0.0f64);
+        for &(i, cap) in &crest {
+            assert!(
+                aware.speed[i] <= cap * (1.0 + 1e-9),
+                "station {i}: {} m/s over the take-off speed {cap} m/s",
+                aware.speed[i]
+            );
+            closest = closest.max(aware.speed[i] / cap);
+            blind_over = blind_over.max(blind.speed[i] / cap);
+        }
+        assert!(closest > 0.99, "{closest}");
+        assert!(blind_over > 1.2, "{blind_over}");
+        // Without downforce the take-off speed at the top is √(g/−κ_v) ≈ 31.3 m/s: the wings
+        // hold the car down to a higher one, but not to the run-up's.
+        let top = crest.iter().map(|&(_, v)| v).fold(f64::INFINITY, f64::min);
+        assert!((31.3..45.0).contains(&top), "{top}");
     }
 
     #[test]

@@ -17,7 +17,8 @@ pub struct CeilingArgs {
     #[arg(long, value_enum, default_value_t)]
     steering: super::SteeringChoice,
     /// The line the car holds: on the minimum-curvature line the profile tracked is that
-    /// line's limit (read at the centre line's stations) and the shares are of that limit.
+    /// line's crest-aware limit (read at the centre line's stations) and the shares are of
+    /// that line's crest-blind limit, then of the centre line's.
     #[arg(long, value_enum, default_value_t)]
     line: super::line::FixedLine,
     /// Print JSON.
@@ -41,10 +42,12 @@ pub fn run(args: &CeilingArgs, data: &DataPath) -> CliResult {
     let (track, car) = args.setup.load(data)?;
     let name = track.name.clone();
     let line = args.line.base_line().line(&track, &car)?;
+    // The shares are of the crest-blind limit, the profile tracked is the crest-aware one's.
     let limit = match &line {
         Some(line) => cdbo::limit::line_limit_on_centre(&track, line, &car),
         None => cdbo::limit::limit_lap(&track, &car),
     };
+    let profile = cdbo::ceiling::profile(&track, &car, line.as_deref());
     let which = if line.is_some() {
         "minimum-curvature-line"
     } else {
@@ -57,7 +60,7 @@ pub fn run(args: &CeilingArgs, data: &DataPath) -> CliResult {
     let mut sim = cdbo::sim::Simulator::new(track, &car);
     sim.config.steering = args.steering.steering();
     sim.config.line = line;
-    let c = ceiling_with(&sim, &limit, args.kernels)?;
+    let c = ceiling_with(&sim, &limit, &profile, args.kernels)?;
     if args.json {
         return print_json(&CeilingReport {
             ceiling: &c,
@@ -82,11 +85,12 @@ pub fn run(args: &CeilingArgs, data: &DataPath) -> CliResult {
         format!("none completes within {} laps", cdbo::ceiling::REPAIR_LAPS)
     };
     println!(
-        "{} on {}: {which} limit {:.2} m/s; tracking {:.3} x the limit's speed profile {:.2} m/s ({:.1} % of the {which} limit{of_centre}); {}-kernel policy fitted to its pedal, repaired where it fails: {}",
+        "{} on {}: {which} limit {:.2} m/s; tracking {:.3} x the crest-aware limit's speed profile (its lap {:.2} m/s): {:.2} m/s ({:.1} % of the {which} limit{of_centre}); {}-kernel policy fitted to its pedal, repaired where it fails: {}",
         car.name,
         name,
         c.limit_mps,
         c.k,
+        c.profile_mps,
         c.tracked_mps,
         pct(c.tracked_mps),
         c.kernels,

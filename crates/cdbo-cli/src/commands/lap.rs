@@ -142,7 +142,8 @@ pub fn run(args: &LapArgs, data: &DataPath, simulator: Simulator) -> CliResult {
     sim.config.trace = false;
     // The ceiling is the centre line's, as `cdbo race` reports it.
     sim.config.line = None;
-    let (_, ceiling_mps) = cdbo::ceiling::tracked_profile(&sim, &limit)?;
+    let profile = cdbo::ceiling::profile(&sim.track, &car, None);
+    let (_, ceiling_mps) = cdbo::ceiling::tracked_profile(&sim, &profile)?;
     print_report(
         LapReport::new(
             &sim.track.name,
@@ -218,7 +219,8 @@ fn run_torcs(args: &LapArgs, data: &DataPath) -> CliResult {
     let limit = limit_lap(&track, &req.car);
     let mut ours = cdbo::sim::Simulator::new(track.clone(), &req.car);
     ours.config.steering = steering.steering();
-    let (_, ceiling_mps) = cdbo::ceiling::tracked_profile(&ours, &limit)?;
+    let profile = cdbo::ceiling::profile(&track, &req.car, None);
+    let (_, ceiling_mps) = cdbo::ceiling::tracked_profile(&ours, &profile)?;
     print_report(
         LapReport::new(&track.name, car_name, &lap, &limit, ceiling_mps, "torcs"),
         args.json,

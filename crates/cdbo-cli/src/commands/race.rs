@@ -220,7 +220,8 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     let wall_s = start.elapsed().as_secs_f64();
     let mut ceiling_sim = cdbo::sim::Simulator::new(track.clone(), &car);
     ceiling_sim.config.steering = args.steering.steering();
-    let (_, ceiling_mps) = cdbo::ceiling::tracked_profile(&ceiling_sim, &outcome.limit)?;
+    let profile = cdbo::ceiling::profile(&track, &car, None);
+    let (_, ceiling_mps) = cdbo::ceiling::tracked_profile(&ceiling_sim, &profile)?;
     write_outputs(&out, &outcome, config.base_line, args.steering.law())?;
     // The speed plots re-drive the initial and best policies where the race was driven, on
     // its base line.

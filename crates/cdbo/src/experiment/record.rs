@@ -36,8 +36,9 @@ pub struct RunRecord {
     /// Reward of the limit lap.
     pub limit_reward_mps: f64,
     /// Reward of the ceiling: the tracked limit profile's lap
-    /// ([`tracked_profile`](crate::ceiling::tracked_profile)); absent in records written
-    /// before it was stored.
+    /// ([`tracked_profile`](crate::ceiling::tracked_profile)), the crest-aware profile's
+    /// ([`profile`](crate::ceiling::profile)) in records written after session 20; absent in
+    /// records written before it was stored.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ceiling_reward_mps: Option<f64>,
     /// Reward of the initial policy π(w₀).
@@ -220,7 +221,10 @@ pub fn run_at(
     .off_track_at(grid.off_track_margin);
     let outcome = race(&venue, &track, car, &config, progress)?;
     let ceiling_reward_mps = match venue {
-        Venue::Simulator(sim) => Some(crate::ceiling::tracked_profile(&sim, &outcome.limit)?.1),
+        Venue::Simulator(sim) => {
+            let profile = crate::ceiling::profile(&track, car, None);
+            Some(crate::ceiling::tracked_profile(&sim, &profile)?.1)
+        }
         Venue::Game { .. } => None,
     };
     Ok(RunRecord {
