@@ -32,8 +32,9 @@
  *                                lap's end (drive::periodic_linear); without it the centre line
  *   steering pi T_LA D_MIN K_I   the PI law: look-ahead time (s), shortest look-ahead (m),
  *                                integral gain
- *   steering tracker T_P X_MIN T_F C   the path tracker: preview time (s), shortest preview
- *                                (m), feed-forward time (s), yaw-rate gain
+ *   steering tracker T_P X_MIN T_F C V_Y   the path tracker: preview time (s), shortest
+ *                                preview (m), feed-forward time (s), yaw-rate gain and the
+ *                                speed per unit of it below that gain (m/s)
  *   chassis M A B                (the tracker) mass (kg), distances of the front and rear
  *                                axle from the centre of gravity (m)
  *   cornering_front V1 C1 ...    (the tracker) the axle's cornering stiffness (N/rad) on a
@@ -183,11 +184,11 @@ bool read_settings(const std::string &path, Settings *s, std::string *error) {
             if ((ok = need(3))) { s->tracker = false; s->lookahead_time = nums[0]; s->lookahead_min = nums[1]; s->ki = nums[2]; }
         }
         else if (k == "steering" && word == "tracker") {
-            if ((ok = need(4))) { s->tracker = true; s->gains = {nums[0], nums[1], nums[2], nums[3]}; }
+            if ((ok = need(5))) { s->tracker = true; s->gains = {nums[0], nums[1], nums[2], nums[3], nums[4]}; }
         }
         else if (k == "steering") {
             *error = path + ":" + std::to_string(number) + ": steering must be 'pi T_LA D_MIN K_I' or "
-                     "'tracker T_P X_MIN T_F C', got '" + word + "'";
+                     "'tracker T_P X_MIN T_F C V_Y', got '" + word + "'";
             ok = false;
         }
         else if (k == "chassis") {

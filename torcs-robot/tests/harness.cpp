@@ -122,13 +122,14 @@ const std::map<std::string, Case> kCases = {
          double x0 = a.num(), y0 = a.num(), x1 = a.num(), y1 = a.num(), x2 = a.num();
          return std::vector<double>{drive::curvature(x0, y0, x1, y1, x2, a.num())};
      }},
-    {"tracker_law",  // T_P X_MIN T_F C  M L A B LOCK  E DPSI KAPPA V R CF CR -> delta
+    {"tracker_law",  // T_P X_MIN T_F C V_Y  M L A B LOCK  E DPSI KAPPA V R CF CR -> delta
      [](Args &a) {
          drive::TrackerGains g;
          g.preview_time = a.num();
          g.preview_min = a.num();
          g.feedforward_time = a.num();
          g.yaw_rate_gain = a.num();
+         g.yaw_rate_speed = a.num();
          drive::TrackerCar car;
          car.mass = a.num();
          car.wheelbase = a.num();

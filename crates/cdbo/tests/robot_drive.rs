@@ -384,7 +384,7 @@ fn the_robots_decisions_are_the_rust_ones_on_recorded_laps() {
     assert!(n > 10 * (demo.len() + fast.len()), "{n} calls");
 }
 
-/// The path tracker's steering in the robot is the Rust one: on every driver step of two laps
+/// The path tracker's steering in the robot is the Rust one: on every driver step of three laps
 /// of the simulator steered by the tracker (the demonstration and the learned policy), rebuilt
 /// from the recorded position, heading, speed and yaw rate, the C++ gives the same heading
 /// error, curvature and steering command, bit for bit; the cornering stiffness the robot
@@ -422,6 +422,7 @@ fn the_robots_tracker_is_the_rust_one_on_a_recorded_lap() {
         tracker.preview_min,
         tracker.feedforward_time,
         tracker.yaw_rate_gain,
+        tracker.yaw_rate_speed,
     ];
     let tc = TrackerCar::of(&car);
     let chassis = [
@@ -503,10 +504,33 @@ fn the_robots_tracker_is_the_rust_one_on_a_recorded_lap() {
             fastest = fastest.max(p.speed);
         }
     }
+    // The lock, which a smooth lap does not reach: 5 m off the path either side at 15 m/s.
+    for e in [5.0, -5.0] {
+        let input = TrackerInput {
+            lateral_error: e,
+            heading_error: 0.0,
+            curvature: 0.0,
+            speed: 15.0,
+            yaw_rate: 0.0,
+            cornering_stiffness: sim.vehicle.cornering_stiffness(15.0, 1.0),
+        };
+        let delta = tracker.law(&tc, &input);
+        let mut args = [&gains[..], &chassis[..]].concat();
+        args.extend([e, 0.0, 0.0, 15.0, 0.0]);
+        args.extend(input.cornering_stiffness);
+        calls.check(
+            &format!("e = {e} m"),
+            "tracker_law",
+            &args,
+            &[delta],
+            Agree::Exactly,
+        );
+        saturated += usize::from(delta == -e.signum() * car.steer_lock);
+    }
     // The states span the law: corners, a fast lap, the lock.
     assert!(cornering > 1000, "{cornering} steps in corners");
     assert!(fastest > 25.0, "{fastest} m/s");
-    assert!(saturated >= 1, "{saturated} steps at the lock");
+    assert!(saturated >= 2, "{saturated} steps at the lock");
     let n = calls.run(&exe);
     assert!(n > 7 * (demo.len() + fast.len()), "{n} calls");
 }
@@ -653,7 +677,7 @@ fn the_robots_line_is_the_rust_one_on_recorded_laps() {
                         let tc = TrackerCar::of(&car);
                         let delta = t.law(&tc, &input);
                         let mut args = vec![t.preview_time, t.preview_min];
-                        args.extend([t.feedforward_time, t.yaw_rate_gain]);
+                        args.extend([t.feedforward_time, t.yaw_rate_gain, t.yaw_rate_speed]);
                         args.extend([tc.mass, tc.wheelbase, tc.cg_to_front, tc.cg_to_rear]);
                         args.extend([tc.steer_lock, p.lateral - d, -bearing, kappa, v]);
                         args.extend([p.yaw_rate, stiffness[0], stiffness[1]]);

@@ -268,8 +268,12 @@ fn settings(
         Steering::Tracker(t) => {
             let _ = writeln!(
                 s,
-                "steering tracker {:e} {:e} {:e} {:e}",
-                t.preview_time, t.preview_min, t.feedforward_time, t.yaw_rate_gain
+                "steering tracker {:e} {:e} {:e} {:e} {:e}",
+                t.preview_time,
+                t.preview_min,
+                t.feedforward_time,
+                t.yaw_rate_gain,
+                t.yaw_rate_speed
             );
             let (a, b) = (car.cg_to_front(), car.cg_to_rear());
             let _ = writeln!(s, "chassis {:e} {a:e} {b:e}", car.mass);
