@@ -12,6 +12,17 @@ LINE = dict(line="learn", line_kernels=8, line_start="min-curvature")
 FLAGS = ("--line", "learn", "--line-kernels", 8, "--line-start", "min-curvature")
 
 
+def asked_and_told(env, opt, laps):
+    """The rewards of `laps` laps of the README's loop: ask, drive, tell the whole lap."""
+    rewards = []
+    for _ in range(laps):
+        w = opt.ask()
+        lap = env.lap(w)
+        opt.tell(w, lap)
+        rewards.append(float(lap))
+    return rewards
+
+
 def test_a_learned_line_is_the_clis_and_the_envs_race(cli, tmp_path):
     laps = 30
     args = ("--method", "pattern-search", "--kernels", 12, "--laps", laps, "--seed", 1)
@@ -28,13 +39,7 @@ def test_a_learned_line_is_the_clis_and_the_envs_race(cli, tmp_path):
     assert (env.base_line, env.line_kernels) == ("min-curvature", 8)
     assert env.w0.shape == (20,) and not env.w0[12:].any()
     opt = env.optimizer("pattern-search", seed=1)
-    rewards = []
-    for _ in range(laps):
-        w = opt.ask()
-        lap = env.lap(w)
-        opt.tell(w, lap)
-        rewards.append(float(lap))
-    assert rewards == [lap["reward"] for lap in result.laps]
+    assert asked_and_told(env, opt, laps) == [lap["reward"] for lap in result.laps]
     # The best policy's lap again, on the line it was raced on.
     sim = cdbo.Simulator("ridgeway", line="min-curvature")
     assert sim.lap(result.best, line=result.best_line).reward == result.best_reward
@@ -72,13 +77,7 @@ def test_steering_and_the_off_track_margin_are_the_clis(cli, tmp_path):
     ).best_reward
     env = cdbo.RaceEnv("ridgeway", kernels=20, **how)
     opt = env.optimizer("pattern-search")
-    rewards = []
-    for _ in range(laps):
-        w = opt.ask()
-        lap = env.lap(w)
-        opt.tell(w, lap)
-        rewards.append(float(lap))
-    assert rewards == [lap["reward"] for lap in result.laps]
+    assert asked_and_told(env, opt, laps) == [lap["reward"] for lap in result.laps]
     with pytest.raises(ValueError, match="steering"):
         cdbo.RaceEnv("ridgeway", kernels=10, steering="stanley")
     with pytest.raises(ValueError, match="off-track margin"):
