@@ -214,23 +214,23 @@ impl RacedPolicy {
     /// A policy file's text, every block checked; `file` names it in errors.
     pub fn from_json(text: &str, file: &str) -> Result<RacedPolicy> {
         #[derive(Deserialize)]
-        struct Base {
+        struct Raced {
             #[serde(default)]
             base_line: BaseLine,
-        }
-        #[derive(Deserialize)]
-        struct Steered {
             #[serde(default)]
             steering: SteeringLaw,
         }
-        let base: Base = serde_json::from_str(text)
-            .map_err(|e| Error::parse(file, "base_line", format!("not a base line: {e}")))?;
-        let steered: Steered = serde_json::from_str(text)
-            .map_err(|e| Error::parse(file, "steering", format!("not a steering law: {e}")))?;
+        let raced: Raced = serde_json::from_str(text).map_err(|e| {
+            Error::parse(
+                file,
+                "base_line, steering",
+                format!("not a base line and steering law: {e}"),
+            )
+        })?;
         Ok(RacedPolicy {
             policy: Policy::from_json(text, file)?,
-            base_line: base.base_line,
-            steering: steered.steering,
+            base_line: raced.base_line,
+            steering: raced.steering,
         })
     }
 }
