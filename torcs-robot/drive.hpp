@@ -137,8 +137,8 @@ inline void offset_left(double x, double y, double sin_h, double cos_h, double d
 // ---- The path tracker ------------------------------------------------------------------------
 
 /// Half the spacing (m) of the path points the heading and curvature are read from
-/// (drive/tracker.rs PATH_STEP).
-constexpr double kPathStep = 2.0;
+/// (drive/tracker.rs PATH_STEP: one station of a racing line, line::SPACING).
+constexpr double kPathStep = 3.0;
 /// The speed (m/s) below which the tracker's gains are those of this speed
 /// (drive/tracker.rs MIN_SPEED).
 constexpr double kTrackerMinSpeed = 1.0;

@@ -62,8 +62,17 @@ pub const YAW_RATE_GAIN: f64 = 4.0;
 /// 111.6 / 104.4 % of the centre-line limit against 95.8 / 106.3 / 111.5 / 104.3 (v_y = 5:
 /// 96.8 / 106.5 / 110.6 / 104.6).
 pub const YAW_RATE_SPEED: f64 = 6.0;
-/// Half the spacing of the path points the heading and curvature are read from (m).
-pub const PATH_STEP: f64 = 2.0;
+/// Half the spacing of the path points the heading and curvature are read from (m): one
+/// station of a racing line ([`crate::line::SPACING`]). A line is linear between its stations,
+/// so its curvature sits in kinks there; three points a station apart read each kink's share
+/// evenly wherever the car is, where points 2 m apart read a kink whole or not at all as the
+/// car moves 1.2 m a driver step past 3 m stations. With 2 m the feed-forward rang on
+/// E-Track 2's minimum-curvature line at speed (car1-trb1, a learned lap above 40 m/s: the
+/// steering's second difference 0.070 rad a step, 0.0007 on the centre line; with 3 m
+/// 0.0006). The pattern search's best lap there (50 kernels, 3 seeds, in cdbo's simulator)
+/// 127.67 s with 2 m, 125.25 s with 3 m; in the game (`cdbo --simulator torcs race --track
+/// e-track-2 --kernels 50 --steering tracker --line min-curvature`) 132.70 s and 128.39 s.
+pub const PATH_STEP: f64 = crate::line::SPACING;
 /// The speed below which the gains are those of this speed (m/s): the standing start.
 pub const MIN_SPEED: f64 = 1.0;
 
