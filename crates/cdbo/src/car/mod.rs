@@ -27,7 +27,8 @@ pub enum Drive {
 pub struct Tyre {
     /// Rolling radius (m): rim diameter / 2 + tyre width × aspect ratio.
     pub radius: f64,
-    /// Peak friction coefficient μ.
+    /// Peak friction coefficient μ, with the camber's grip where the car file gives a camber
+    /// (simuv2's `wheel.cpp` multiplies the force by 1 + 0.05·sin(−18·camber), camber in rad).
     pub mu: f64,
     /// Magic-Formula stiffness (TORCS `stiffness`, = B·C).
     pub stiffness: f64,
@@ -41,6 +42,47 @@ pub struct Tyre {
     pub rolling_resistance: f64,
     /// Rotational inertia of one wheel with its brake disc (kg·m²).
     pub inertia: f64,
+}
+
+/// The suspension as it sets the body's ride height, which TORCS's simuv2 (`aero.cpp`) makes
+/// the body's downforce depend on: Fᵢ = Clᵢ·v²·h(Σ), h(Σ) = 2·exp(−3·(1.5·Σ)⁴), Σ the four
+/// wheels' ride heights summed (car1-trb1 with its fuel: h = 1.45 at rest, 1.78 at 55 m/s as the
+/// downforce compresses the springs, a body downforce 17 % and 44 % above 0.645·Cl·A·v²). A
+/// wheel under load F_z rides at x₀ − (F_z − F₀)/k (`susp.cpp`),
+/// within [0, its travel].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Ride {
+    /// Ride height x₀ of a front and of a rear wheel under its static load F₀ (m).
+    pub height: [f64; 2],
+    /// F₀ of a front and of a rear wheel (N): simuv2's `weight0`, from the mass without fuel.
+    pub load: [f64; 2],
+    /// Wheel rate k of a front and of a rear wheel (N/m): the spring's rate times the
+    /// bellcrank's ratio squared.
+    pub rate: [f64; 2],
+    /// Travel of a front and of a rear wheel (m): the suspension course over the bellcrank.
+    pub travel: [f64; 2],
+}
+
+impl Ride {
+    /// h(Σ) = 2·exp(−3·(1.5·Σ)⁴) of simuv2's `aero.cpp`, Σ the ride heights' sum (m).
+    pub fn ground_effect(sum: f64) -> f64 {
+        let x = 1.5 * sum;
+        let x2 = x * x;
+        2.0 * (-3.0 * x2 * x2).exp()
+    }
+
+    /// The sum of the four wheels' ride heights (m) when a front wheel carries `front` and a
+    /// rear wheel `rear` (N).
+    pub fn height_sum(&self, front: f64, rear: f64) -> f64 {
+        [front, rear]
+            .iter()
+            .enumerate()
+            .map(|(k, &fz)| {
+                2.0 * (self.height[k] - (fz - self.load[k]) / self.rate[k])
+                    .clamp(0.0, self.travel[k])
+            })
+            .sum()
+    }
 }
 
 /// One axle's brakes (both wheels alike).
@@ -94,7 +136,9 @@ pub struct Car {
     pub front_weight: f64,
     /// Distance between the axles (m).
     pub wheelbase: f64,
-    /// Yaw inertia factor k: I_z = k·m·a·b (TORCS `mass repartition coefficient`).
+    /// Yaw inertia factor k: I_z = k·m·a·b. For a TORCS car file, the factor that gives
+    /// simuv2's I_z = m₀·(w² + c²·l²)/12 (m₀ the mass without fuel, w and l the body's width
+    /// and length, c the `mass repartition coefficient`).
     pub yaw_inertia_factor: f64,
     /// Drag coefficient Cx.
     pub cx: f64,
@@ -104,6 +148,9 @@ pub struct Car {
     pub clift: [f64; 2],
     /// Front and rear wings.
     pub wings: [Wing; 2],
+    /// The suspension's ride height, for a body downforce that depends on it as in TORCS's
+    /// simuv2 ([`Ride`]; a TORCS car file gives it); `None`: Fᵢ = 0.645·Clᵢ·A·v².
+    pub ride: Option<Ride>,
     /// Engine torque curve: (engine speed rad/s, torque N·m), increasing speed.
     pub torque_curve: Vec<(f64, f64)>,
     /// Rev limiter (rad/s): no torque above it.
@@ -196,6 +243,7 @@ impl Car {
             front_area: 1.85,
             clift: [0.65, 0.61],
             wings: [Wing::default(); 2],
+            ride: None,
             torque_curve: curve_rpm_nm.iter().map(|&(r, t)| (r * rpm, t)).collect(),
             rev_limiter: 8500.0 * rpm,
             tickover: 2000.0 * rpm,
@@ -284,17 +332,41 @@ impl Car {
         (AIR_HALF_RHO * self.cx * self.front_area + wings) * v * v * self.scales.drag
     }
 
-    /// Downforce on the front and rear axles at speed v: Fᵢ = 0.645·Clᵢ·A·v² plus the wings',
-    /// each shared between the axles by its position, times the calibration's scale (N).
+    /// Downforce on the front and rear axles at speed v, level road and no acceleration: the
+    /// body's Fᵢ = 0.645·Clᵢ·A·v², or with a [`Ride`] simuv2's Clᵢ·v²·h(Σ) at the ride heights
+    /// the car settles at under its weight and this downforce; plus the wings', each shared
+    /// between the axles by its position; times the calibration's scale (N).
     pub fn downforce(&self, v: f64) -> [f64; 2] {
-        let q = AIR_HALF_RHO * self.front_area * v * v;
-        let mut f = [q * self.clift[0], q * self.clift[1]];
+        let v2 = v * v;
+        let mut wings = [0.0; 2];
         for w in &self.wings {
-            let d = w.downforce_per_v2() * v * v;
-            f[0] += d * w.front_share;
-            f[1] += d * (1.0 - w.front_share);
+            let d = w.downforce_per_v2() * v2;
+            wings[0] += d * w.front_share;
+            wings[1] += d * (1.0 - w.front_share);
         }
-        f.map(|f| f * self.scales.downforce)
+        let s = self.scales.downforce;
+        let Some(ride) = &self.ride else {
+            let q = AIR_HALF_RHO * self.front_area * v2;
+            return [0, 1].map(|k| (q * self.clift[k] + wings[k]) * s);
+        };
+        let weight = [
+            self.mass * crate::sim::vehicle::G * self.cg_to_rear() / self.wheelbase,
+            self.mass * crate::sim::vehicle::G * self.cg_to_front() / self.wheelbase,
+        ];
+        let total = |sum: f64| {
+            let h = Ride::ground_effect(sum);
+            [0, 1].map(|k| (self.clift[k] * v2 * h + wings[k]) * s)
+        };
+        // The ride heights' sum Σ solves Σ = Σ_ride(loads(Σ)): the right side grows with Σ
+        // (less ground effect, less load, less compression) more slowly than Σ, so bisect.
+        let (mut lo, mut hi) = (0.0, 2.0 * (ride.travel[0] + ride.travel[1]));
+        for _ in 0..50 {
+            let mid = 0.5 * (lo + hi);
+            let d = total(mid);
+            let sum = ride.height_sum(0.5 * (weight[0] + d[0]), 0.5 * (weight[1] + d[1]));
+            if sum > mid { lo = mid } else { hi = mid }
+        }
+        total(0.5 * (lo + hi))
     }
 }
 
@@ -310,6 +382,73 @@ pub const DEFAULT_PAD_MU: f64 = 0.30;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A car with simuv2's ride height: car1-trb1's figures (its file is not in the repository).
+    fn on_springs() -> Car {
+        let rate = 5500.0 * 0.453_592_37 / 0.0254 * 1.1 * 1.1;
+        Car {
+            mass: 1244.0,
+            clift: [0.69, 0.7],
+            ride: Some(Ride {
+                height: [0.09, 0.105],
+                load: [2932.0, 2706.0],
+                rate: [rate, rate],
+                travel: [0.2 / 1.1, 0.2 / 1.1],
+            }),
+            ..Car::spirit_300()
+        }
+    }
+
+    /// h(Σ) = 2·exp(−3·(1.5·Σ)⁴): 2 on the ground, e^(−3) ·2 at 1.5·Σ = 1.
+    #[test]
+    fn the_ground_effect_is_simuv2s() {
+        assert_eq!(Ride::ground_effect(0.0), 2.0);
+        assert!((Ride::ground_effect(1.0 / 1.5) - 2.0 * (-3f64).exp()).abs() < 1e-12);
+        assert!(Ride::ground_effect(0.3) > Ride::ground_effect(0.4));
+    }
+
+    /// The downforce solves its own ride height: the loads it and the weight put on the wheels
+    /// compress the springs to the Σ at which the body's lift is Cl·v²·h(Σ); and it grows
+    /// faster than v² as the car sinks.
+    #[test]
+    fn the_downforce_settles_the_ride_height_it_depends_on() {
+        let car = on_springs();
+        let ride = car.ride.unwrap();
+        let wings = |v: f64| {
+            let mut w = [0.0; 2];
+            for wing in &car.wings {
+                w[0] += wing.downforce_per_v2() * v * v * wing.front_share;
+                w[1] += wing.downforce_per_v2() * v * v * (1.0 - wing.front_share);
+            }
+            w
+        };
+        let g = crate::sim::vehicle::G;
+        let mut last = 0.0;
+        for v in [1.0, 20.0, 40.0, 60.0, 80.0] {
+            let d = car.downforce(v);
+            let w = wings(v);
+            let (a, b, l) = (car.cg_to_front(), car.cg_to_rear(), car.wheelbase);
+            let sum = ride.height_sum(
+                0.5 * (car.mass * g * b / l + d[0]),
+                0.5 * (car.mass * g * a / l + d[1]),
+            );
+            let h = Ride::ground_effect(sum);
+            for k in 0..2 {
+                let body = car.clift[k] * v * v * h;
+                assert!(
+                    (d[k] - w[k] - body).abs() < 1e-6 * d[k].max(1.0),
+                    "{v}: {d:?}"
+                );
+            }
+            let per_v2 = (d[0] + d[1]) / (v * v);
+            assert!(per_v2 > last, "{v}: {per_v2} after {last}");
+            last = per_v2;
+        }
+        // At 60 m/s the springs give 25 mm a wheel and the ground effect 1.7.
+        let d = car.downforce(60.0);
+        let h = (d[0] + d[1] - wings(60.0)[0] - wings(60.0)[1]) / (1.39 * 3600.0);
+        assert!((1.6..1.9).contains(&h), "{h}");
+    }
 
     #[test]
     fn spirit_300_has_the_papers_figures() {

@@ -150,8 +150,10 @@ pub struct Vehicle {
     aid_threshold: [f64; 2],
     /// 0.645·Cx·A (kg/m).
     drag_per_v2: f64,
-    /// 0.645·Clᵢ·A per axle (kg/m).
-    downforce_per_v2: [f64; 2],
+    /// Downforce per v² per axle (kg/m) at speeds 0, [`DOWNFORCE_SPEED_STEP`], 2·… m/s
+    /// ([`Car::downforce`]: constant, 0.645·Clᵢ·A plus the wings', without a ride height; a
+    /// function of the speed with one), linear in between, the last held beyond.
+    downforce_per_v2: Vec<[f64; 2]>,
 }
 
 impl Vehicle {
@@ -175,7 +177,16 @@ impl Vehicle {
             static_load: [car.mass * G * b / l, car.mass * G * a / l],
             transfer_per_accel: car.mass * car.cg_height / l,
             drag_per_v2: car.drag(1.0),
-            downforce_per_v2: car.downforce(1.0),
+            downforce_per_v2: match car.ride {
+                None => vec![car.downforce(1.0)],
+                Some(_) => (0..=DOWNFORCE_SPEEDS)
+                    .map(|i| {
+                        // At v → 0 the coefficient tends to its value at rest: take it at 1 mm/s.
+                        let v = (i as f64 * DOWNFORCE_SPEED_STEP).max(1e-3);
+                        car.downforce(v).map(|f| f / (v * v))
+                    })
+                    .collect(),
+            },
             tyres,
             radius: [car.front_tyre.radius, car.rear_tyre.radius],
             wheel_inertia: [2.0 * car.front_tyre.inertia, 2.0 * car.rear_tyre.inertia],
@@ -194,6 +205,23 @@ impl Vehicle {
         }
     }
 
+    /// Downforce per v² (kg/m) of the front and rear axles at speed v (m/s).
+    #[inline]
+    pub fn downforce_per_v2(&self, v: f64) -> [f64; 2] {
+        let table = &self.downforce_per_v2;
+        if table.len() == 1 {
+            return table[0];
+        }
+        let x = v / DOWNFORCE_SPEED_STEP;
+        let i = x as usize;
+        if i + 1 >= table.len() {
+            return table[table.len() - 1];
+        }
+        let w = x - i as f64;
+        let (a, b) = (table[i], table[i + 1]);
+        [a[0] + w * (b[0] - a[0]), a[1] + w * (b[1] - a[1])]
+    }
+
     /// The tyre models of the front and rear axles.
     pub fn tyres(&self) -> &[TyreModel; 2] {
         &self.tyres
@@ -205,7 +233,7 @@ impl Vehicle {
     pub fn cornering_stiffness(&self, speed: f64, friction: f64) -> [f64; 2] {
         let v2 = speed * speed;
         [0, 1].map(|k| {
-            let fz = self.static_load[k] + self.downforce_per_v2[k] * v2;
+            let fz = self.static_load[k] + self.downforce_per_v2(speed)[k] * v2;
             let tyre = &self.tyres[k];
             tyre.axle_max_force(fz, friction) * tyre.b * tyre.c
         })
@@ -254,7 +282,8 @@ impl Vehicle {
         let car = &self.car;
         let m = car.mass;
         let v2 = s.vx * s.vx + s.vy * s.vy;
-        let down = [self.downforce_per_v2[0] * v2, self.downforce_per_v2[1] * v2];
+        let per_v2 = self.downforce_per_v2(v2.sqrt());
+        let down = [per_v2[0] * v2, per_v2[1] * v2];
         // The road's push per unit of the car's weight: gravity's share on the grade and the
         // banking, and the vertical curvature's vₓ²κ_v (a crest unloads the car).
         let normal =
@@ -394,6 +423,51 @@ fn scale_to_budget(x: f64, y: f64, fmax: f64) -> (f64, f64) {
     (x * scale, y * scale)
 }
 
+/// Speed step (m/s) of the table of downforce per v².
+const DOWNFORCE_SPEED_STEP: f64 = 0.5;
+/// Steps of the table: up to 150 m/s.
+const DOWNFORCE_SPEEDS: usize = 300;
+
 /// 1 / time constant of the longitudinal load transfer (1/s): the pitch dynamics follow
 /// the acceleration with a 50 ms lag.
 const PITCH_RATE: f64 = 20.0;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::car::Ride;
+
+    /// Between the table's speeds the downforce per v² is the car's within 0.1 %, and a car
+    /// without a ride height keeps its constant.
+    #[test]
+    fn the_downforce_table_follows_the_car() {
+        let rate = 5500.0 * 0.453_592_37 / 0.0254 * 1.21;
+        let car = Car {
+            mass: 1244.0,
+            clift: [0.69, 0.7],
+            ride: Some(Ride {
+                height: [0.09, 0.105],
+                load: [2932.0, 2706.0],
+                rate: [rate, rate],
+                travel: [0.18, 0.18],
+            }),
+            ..Car::spirit_300()
+        };
+        let v = Vehicle::new(&car);
+        for speed in [0.3, 7.77, 31.1, 55.55, 89.9, 149.0] {
+            let exact = car.downforce(speed).map(|f| f / (speed * speed));
+            let table = v.downforce_per_v2(speed);
+            for k in 0..2 {
+                assert!(
+                    (table[k] - exact[k]).abs() < 1e-3 * exact[k],
+                    "{speed}: {table:?} vs {exact:?}"
+                );
+            }
+        }
+        let plain = Vehicle::new(&Car::spirit_300());
+        assert_eq!(
+            plain.downforce_per_v2(42.0),
+            Car::spirit_300().downforce(1.0)
+        );
+    }
+}
