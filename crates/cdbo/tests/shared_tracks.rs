@@ -182,12 +182,16 @@ fn spirit_300_from_its_files_equals_the_builtin_car() {
             ride: car.ride,
             front_tyre: Tyre {
                 mu: car.front_tyre.mu,
+                skid: cdbo::car::torcs::SKID_FACTOR,
                 ..builtin.front_tyre
             },
             rear_tyre: Tyre {
                 mu: car.rear_tyre.mu,
+                skid: cdbo::car::torcs::SKID_FACTOR,
                 ..builtin.rear_tyre
             },
+            // The game's car, as cdbo's robot drives it.
+            torcs_robot: true,
             ..builtin
         }
     );

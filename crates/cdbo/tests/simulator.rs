@@ -308,3 +308,82 @@ fn the_limit_on_the_minimum_curvature_line_beats_the_centre_lines() {
         assert!(on_line.line_length_m < t.length);
     }
 }
+
+/// A car the TORCS robot drives pulls away on simuv2's slipping clutch. Open (τ = 0), the
+/// engine revs unloaded, ω_e + T_e(ω_e)·dt/I_e in a step, and the car stays still; at
+/// τ = 1/2 (≥ 1/3) the wheels get the engine's whole torque T_e(ω_e)·g, so from rest one
+/// implicit step spins the rear axle to ω = T_e·g·dt/(I_w + dt·R²·F_max·B·C/v₀) (the slip's
+/// slope at rest, v₀ the slip speed floor), and the engine's speed becomes
+/// ω·g·τ⁴ + (ω_e + T_e·dt/I_e)(1 − τ⁴). From rest at full throttle the car then reaches 2 m
+/// with v²/(2·2 m), its mean acceleration over the distance, past the rear axle's grip without the skid factor (which gives a
+/// spinning tyre up to 1 + 0.3·1.5 times the force), and within it with the factor.
+#[test]
+fn the_robot_pulls_away_on_the_slipping_clutch() {
+    let mut car = Car::spirit_300();
+    car.torcs_robot = true;
+    car.front_tyre.skid = 0.3;
+    car.rear_tyre.skid = 0.3;
+    let vehicle = Vehicle::new(&car);
+    let track = straight(1000.0);
+    let frame = *track.frame(0);
+    let full = Controls::new(0.0, 1.0, 0.0);
+    let dt = 0.002;
+    let g = car.gears[0] * car.final_drive;
+
+    let mut s = vehicle.at_rest(0.0, 0.0, 0.0);
+    s.clutch = 1.0;
+    let w0 = car.tickover;
+    vehicle.step(&mut s, &full, &frame, dt);
+    let free = w0 + car.engine_torque(w0) * dt / car.engine_inertia;
+    assert!(
+        (s.engine_speed - free).abs() < 1e-12 * free,
+        "{} vs {free}",
+        s.engine_speed
+    );
+    assert_eq!((s.vx, s.omega), (0.0, [0.0, 0.0]));
+
+    let mut s = vehicle.at_rest(0.0, 0.0, 0.0);
+    let (tau, we) = (0.5, 600.0);
+    s.clutch = 1.0 - tau;
+    s.engine_speed = we;
+    vehicle.step(&mut s, &full, &frame, dt);
+    let te = car.engine_torque(we);
+    let (r, rear) = (car.rear_tyre.radius, &vehicle.tyres()[1]);
+    let fz = car.mass * G * car.cg_to_front() / car.wheelbase;
+    let slope = rear.axle_max_force(fz, frame.friction) * rear.b * rear.c;
+    let floor = cdbo::sim::vehicle::SLIP_SPEED_FLOOR;
+    let omega = te * g * dt / (2.0 * car.rear_tyre.inertia + dt * r * r * slope / floor);
+    assert!(
+        (s.omega[1] - omega).abs() < 1e-9 * omega,
+        "{} vs {omega}",
+        s.omega[1]
+    );
+    let t4 = tau.powi(4);
+    let engine = omega * g * t4 + (we + te * dt / car.engine_inertia) * (1.0 - t4);
+    assert!((s.engine_speed - engine).abs() < 1e-9 * engine);
+
+    let mut s = vehicle.at_rest(0.0, 0.0, 0.0);
+    for i in 0.. {
+        if i % 10 == 0 {
+            vehicle.shift(&mut s, 1.0);
+            vehicle.clutch(&mut s, 1.0, 10.0 * dt);
+        }
+        vehicle.step(&mut s, &full, &frame, dt);
+        if s.x >= 2.0 {
+            break;
+        }
+    }
+    let mean = s.vx * s.vx / (2.0 * s.x);
+    // The rear axle's grip at an acceleration a, its load moved rearwards by m·h·a/L.
+    let limit = |cap: f64| {
+        (0..50).fold(0.0, |a: f64, _| {
+            let fz = fz + car.mass * car.cg_height * a / car.wheelbase;
+            rear.axle_max_force(fz, frame.friction) * cap / car.mass
+        })
+    };
+    let (without, with) = (limit(1.0), limit(rear.force_cap));
+    assert!(
+        mean > without && mean < with,
+        "{mean} m/s² vs {without}..{with}"
+    );
+}

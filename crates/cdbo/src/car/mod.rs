@@ -42,6 +42,11 @@ pub struct Tyre {
     pub rolling_resistance: f64,
     /// Rotational inertia of one wheel with its brake disc (kg·m²).
     pub inertia: f64,
+    /// The skid factor k: TORCS's simuv2 (`wheel.cpp`) multiplies the force by
+    /// 1 + k·min(s, 1.5) for the slip's magnitude s, k from the driver's skill level
+    /// (`categories.cpp`: 0.4, 0.35, 0.3, 0 for rookie, amateur, semi-pro, pro); 0 for a car
+    /// that is not the game's.
+    pub skid: f64,
 }
 
 /// The suspension as it sets the body's ride height, which TORCS's simuv2 (`aero.cpp`) makes
@@ -191,6 +196,12 @@ pub struct Car {
     /// Overall width of the body (m), TORCS `Car/overall width` (else `body width`): how
     /// much of the road a racing line leaves between the car's centre and the edge.
     pub width: f64,
+    /// Whether cdbo's simulator drives the car as cdbo's TORCS robot drives the game's car (a
+    /// car read from TORCS files): pulling away on simuv2's slipping clutch, closed by the
+    /// robot's launch clutch ([`crate::torcs::launch`]), and with the robot's traction control
+    /// on the driven wheels' slip speed ([`crate::torcs::traction`]). Else (the built-in car)
+    /// the clutch slips only below idle and traction control acts on the relative slip.
+    pub torcs_robot: bool,
     /// Calibration scales over the car file's values ([`calibration`]): 1 for a stock car.
     /// Grip and peak slip are already in the tyres; drag, downforce, rolling resistance and
     /// the launch are applied where those forces are computed.
@@ -231,6 +242,7 @@ impl Car {
             operating_load: load,
             rolling_resistance: 0.01,
             inertia,
+            skid: 0.0,
         };
         Car {
             name: "Spirit 300".into(),
@@ -270,6 +282,7 @@ impl Car {
             },
             steer_lock: 45f64.to_radians(),
             width: 1.90,
+            torcs_robot: false,
             scales: Scales::ONE,
         }
     }

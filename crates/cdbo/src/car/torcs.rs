@@ -59,6 +59,11 @@ fn find_category(car: &Path, cat: &str) -> Option<PathBuf> {
 /// Rolling resistance of TORCS's asphalt surfaces (`data/tracks/surfaces.xml`).
 const ASPHALT_ROLLING_RESISTANCE: f64 = 0.001;
 
+/// The game's skid factor for cdbo's robot ([`Tyre::skid`]): its `cdbo.xml` names no skill
+/// level, so TORCS's race engine (`raceinit.cpp`) ranks it semi-pro, whose factor in simuv2's
+/// `categories.cpp` (`simSkidFactor`) is 0.3.
+pub const SKID_FACTOR: f64 = 0.3;
+
 /// Gravity as TORCS's `tgf.h` has it (m/s²), for the wheels' static loads.
 const TORCS_G: f64 = 9.80665;
 
@@ -259,6 +264,7 @@ pub fn from_params(p: &Params) -> Result<Car> {
             // a car file without one rolls like the game's asphalt (0.001).
             rolling_resistance: w.num_or("rolling resistance", ASPHALT_ROLLING_RESISTANCE)?,
             inertia: w.num_or("inertia", 1.5)? + brake.num_or("inertia", 0.13)?,
+            skid: SKID_FACTOR,
         })
     };
     let brake = |name: &str| -> Result<Brake> {
@@ -332,6 +338,7 @@ pub fn from_params(p: &Params) -> Result<Car> {
             sec("Steer").num_or("steer lock", 0.43)?,
         )?,
         width: positive(car, "overall width", car_width(car)?)?,
+        torcs_robot: true,
         scales: super::Scales::ONE,
     })
 }
