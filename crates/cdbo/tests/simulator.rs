@@ -98,9 +98,9 @@ fn same_inputs_give_bit_identical_laps() {
     assert_eq!(a.trace, b.trace);
 }
 
-/// Lap times converge as the physics step shrinks: against a 0.5 ms reference the error falls
-/// by a factor of 1.5 to 6 from 2 ms to 1 ms, and is below 0.3 % at the default 4 ms (the
-/// driver stays at 50 Hz).
+/// Lap times converge as the physics step shrinks: against a 0.5 ms reference the error is
+/// below 0.3 % at the default 4 ms, and falls by a factor of 1.5 to 6 from 2 ms to 1 ms
+/// unless it is already at the lap time's resolution (the driver stays at 50 Hz).
 #[test]
 fn the_lap_time_converges_as_the_step_shrinks() {
     let car = Car::spirit_300();
@@ -118,11 +118,15 @@ fn the_lap_time_converges_as_the_step_shrinks() {
         let error = |dt| (lap_time(dt) - reference).abs() / reference;
         let (e1, e2, e4) = (error(0.001), error(0.002), error(0.004));
         assert!(e4 < 3e-3, "{}: {e4}", track.name);
-        // From 2 ms down the error shrinks with the step; at 4 ms the light driven axle (no
-        // engine inertia on it, as in simuv2) adds a step error of some 0.1-0.25 %.
+        // From 2 ms down the error shrinks with the step, where it stands above the lap time's
+        // resolution (a driver step, 0.02 s, some 1.3e-4 of Ridgeway's lap): with the rear
+        // wheels each on its own (each half the axle's inertia, joined by the differential)
+        // Ridgeway's errors are all at that level (1.1e-4, 1.8e-4, 0.7e-4); before, the one
+        // light driven axle added a step error of some 0.1-0.25 % at 4 ms.
+        let resolution = 0.02 / reference;
         let ratio = e2 / e1;
         assert!(
-            (1.5..6.0).contains(&ratio) && e4 > e2,
+            e2 < 2.0 * resolution || ((1.5..6.0).contains(&ratio) && e4 > e2),
             "{}: errors {e1:e} {e2:e} {e4:e}",
             track.name
         );
@@ -145,7 +149,11 @@ fn drive_straight(
     let vehicle = Vehicle::new(&car);
     let mut s = vehicle.at_rest(0.0, 0.0, 0.0);
     s.vx = v0;
-    s.omega = [v0 / car.front_tyre.radius, v0 / car.rear_tyre.radius];
+    s.omega = [
+        v0 / car.front_tyre.radius,
+        v0 / car.rear_tyre.radius,
+        v0 / car.rear_tyre.radius,
+    ];
     // Settle the gearbox into the gear for this speed before the clock starts.
     for _ in 0..car.gears.len() {
         vehicle.shift(&mut s, throttle);
@@ -198,7 +206,11 @@ fn over_a_sharp_enough_crest_the_tyres_carry_nothing() {
         frame.vertical_curvature = vertical_curvature;
         let mut s = vehicle.at_rest(0.0, 0.0, 0.0);
         s.vx = v0;
-        s.omega = [v0 / car.front_tyre.radius, v0 / car.rear_tyre.radius];
+        s.omega = [
+            v0 / car.front_tyre.radius,
+            v0 / car.rear_tyre.radius,
+            v0 / car.rear_tyre.radius,
+        ];
         let c = Controls::new(0.0, 0.0, 1.0);
         for _ in 0..(seconds / dt).round() as usize {
             vehicle.step(&mut s, &c, &frame, dt);
@@ -340,7 +352,7 @@ fn the_robot_pulls_away_on_the_slipping_clutch() {
         "{} vs {free}",
         s.engine_speed
     );
-    assert_eq!((s.vx, s.omega), (0.0, [0.0, 0.0]));
+    assert_eq!((s.vx, s.omega), (0.0, [0.0; 3]));
 
     let mut s = vehicle.at_rest(0.0, 0.0, 0.0);
     let (tau, we) = (0.5, 600.0);

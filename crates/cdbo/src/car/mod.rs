@@ -90,6 +90,57 @@ impl Ride {
     }
 }
 
+/// The axles as TORCS's simuv2 loads their wheels in a corner (`car.cpp`, `axle.cpp`,
+/// `susp.cpp`): each wheel's lateral force Fᵧ pushes the body about its roll axis at the
+/// axle's roll centre height, not at the centre of gravity (`car.cpp`: M_x = Σ F_z·y +
+/// Σ Fᵧ·h_rc), and the springs and anti-roll bars take that moment up in proportion to their
+/// roll rates. With the body rolled by φ a wheel at y carries κ·y·φ more (the left) or less,
+/// κ = K·b² + 2·K_arb·b its rate in roll (spring K, bellcrank b, anti-roll bar K_arb), so in
+/// the steady roll the axle a moves ΔF_a = M·κ_a·y_a / (2·Σ_b κ_b·y_b²) from its inner wheel
+/// to its outer one, M = Σ_a Fᵧ,a·h_rc,a.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Axles {
+    /// Half the track of the front and rear axles, |y| of their wheels (m).
+    pub half_track: [f64; 2],
+    /// Roll centre height of the front and rear axles (m), TORCS `roll center height`.
+    pub roll_centre: [f64; 2],
+    /// Rate in roll κ = K·b² + 2·K_arb·b of a front and of a rear wheel (N/m).
+    pub roll_rate: [f64; 2],
+    /// The height above the road at which the tyres' longitudinal forces pitch the body
+    /// (m): simuv2 takes the centre of gravity's height plus the wheel's ride height
+    /// (`car.cpp`: M_y = −Σ Fₓ·(h + x_ride)); the load moved from front to rear is
+    /// ΣFₓ·(that height)/L.
+    pub pitch_height: f64,
+}
+
+/// The kind of differential of the driven rear axle ([`Differential`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum DiffKind {
+    /// Both wheels on one shaft.
+    Spool,
+    /// An open differential (simuv2's FREE).
+    Free,
+    /// simuv2's LIMITED SLIP.
+    LimitedSlip,
+}
+
+/// The rear differential as TORCS's simuv2 drives the rear wheels through it
+/// (`differential.cpp`; [`crate::sim::vehicle`] has the formulas).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Differential {
+    /// Its kind.
+    pub kind: DiffKind,
+    /// The wheels' largest speed ratio |ω₀ − ω₁|/(|ω₀| + |ω₁|) without drive torque (TORCS
+    /// `max slip bias`, 0.03 by default).
+    pub slip_max: f64,
+    /// Drive torque at the differential (N·m) from which a limited slip locks (TORCS
+    /// `locking input torque`, 3000 by default).
+    pub lock_torque: f64,
+    /// Braking (engine brake) torque from which it locks (N·m; TORCS `locking brake input
+    /// torque`, a third of the locking input torque by default).
+    pub lock_brake_torque: f64,
+}
+
 /// One axle's brakes (both wheels alike).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Brake {
@@ -196,6 +247,12 @@ pub struct Car {
     /// Overall width of the body (m), TORCS `Car/overall width` (else `body width`): how
     /// much of the road a racing line leaves between the car's centre and the edge.
     pub width: f64,
+    /// The axles' track, roll centres and roll rates: how the wheels share the load in a
+    /// corner and under acceleration ([`Axles`]).
+    pub axles: Axles,
+    /// The rear axle's differential ([`Differential`]); a rear axle without drive has its
+    /// wheels roll free.
+    pub differential: Differential,
     /// Whether cdbo's simulator drives the car as cdbo's TORCS robot drives the game's car (a
     /// car read from TORCS files): pulling away on simuv2's slipping clutch, closed by the
     /// robot's launch clutch ([`crate::torcs::launch`]), and with the robot's traction control
@@ -282,6 +339,21 @@ impl Car {
             },
             steer_lock: 45f64.to_radians(),
             width: 1.90,
+            // sc-spirit-300.xml: wheels at y = ±0.78 / ±0.80 m, roll centres 0.39 m, springs
+            // 37 / 57 kN/m (bellcrank 1, no anti-roll bars), ride height 0.11 m; a limited-slip
+            // differential with max slip bias 0.4 and simuv2's default locking torques.
+            axles: Axles {
+                half_track: [0.78, 0.80],
+                roll_centre: [0.39, 0.39],
+                roll_rate: [37.0e3, 57.0e3],
+                pitch_height: 0.285 + 0.11,
+            },
+            differential: Differential {
+                kind: DiffKind::LimitedSlip,
+                slip_max: 0.4,
+                lock_torque: 3000.0,
+                lock_brake_torque: 990.0,
+            },
             torcs_robot: false,
             scales: Scales::ONE,
         }

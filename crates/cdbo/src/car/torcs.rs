@@ -5,7 +5,10 @@
 
 use std::path::{Path, PathBuf};
 
-use super::{Brake, Car, DEFAULT_ENGINE_BRAKE, DEFAULT_PAD_MU, Drive, Ride, Tyre, Wing};
+use super::{
+    Axles, Brake, Car, DEFAULT_ENGINE_BRAKE, DEFAULT_PAD_MU, DiffKind, Differential, Drive, Ride,
+    Tyre, Wing,
+};
 use crate::bounded;
 use crate::error::{Error, Result};
 use crate::params::{Params, Section};
@@ -233,7 +236,7 @@ pub fn from_params(p: &Params) -> Result<Car> {
         }
     };
     let diff = |name: &str| sec(name).num_or("ratio", 1.0);
-    let (final_drive, differential) = match drive {
+    let (final_drive, diff_section) = match drive {
         Drive::Rear => (diff("Rear Differential")?, "Rear Differential"),
         Drive::Front => (diff("Front Differential")?, "Front Differential"),
         Drive::All => (
@@ -295,6 +298,69 @@ pub fn from_params(p: &Params) -> Result<Car> {
             travel: [f.2, r.2],
         }
     };
+    // The axles as simuv2 loads their wheels in a corner (`axle.cpp`, `susp.cpp`, `car.cpp`):
+    // the wheels' |y|, the roll centres (0.15 m by default), and each wheel's rate in roll,
+    // K·b² of its spring plus 2·K_arb·b of the axle's anti-roll bar (0 by default).
+    let axles = {
+        let axle = |axle: &str, wheel: &str, susp: &str, arb: &str| -> Result<(f64, f64, f64)> {
+            let (a, w, s) = (sec(axle), sec(wheel), sec(susp));
+            let bellcrank = positive(s, "bellcrank", s.num_or("bellcrank", 1.0)?)?;
+            let spring = s.num_or("spring", 175_000.0)?;
+            let bar = sec(arb).num_or("spring", 0.0)?;
+            let rate = spring * bellcrank * bellcrank + 2.0 * bar * bellcrank;
+            if !(rate >= 0.0 && rate.is_finite()) {
+                return Err(s.value_error("spring", format!("must be non-negative, got {spring}")));
+            }
+            Ok((
+                w.num_or("ypos", 0.0)?.abs(),
+                a.num_or("roll center height", 0.15)?,
+                rate,
+            ))
+        };
+        let f = axle(
+            "Front Axle",
+            "Front Right Wheel",
+            "Front Right Suspension",
+            "Front Anti-Roll Bar",
+        )?;
+        let r = axle(
+            "Rear Axle",
+            "Rear Right Wheel",
+            "Rear Right Suspension",
+            "Rear Anti-Roll Bar",
+        )?;
+        Axles {
+            half_track: [f.0, r.0],
+            roll_centre: [f.1, r.1],
+            roll_rate: [f.2, r.2],
+            pitch_height: cg_height + 0.5 * (ride.height[0] + ride.height[1]),
+        }
+    };
+    // The rear differential (`differential.cpp`; defaults of TORCS 1.3's simuv2). A viscous
+    // coupler or none on a driven axle is taken as a free differential.
+    let differential = {
+        let d = sec("Rear Differential");
+        let kind = match d.str("type").unwrap_or("NONE") {
+            "SPOOL" => DiffKind::Spool,
+            "LIMITED SLIP" => DiffKind::LimitedSlip,
+            _ => DiffKind::Free,
+        };
+        let lock_torque = positive(
+            d,
+            "locking input torque",
+            d.num_or("locking input torque", 3000.0)?,
+        )?;
+        Differential {
+            kind,
+            slip_max: d.num_or("max slip bias", 0.03)?.max(0.0),
+            lock_torque,
+            lock_brake_torque: positive(
+                d,
+                "locking brake input torque",
+                d.num_or("locking brake input torque", 0.33 * lock_torque)?,
+            )?,
+        }
+    };
     let brakes = sec("Brake System");
     Ok(Car {
         name: p.root.name.clone(),
@@ -308,6 +374,8 @@ pub fn from_params(p: &Params) -> Result<Car> {
         clift,
         wings,
         ride: Some(ride),
+        axles,
+        differential,
         torque_curve,
         rev_limiter,
         tickover,
@@ -315,7 +383,7 @@ pub fn from_params(p: &Params) -> Result<Car> {
         engine_brake,
         engine_inertia,
         gears,
-        final_drive: positive(sec(differential), "ratio", final_drive)?,
+        final_drive: positive(sec(diff_section), "ratio", final_drive)?,
         shift_time,
         drive,
         front_tyre: tyre("Front Right Wheel", static_wheel_load[0])?,

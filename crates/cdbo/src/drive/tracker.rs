@@ -344,9 +344,15 @@ mod tests {
                 (heading_error - heading).abs() < 0.025 * b * kappa,
                 "d {offset}: Δψ {heading_error} against {heading}"
             );
+            // The bicycle's steer is the mean of the front wheels' angles: the inner one's δ
+            // and the outer one's Ackermann angle (`sim::vehicle`); the lateral load transfer
+            // leaves 0.3 % more.
+            let track = car.axles.half_track[0] + car.axles.half_track[1];
+            let outer = (l * delta.tan() / (l + track * delta.tan().abs())).atan();
+            let mean = 0.5 * (delta + outer);
             assert!(
-                (delta / steer - 1.0).abs() < 0.002,
-                "d {offset}: δ {delta} against {steer}"
+                (mean / steer - 1.0).abs() < 0.005,
+                "d {offset}: δ {delta} (mean {mean}) against {steer}"
             );
         }
     }

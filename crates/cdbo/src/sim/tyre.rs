@@ -106,6 +106,13 @@ impl TyreModel {
         }
     }
 
+    /// Largest force one tyre can give under its load `fz` on a surface of friction `surface`
+    /// (N): F_z·μ·μ_surface·λ(F_z), as simuv2's `wheel.cpp` has it per wheel.
+    #[inline]
+    pub fn wheel_max_force(&self, fz: f64, surface: f64) -> f64 {
+        fz * self.mu * surface * self.load_factor(fz)
+    }
+
     /// Largest force an axle of two such tyres can give under its load `fz` on a surface of
     /// friction `surface` (N): F_z·μ·μ_surface·λ(F_z/2).
     #[inline]
