@@ -287,7 +287,8 @@ mod tests {
     /// The closed-form steady state (see the module): on a circle of radius 100 m, with a line
     /// 3 m inside it (and outside it) at 15 m/s (0.23 g), the car settles on the line (e = 0
     /// within 5 mm) with the steering δ = (L + K·v²)·κ of the linear single-track car (within
-    /// 0.2 %) and its heading error Δψ_ss = κ·(m·a·v²/(L·C_r) − b) (within 2.5 % of κ·b, the
+    /// 0.5 %, as the front wheels' mean angle: the outer wheel steers by its Ackermann angle)
+    /// and its heading error Δψ_ss = κ·(m·a·v²/(L·C_r) − b) (within 2.5 % of κ·b, the
     /// two terms nearly cancelling at this speed; the drive force on the rear tyres' budget
     /// moves the rear slip a little), κ = 1/(R − d) the line's curvature.
     #[test]

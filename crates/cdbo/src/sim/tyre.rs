@@ -10,8 +10,9 @@
 //! Longitudinal and lateral forces share this one budget along the slip vector:
 //! Fₓ = F·sₓ/s, F_y = F·s_y/s (the friction ellipse of combined slip).
 //!
-//! The single-track model lumps an axle's two tyres: its budget is F_z·μ·μ_surface·λ(F_z/2),
-//! the load sensitivity taken at the load of one tyre, as TORCS applies it per wheel.
+//! The vehicle ([`super::vehicle`]) gives each wheel its own budget F_z·μ·μ_surface·λ(F_z)
+//! under its own load, as TORCS applies it per wheel; the limit solver and the cornering
+//! stiffness lump an axle's two tyres at equal loads, F_z·μ·μ_surface·λ(F_z/2).
 //!
 //! In the hot loop the shape is read as g(u) = f(√u)/√u on u = s² = sₓ² + s_y²: f is odd, so
 //! g is smooth in u, and Fₓ = F_max·g(u)·sₓ, F_y = F_max·g(u)·s_y need neither a square root
