@@ -796,6 +796,119 @@ mod tests {
     use super::*;
     use crate::car::Ride;
 
+    /// A level straight's frame.
+    fn level() -> Frame {
+        let t = crate::track::Track::from_pieces(
+            "straight",
+            "test",
+            &[crate::track::Piece::flat(500.0, 0.0)],
+            vec![],
+        );
+        *t.frame(0)
+    }
+
+    /// The car mirrored: steering, lateral velocity, yaw rate, roll moment and the rear wheels
+    /// swapped left for right give the mirrored step, to the last bits (the Ackermann wheel,
+    /// the wheels' loads and the rear wheels' yaw moment take the right sides), for a limited
+    /// slip, a spool and a free differential, under drive and under the brakes.
+    #[test]
+    fn a_left_hand_turn_mirrors_a_right_hand_one() {
+        for kind in [DiffKind::LimitedSlip, DiffKind::Spool, DiffKind::Free] {
+            let mut car = Car::spirit_300();
+            car.differential.kind = kind;
+            let v = Vehicle::new(&car);
+            let frame = level();
+            for (throttle, brake) in [(0.8, 0.0), (0.0, 0.6)] {
+                let mut left = v.at_rest(0.0, 0.0, 0.0);
+                left.vx = 30.0;
+                left.vy = 0.4;
+                left.yaw_rate = 0.5;
+                left.roll = 2000.0;
+                left.omega = [30.0 / v.radius[0], 31.0 / v.radius[1], 32.0 / v.radius[1]];
+                left.yaw_sin_cos = left.yaw.sin_cos();
+                v.shift(&mut left, throttle);
+                let mut right = left;
+                right.vy = -left.vy;
+                right.yaw_rate = -left.yaw_rate;
+                right.roll = -left.roll;
+                right.omega = [left.omega[0], left.omega[2], left.omega[1]];
+                for _ in 0..50 {
+                    v.step(
+                        &mut left,
+                        &Controls::new(0.1, throttle, brake),
+                        &frame,
+                        0.004,
+                    );
+                    v.step(
+                        &mut right,
+                        &Controls::new(-0.1, throttle, brake),
+                        &frame,
+                        0.004,
+                    );
+                }
+                let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(1.0);
+                assert!(close(left.vx, right.vx), "{kind:?}: {left:?} {right:?}");
+                assert!(close(left.vy, -right.vy), "{kind:?}: {left:?} {right:?}");
+                assert!(close(left.yaw_rate, -right.yaw_rate), "{kind:?}");
+                assert!(close(left.roll, -right.roll), "{kind:?}");
+                assert!(close(left.omega[1], right.omega[2]), "{kind:?}");
+                assert!(close(left.omega[2], right.omega[1]), "{kind:?}");
+                assert!(left.yaw_rate > 0.0 && left.roll > 0.0, "{kind:?}: {left:?}");
+            }
+        }
+    }
+
+    /// The lateral load transfer takes the roll moment up: the axles' transfers ΔF_a at ±y_a
+    /// give back M (Σ 2·ΔF_a·y_a = M), shared as the rates in roll times the tracks.
+    #[test]
+    fn the_wheels_take_up_the_roll_moment() {
+        let car = Car::spirit_300();
+        let v = Vehicle::new(&car);
+        let (y, k) = (car.axles.half_track, car.axles.roll_rate);
+        let moment = 2.0 * (v.roll_share[0] * y[0] + v.roll_share[1] * y[1]);
+        assert!((moment - 1.0).abs() < 1e-12, "{moment}");
+        let ratio = v.roll_share[0] / v.roll_share[1];
+        assert!((ratio - k[0] * y[0] / (k[1] * y[1])).abs() < 1e-12);
+    }
+
+    /// Through a spool the rear wheels turn as one; through a limited slip under a drive
+    /// torque T below its locking torque their speed ratio ends within ρ_s·(1 − T/T_lock);
+    /// through a free one, on a slippery road, the drive spins both up alike.
+    #[test]
+    fn the_differential_holds_the_rear_wheels_as_its_kind() {
+        let r = Car::spirit_300().rear_tyre.radius;
+        let rear = RearWheels {
+            loads: [3000.0, 3000.0],
+            vt: [30.0, 30.0],
+            vl: 0.0,
+            inv_denom: [1.0 / 30.0; 2],
+            inv_axle: 1.0 / 30.0,
+        };
+        let spun = |kind: DiffKind, drive: f64, omega: [f64; 2], friction: f64| {
+            let mut car = Car::spirit_300();
+            car.differential.kind = kind;
+            let v = Vehicle::new(&car);
+            let mut s = v.at_rest(0.0, 0.0, 0.0);
+            s.vx = 30.0;
+            s.omega = [30.0 / r, omega[0], omega[1]];
+            v.rear_wheels(&mut s, 0.0, drive, &rear, friction, 0.004);
+            [s.omega[1], s.omega[2]]
+        };
+        let w = spun(DiffKind::Spool, 500.0, [30.0 / r, 33.0 / r], 1.0);
+        assert_eq!(w[0], w[1]);
+        let diff = Car::spirit_300().differential;
+        let drive = 600.0;
+        let w = spun(DiffKind::LimitedSlip, drive, [30.0 / r, 36.0 / r], 1.0);
+        let ratio = (w[0] - w[1]).abs() / (w[0].abs() + w[1].abs());
+        assert!(
+            ratio <= diff.slip_max * (1.0 - drive / diff.lock_torque) + 1e-12,
+            "{ratio}"
+        );
+        // Both wheels on a road of friction 0.05, from rolling.
+        let w = spun(DiffKind::Free, 800.0, [30.0 / r, 30.0 / r], 0.05);
+        assert!(w[0] > 30.0 / r && (w[0] - w[1]).abs() < 1e-9, "{w:?}");
+    }
+
     /// Between the table's speeds the downforce per v² is the car's within 0.1 %, and a car
     /// without a ride height keeps its constant.
     #[test]
