@@ -31,8 +31,9 @@ fn observed_with(track: &Track, base: &Car, truth: &Scales) -> TrackLaps {
 }
 
 /// Grip 15 % down and the launch 15 % up on the Spirit 300 round Ridgeway: the fit of those
-/// two from the stock car, on all five probes, finds both within 2 % (0.8505 and 1.132), and
-/// its cost falls a hundredfold; the same fit again gives the same scales to the bit. (On the
+/// two from the stock car, on all five probes, finds both within 2 % (0.8505 and 1.139), and
+/// its cost falls some hundredfold (99-fold since the rear wheels turn each on its own,
+/// 2.99 to 0.0303); the same fit again gives the same scales to the bit. (On the
 /// launch-and-brake and the fast probes alone, since the road's vertical curvature loads the
 /// car, it stops at a launch of 1.18.)
 #[test]
@@ -54,7 +55,7 @@ fn the_fit_recovers_known_scales_from_its_own_laps() {
         ..FitConfig::default()
     };
     let fit = calibrate::fit(&base, &observed, &config).unwrap();
-    assert!(fit.cost < 0.01 * fit.cost_start, "{fit:?}");
+    assert!(fit.cost < 0.015 * fit.cost_start, "{fit:?}");
     assert!((fit.scales.grip / 0.85 - 1.0).abs() < 0.02, "{fit:?}");
     assert!((fit.scales.launch / 1.15 - 1.0).abs() < 0.02, "{fit:?}");
     assert_eq!(calibrate::fit(&base, &observed, &config).unwrap(), fit);

@@ -94,7 +94,7 @@ fn tracks_are_found_by_name_in_data_folders() {
 
 #[test]
 fn spirit_300_from_its_files_equals_the_builtin_car() {
-    use cdbo::car::{Car, catalog, torcs};
+    use cdbo::car::{Car, Tyre, catalog, torcs};
     let car = torcs::read(
         &shared("speed-dreams/cars/models/sc-spirit-300/sc-spirit-300.xml"),
         None,
@@ -102,8 +102,30 @@ fn spirit_300_from_its_files_equals_the_builtin_car() {
     .unwrap();
     let builtin = Car::spirit_300();
     assert_eq!(car.name, "Spirit 300");
+    // What the game's simuv2 adds to the paper's car (the built-in keeps the paper's
+    // figures): the file's 70 l of fuel to the mass moved, the camber's grip (−3° front, −2°
+    // rear: 1 + 0.05·sin(−18γ)), a yaw inertia from the body's size, the ride height.
+    assert_eq!(car.mass, builtin.mass + 70.0);
+    for (tyre, camber, base) in [
+        (&car.front_tyre, -3.0f64, &builtin.front_tyre),
+        (&car.rear_tyre, -2.0, &builtin.rear_tyre),
+    ] {
+        let grip = 1.0 + 0.05 * (-18f64 * camber.to_radians()).sin();
+        assert!(
+            (tyre.mu - base.mu * grip).abs() < 1e-9,
+            "{} vs {}",
+            tyre.mu,
+            base.mu
+        );
+    }
+    let yaw = 1440.0 * (1.90f64.powi(2) + (0.62f64 * 4.2).powi(2)) / 12.0;
+    assert!(
+        (car.yaw_inertia() - yaw).abs() < 1e-6 * yaw,
+        "{}",
+        car.yaw_inertia()
+    );
+    assert!(car.ride.is_some());
     for (a, b, what) in [
-        (car.mass, builtin.mass, "mass"),
         (car.cg_height, builtin.cg_height, "cg"),
         (car.front_weight, builtin.front_weight, "front weight"),
         (car.wheelbase, builtin.wheelbase, "wheelbase"),
@@ -155,11 +177,29 @@ fn spirit_300_from_its_files_equals_the_builtin_car() {
         car,
         Car {
             torque_curve: car.torque_curve.clone(),
+            mass: car.mass,
+            yaw_inertia_factor: car.yaw_inertia_factor,
+            ride: car.ride,
+            front_tyre: Tyre {
+                mu: car.front_tyre.mu,
+                skid: cdbo::car::torcs::SKID_FACTOR,
+                ..builtin.front_tyre
+            },
+            rear_tyre: Tyre {
+                mu: car.rear_tyre.mu,
+                skid: cdbo::car::torcs::SKID_FACTOR,
+                ..builtin.rear_tyre
+            },
+            // The game's car, as cdbo's robot drives it.
+            torcs_robot: true,
             ..builtin
         }
     );
     let data = cdbo::data_path::DataPath::with_env(&[shared("")], "");
-    assert_eq!(catalog::find("sc-spirit-300", &data).unwrap().mass, 1440.0);
+    assert_eq!(
+        catalog::find("sc-spirit-300", &data).unwrap().mass,
+        1440.0 + 70.0
+    );
     let trb1 = catalog::find("car1-trb1", &data).unwrap();
     assert!(trb1.mass > 500.0 && !trb1.gears.is_empty());
     // Its wings (front 0.25 m² at 6°, rear 0.7 m² at 14°) add 1.23·A·sin α to the drag and four
@@ -171,9 +211,25 @@ fn spirit_300_from_its_files_equals_the_builtin_car() {
         "{}",
         trb1.drag(1.0)
     );
+    // The body's lift is simuv2's Cl·v²·h(Σ), h(Σ) = 2·exp(−3·(1.5·Σ)⁴), at the ride heights
+    // (90 mm front, 105 mm rear under the wheels' loads without fuel) less what the 94 kg of
+    // fuel compresses the springs (5500 lbs/in through a bellcrank of 1.1).
+    assert_eq!(trb1.mass, 1150.0 + 94.0);
+    let rate = 5500.0 * 0.453_592_37 / 0.0254 * 1.1 * 1.1;
+    let fuel_load =
+        |share: f64| 94.0 * 9.81 * share / 2.0 + 1150.0 * (9.81 - 9.80665) * share / 2.0;
+    let sum = 2.0 * (0.090 - fuel_load(0.52) / rate) + 2.0 * (0.105 - fuel_load(0.48) / rate);
+    let h = 2.0 * (-3.0 * (1.5 * sum).powi(4)).exp();
     let [front, rear] = trb1.downforce(1.0);
-    let lift = 0.645 * 1.92 * (0.69 + 0.7);
-    assert!((front + rear - lift - 4.0 * wings).abs() < 1e-9);
+    let lift = (0.69 + 0.7) * h;
+    // (within 0.1 %: at 1 m/s the downforce's own 3 N sink the car by some 10 µm more)
+    assert!(
+        (front + rear - lift - 4.0 * wings).abs() < 1e-3 * lift,
+        "{} vs {}",
+        front + rear,
+        lift + 4.0 * wings
+    );
+    assert!((h - 1.45).abs() < 0.01, "{h}");
     assert!(rear > front, "the rear wing loads the rear axle");
     assert_eq!(trb1.engine_brake, 0.33);
     assert!((trb1.revs_max - 10_000.0 * std::f64::consts::PI / 30.0).abs() < 1e-9);

@@ -27,7 +27,8 @@ pub enum Drive {
 pub struct Tyre {
     /// Rolling radius (m): rim diameter / 2 + tyre width × aspect ratio.
     pub radius: f64,
-    /// Peak friction coefficient μ.
+    /// Peak friction coefficient μ, with the camber's grip where the car file gives a camber
+    /// (simuv2's `wheel.cpp` multiplies the force by 1 + 0.05·sin(−18·camber), camber in rad).
     pub mu: f64,
     /// Magic-Formula stiffness (TORCS `stiffness`, = B·C).
     pub stiffness: f64,
@@ -41,6 +42,103 @@ pub struct Tyre {
     pub rolling_resistance: f64,
     /// Rotational inertia of one wheel with its brake disc (kg·m²).
     pub inertia: f64,
+    /// The skid factor k: TORCS's simuv2 (`wheel.cpp`) multiplies the force by
+    /// 1 + k·min(s, 1.5) for the slip's magnitude s, k from the driver's skill level
+    /// (`categories.cpp`: 0.4, 0.35, 0.3, 0 for rookie, amateur, semi-pro, pro); 0 for a car
+    /// that is not the game's.
+    pub skid: f64,
+}
+
+/// The suspension as it sets the body's ride height, which TORCS's simuv2 (`aero.cpp`) makes
+/// the body's downforce depend on: Fᵢ = Clᵢ·v²·h(Σ), h(Σ) = 2·exp(−3·(1.5·Σ)⁴), Σ the four
+/// wheels' ride heights summed (car1-trb1 with its fuel: h = 1.45 at rest, 1.78 at 55 m/s as the
+/// downforce compresses the springs, a body downforce 17 % and 44 % above 0.645·Cl·A·v²). A
+/// wheel under load F_z rides at x₀ − (F_z − F₀)/k (`susp.cpp`),
+/// within [0, its travel].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Ride {
+    /// Ride height x₀ of a front and of a rear wheel under its static load F₀ (m).
+    pub height: [f64; 2],
+    /// F₀ of a front and of a rear wheel (N): simuv2's `weight0`, from the mass without fuel.
+    pub load: [f64; 2],
+    /// Wheel rate k of a front and of a rear wheel (N/m): the spring's rate times the
+    /// bellcrank's ratio squared.
+    pub rate: [f64; 2],
+    /// Travel of a front and of a rear wheel (m): the suspension course over the bellcrank.
+    pub travel: [f64; 2],
+}
+
+impl Ride {
+    /// h(Σ) = 2·exp(−3·(1.5·Σ)⁴) of simuv2's `aero.cpp`, Σ the ride heights' sum (m).
+    pub fn ground_effect(sum: f64) -> f64 {
+        let x = 1.5 * sum;
+        let x2 = x * x;
+        2.0 * (-3.0 * x2 * x2).exp()
+    }
+
+    /// The sum of the four wheels' ride heights (m) when a front wheel carries `front` and a
+    /// rear wheel `rear` (N).
+    pub fn height_sum(&self, front: f64, rear: f64) -> f64 {
+        [front, rear]
+            .iter()
+            .enumerate()
+            .map(|(k, &fz)| {
+                2.0 * (self.height[k] - (fz - self.load[k]) / self.rate[k])
+                    .clamp(0.0, self.travel[k])
+            })
+            .sum()
+    }
+}
+
+/// The axles as TORCS's simuv2 loads their wheels in a corner (`car.cpp`, `axle.cpp`,
+/// `susp.cpp`): each wheel's lateral force Fᵧ pushes the body about its roll axis at the
+/// axle's roll centre height, not at the centre of gravity (`car.cpp`: M_x = Σ F_z·y +
+/// Σ Fᵧ·h_rc), and the springs and anti-roll bars take that moment up in proportion to their
+/// roll rates. With the body rolled by φ a wheel at y carries κ·y·φ more (the left) or less,
+/// κ = K·b² + 2·K_arb·b its rate in roll (spring K, bellcrank b, anti-roll bar K_arb), so in
+/// the steady roll the axle a moves ΔF_a = M·κ_a·y_a / (2·Σ_b κ_b·y_b²) from its inner wheel
+/// to its outer one, M = Σ_a Fᵧ,a·h_rc,a.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Axles {
+    /// Half the track of the front and rear axles, |y| of their wheels (m).
+    pub half_track: [f64; 2],
+    /// Roll centre height of the front and rear axles (m), TORCS `roll center height`.
+    pub roll_centre: [f64; 2],
+    /// Rate in roll κ = K·b² + 2·K_arb·b of a front and of a rear wheel (N/m).
+    pub roll_rate: [f64; 2],
+    /// The height above the road at which the tyres' longitudinal forces pitch the body
+    /// (m): simuv2 takes the centre of gravity's height plus the wheel's ride height
+    /// (`car.cpp`: M_y = −Σ Fₓ·(h + x_ride)); the load moved from front to rear is
+    /// ΣFₓ·(that height)/L.
+    pub pitch_height: f64,
+}
+
+/// The kind of differential of the driven rear axle ([`Differential`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum DiffKind {
+    /// Both wheels on one shaft.
+    Spool,
+    /// An open differential (simuv2's FREE).
+    Free,
+    /// simuv2's LIMITED SLIP.
+    LimitedSlip,
+}
+
+/// The rear differential as TORCS's simuv2 drives the rear wheels through it
+/// (`differential.cpp`; [`crate::sim::vehicle`] has the formulas).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Differential {
+    /// Its kind.
+    pub kind: DiffKind,
+    /// The wheels' largest speed ratio |ω₀ − ω₁|/(|ω₀| + |ω₁|) without drive torque (TORCS
+    /// `max slip bias`, 0.03 by default).
+    pub slip_max: f64,
+    /// Drive torque at the differential (N·m) from which a limited slip locks (TORCS
+    /// `locking input torque`, 3000 by default).
+    pub lock_torque: f64,
+    /// Braking (engine brake) torque from which it locks (N·m; TORCS `locking brake input
+    /// torque`, a third of the locking input torque by default).
+    pub lock_brake_torque: f64,
 }
 
 /// One axle's brakes (both wheels alike).
@@ -94,7 +192,9 @@ pub struct Car {
     pub front_weight: f64,
     /// Distance between the axles (m).
     pub wheelbase: f64,
-    /// Yaw inertia factor k: I_z = k·m·a·b (TORCS `mass repartition coefficient`).
+    /// Yaw inertia factor k: I_z = k·m·a·b. For a TORCS car file, the factor that gives
+    /// simuv2's I_z = m₀·(w² + c²·l²)/12 (m₀ the mass without fuel, w and l the body's width
+    /// and length, c the `mass repartition coefficient`).
     pub yaw_inertia_factor: f64,
     /// Drag coefficient Cx.
     pub cx: f64,
@@ -104,6 +204,9 @@ pub struct Car {
     pub clift: [f64; 2],
     /// Front and rear wings.
     pub wings: [Wing; 2],
+    /// The suspension's ride height, for a body downforce that depends on it as in TORCS's
+    /// simuv2 ([`Ride`]; a TORCS car file gives it); `None`: Fᵢ = 0.645·Clᵢ·A·v².
+    pub ride: Option<Ride>,
     /// Engine torque curve: (engine speed rad/s, torque N·m), increasing speed.
     pub torque_curve: Vec<(f64, f64)>,
     /// Rev limiter (rad/s): no torque above it.
@@ -144,6 +247,18 @@ pub struct Car {
     /// Overall width of the body (m), TORCS `Car/overall width` (else `body width`): how
     /// much of the road a racing line leaves between the car's centre and the edge.
     pub width: f64,
+    /// The axles' track, roll centres and roll rates: how the wheels share the load in a
+    /// corner and under acceleration ([`Axles`]).
+    pub axles: Axles,
+    /// The rear axle's differential ([`Differential`]); a rear axle without drive has its
+    /// wheels roll free.
+    pub differential: Differential,
+    /// Whether cdbo's simulator drives the car as cdbo's TORCS robot drives the game's car (a
+    /// car read from TORCS files): pulling away on simuv2's slipping clutch, closed by the
+    /// robot's launch clutch ([`crate::torcs::launch`]), and with the robot's traction control
+    /// on the driven wheels' slip speed ([`crate::torcs::traction`]). Else (the built-in car)
+    /// the clutch slips only below idle and traction control acts on the relative slip.
+    pub torcs_robot: bool,
     /// Calibration scales over the car file's values ([`calibration`]): 1 for a stock car.
     /// Grip and peak slip are already in the tyres; drag, downforce, rolling resistance and
     /// the launch are applied where those forces are computed.
@@ -184,6 +299,7 @@ impl Car {
             operating_load: load,
             rolling_resistance: 0.01,
             inertia,
+            skid: 0.0,
         };
         Car {
             name: "Spirit 300".into(),
@@ -196,6 +312,7 @@ impl Car {
             front_area: 1.85,
             clift: [0.65, 0.61],
             wings: [Wing::default(); 2],
+            ride: None,
             torque_curve: curve_rpm_nm.iter().map(|&(r, t)| (r * rpm, t)).collect(),
             rev_limiter: 8500.0 * rpm,
             tickover: 2000.0 * rpm,
@@ -222,6 +339,22 @@ impl Car {
             },
             steer_lock: 45f64.to_radians(),
             width: 1.90,
+            // sc-spirit-300.xml: wheels at y = ±0.78 / ±0.80 m, roll centres 0.39 m, springs
+            // 37 / 57 kN/m (bellcrank 1, no anti-roll bars), ride height 0.11 m; a limited-slip
+            // differential with max slip bias 0.4 and simuv2's default locking torques.
+            axles: Axles {
+                half_track: [0.78, 0.80],
+                roll_centre: [0.39, 0.39],
+                roll_rate: [37.0e3, 57.0e3],
+                pitch_height: 0.285 + 0.11,
+            },
+            differential: Differential {
+                kind: DiffKind::LimitedSlip,
+                slip_max: 0.4,
+                lock_torque: 3000.0,
+                lock_brake_torque: 990.0,
+            },
+            torcs_robot: false,
             scales: Scales::ONE,
         }
     }
@@ -284,17 +417,41 @@ impl Car {
         (AIR_HALF_RHO * self.cx * self.front_area + wings) * v * v * self.scales.drag
     }
 
-    /// Downforce on the front and rear axles at speed v: Fᵢ = 0.645·Clᵢ·A·v² plus the wings',
-    /// each shared between the axles by its position, times the calibration's scale (N).
+    /// Downforce on the front and rear axles at speed v, level road and no acceleration: the
+    /// body's Fᵢ = 0.645·Clᵢ·A·v², or with a [`Ride`] simuv2's Clᵢ·v²·h(Σ) at the ride heights
+    /// the car settles at under its weight and this downforce; plus the wings', each shared
+    /// between the axles by its position; times the calibration's scale (N).
     pub fn downforce(&self, v: f64) -> [f64; 2] {
-        let q = AIR_HALF_RHO * self.front_area * v * v;
-        let mut f = [q * self.clift[0], q * self.clift[1]];
+        let v2 = v * v;
+        let mut wings = [0.0; 2];
         for w in &self.wings {
-            let d = w.downforce_per_v2() * v * v;
-            f[0] += d * w.front_share;
-            f[1] += d * (1.0 - w.front_share);
+            let d = w.downforce_per_v2() * v2;
+            wings[0] += d * w.front_share;
+            wings[1] += d * (1.0 - w.front_share);
         }
-        f.map(|f| f * self.scales.downforce)
+        let s = self.scales.downforce;
+        let Some(ride) = &self.ride else {
+            let q = AIR_HALF_RHO * self.front_area * v2;
+            return [0, 1].map(|k| (q * self.clift[k] + wings[k]) * s);
+        };
+        let weight = [
+            self.mass * crate::sim::vehicle::G * self.cg_to_rear() / self.wheelbase,
+            self.mass * crate::sim::vehicle::G * self.cg_to_front() / self.wheelbase,
+        ];
+        let total = |sum: f64| {
+            let h = Ride::ground_effect(sum);
+            [0, 1].map(|k| (self.clift[k] * v2 * h + wings[k]) * s)
+        };
+        // The ride heights' sum Σ solves Σ = Σ_ride(loads(Σ)): the right side grows with Σ
+        // (less ground effect, less load, less compression) more slowly than Σ, so bisect.
+        let (mut lo, mut hi) = (0.0, 2.0 * (ride.travel[0] + ride.travel[1]));
+        for _ in 0..50 {
+            let mid = 0.5 * (lo + hi);
+            let d = total(mid);
+            let sum = ride.height_sum(0.5 * (weight[0] + d[0]), 0.5 * (weight[1] + d[1]));
+            if sum > mid { lo = mid } else { hi = mid }
+        }
+        total(0.5 * (lo + hi))
     }
 }
 
@@ -310,6 +467,73 @@ pub const DEFAULT_PAD_MU: f64 = 0.30;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A car with simuv2's ride height: car1-trb1's figures (its file is not in the repository).
+    fn on_springs() -> Car {
+        let rate = 5500.0 * 0.453_592_37 / 0.0254 * 1.1 * 1.1;
+        Car {
+            mass: 1244.0,
+            clift: [0.69, 0.7],
+            ride: Some(Ride {
+                height: [0.09, 0.105],
+                load: [2932.0, 2706.0],
+                rate: [rate, rate],
+                travel: [0.2 / 1.1, 0.2 / 1.1],
+            }),
+            ..Car::spirit_300()
+        }
+    }
+
+    /// h(Σ) = 2·exp(−3·(1.5·Σ)⁴): 2 on the ground, e^(−3) ·2 at 1.5·Σ = 1.
+    #[test]
+    fn the_ground_effect_is_simuv2s() {
+        assert_eq!(Ride::ground_effect(0.0), 2.0);
+        assert!((Ride::ground_effect(1.0 / 1.5) - 2.0 * (-3f64).exp()).abs() < 1e-12);
+        assert!(Ride::ground_effect(0.3) > Ride::ground_effect(0.4));
+    }
+
+    /// The downforce solves its own ride height: the loads it and the weight put on the wheels
+    /// compress the springs to the Σ at which the body's lift is Cl·v²·h(Σ); and it grows
+    /// faster than v² as the car sinks.
+    #[test]
+    fn the_downforce_settles_the_ride_height_it_depends_on() {
+        let car = on_springs();
+        let ride = car.ride.unwrap();
+        let wings = |v: f64| {
+            let mut w = [0.0; 2];
+            for wing in &car.wings {
+                w[0] += wing.downforce_per_v2() * v * v * wing.front_share;
+                w[1] += wing.downforce_per_v2() * v * v * (1.0 - wing.front_share);
+            }
+            w
+        };
+        let g = crate::sim::vehicle::G;
+        let mut last = 0.0;
+        for v in [1.0, 20.0, 40.0, 60.0, 80.0] {
+            let d = car.downforce(v);
+            let w = wings(v);
+            let (a, b, l) = (car.cg_to_front(), car.cg_to_rear(), car.wheelbase);
+            let sum = ride.height_sum(
+                0.5 * (car.mass * g * b / l + d[0]),
+                0.5 * (car.mass * g * a / l + d[1]),
+            );
+            let h = Ride::ground_effect(sum);
+            for k in 0..2 {
+                let body = car.clift[k] * v * v * h;
+                assert!(
+                    (d[k] - w[k] - body).abs() < 1e-6 * d[k].max(1.0),
+                    "{v}: {d:?}"
+                );
+            }
+            let per_v2 = (d[0] + d[1]) / (v * v);
+            assert!(per_v2 > last, "{v}: {per_v2} after {last}");
+            last = per_v2;
+        }
+        // At 60 m/s the springs give 25 mm a wheel and the ground effect 1.7.
+        let d = car.downforce(60.0);
+        let h = (d[0] + d[1] - wings(60.0)[0] - wings(60.0)[1]) / (1.39 * 3600.0);
+        assert!((1.6..1.9).contains(&h), "{h}");
+    }
 
     #[test]
     fn spirit_300_has_the_papers_figures() {

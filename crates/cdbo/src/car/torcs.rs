@@ -5,7 +5,10 @@
 
 use std::path::{Path, PathBuf};
 
-use super::{Brake, Car, DEFAULT_ENGINE_BRAKE, DEFAULT_PAD_MU, Drive, Tyre, Wing};
+use super::{
+    Axles, Brake, Car, DEFAULT_ENGINE_BRAKE, DEFAULT_PAD_MU, DiffKind, Differential, Drive, Ride,
+    Tyre, Wing,
+};
 use crate::bounded;
 use crate::error::{Error, Result};
 use crate::params::{Params, Section};
@@ -59,6 +62,20 @@ fn find_category(car: &Path, cat: &str) -> Option<PathBuf> {
 /// Rolling resistance of TORCS's asphalt surfaces (`data/tracks/surfaces.xml`).
 const ASPHALT_ROLLING_RESISTANCE: f64 = 0.001;
 
+/// The game's skid factor for cdbo's robot ([`Tyre::skid`]): its `cdbo.xml` names no skill
+/// level, so TORCS's race engine (`raceinit.cpp`) ranks it semi-pro, whose factor in simuv2's
+/// `categories.cpp` (`simSkidFactor`) is 0.3.
+pub const SKID_FACTOR: f64 = 0.3;
+
+/// Gravity as TORCS's `tgf.h` has it (m/s²), for the wheels' static loads.
+const TORCS_G: f64 = 9.80665;
+
+/// The grip factor of a tyre's camber γ (rad), simuv2's `wheel.cpp`: 1 + 0.05·sin(−18γ)
+/// (car1-trb1's −4° front: 1.048, −3° rear: 1.040).
+pub fn camber_grip(camber: f64) -> f64 {
+    1.0 + 0.05 * (-18.0 * camber).sin()
+}
+
 /// The car's overall width (m): `overall width`, else `body width` (the names of TORCS's
 /// `car.h`), else 1.9 m.
 fn car_width(car: &Section) -> Result<f64> {
@@ -86,24 +103,50 @@ pub fn from_params(p: &Params) -> Result<Car> {
         }
     };
 
-    let mass = positive(car, "mass", car.require_num("mass")?)?;
+    // simuv2 (`car.cpp`) moves the car's mass and its fuel, m = mass + fuel, the `initial
+    // fuel` (litres, counted as kilograms) capped by the `fuel tank`, both 80 by default;
+    // the wheels' static loads (`weight0`) and the yaw inertia take the mass alone.
+    let dry_mass = positive(car, "mass", car.require_num("mass")?)?;
+    let tank = car.num_or("fuel tank", 80.0)?;
+    let fuel = car.num_or("initial fuel", 80.0)?.min(tank);
+    if !(fuel >= 0.0 && fuel.is_finite()) {
+        return Err(car.value_error("initial fuel", format!("must be non-negative, got {fuel}")));
+    }
+    let mass = dry_mass + fuel;
     let cg_height = positive(car, "GC height", car.num_or("GC height", 0.3)?)?;
     let front_weight = fraction(
         car,
         "front-rear weight repartition",
         car.num_or("front-rear weight repartition", 0.5)?,
     )?;
-    let yaw_inertia_factor = positive(
+    let centring = positive(
         car,
         "mass repartition coefficient",
         car.num_or("mass repartition coefficient", 1.0)?,
     )?;
+    let body_length = positive(car, "body length", car.num_or("body length", 4.7)?)?;
+    let body_width = positive(car, "body width", car.num_or("body width", 1.9)?)?;
+    // The wheels' static loads as simuv2 sets them (`weight0`, from the mass without fuel):
+    // each tyre's `operating load` defaults to 1.2 times its wheel's.
+    let right_share = |name: &str| car.num_or(name, 0.5);
+    let static_wheel_load = [
+        dry_mass * TORCS_G * front_weight * right_share("front right-left weight repartition")?,
+        dry_mass
+            * TORCS_G
+            * (1.0 - front_weight)
+            * right_share("rear right-left weight repartition")?,
+    ];
     let (fa, ra) = (sec("Front Axle"), sec("Rear Axle"));
     let wheelbase = positive(
         fa,
         "xpos",
         fa.num_or("xpos", 1.2)? - ra.num_or("xpos", -1.4)?,
     )?;
+    // simuv2's yaw inertia I_z = m₀·(w² + c²·l²)/12, as k·m·a·b with a = (1 − f)·L and
+    // b = f·L, f the front axle's share of the weight.
+    let yaw_inertia = dry_mass * (body_width.powi(2) + (centring * body_length).powi(2)) / 12.0;
+    let yaw_inertia_factor =
+        yaw_inertia / (mass * (1.0 - front_weight) * front_weight * wheelbase * wheelbase);
 
     let aero = sec("Aerodynamics");
     let cx = positive(aero, "Cx", aero.num_or("Cx", 0.4)?)?;
@@ -193,7 +236,7 @@ pub fn from_params(p: &Params) -> Result<Car> {
         }
     };
     let diff = |name: &str| sec(name).num_or("ratio", 1.0);
-    let (final_drive, differential) = match drive {
+    let (final_drive, diff_section) = match drive {
         Drive::Rear => (diff("Rear Differential")?, "Rear Differential"),
         Drive::Front => (diff("Front Differential")?, "Front Differential"),
         Drive::All => (
@@ -202,23 +245,29 @@ pub fn from_params(p: &Params) -> Result<Car> {
         ),
     };
 
-    let tyre = |name: &str| -> Result<Tyre> {
+    let tyre = |name: &str, static_load: f64| -> Result<Tyre> {
         let w = sec(name);
+        let camber = w.num_or("camber", 0.0)?;
         let rim = w.num_or("rim diameter", 0.33)?;
         let width = w.num_or("tire width", 0.145)?;
         let aspect = w.num_or("tire height-width ratio", 0.75)?;
         let brake = sec(&name.replace("Wheel", "Brake"));
         Ok(Tyre {
             radius: positive(w, "rim diameter", rim / 2.0 + width * aspect)?,
-            mu: positive(w, "mu", w.num_or("mu", 1.0)?)?,
+            mu: positive(w, "mu", w.num_or("mu", 1.0)?)? * camber_grip(camber),
             stiffness: positive(w, "stiffness", w.num_or("stiffness", 30.0)?)?,
             dynamic_friction: fraction(w, "dynamic friction", w.num_or("dynamic friction", 0.8)?)?,
             elasticity: w.num_or("elasticity factor", 0.7)?,
-            operating_load: positive(w, "operating load", w.num_or("operating load", 5000.0)?)?,
+            operating_load: positive(
+                w,
+                "operating load",
+                w.num_or("operating load", 1.2 * static_load)?,
+            )?,
             // TORCS's simuv2 takes rolling resistance from the road's surface, not the tyre:
             // a car file without one rolls like the game's asphalt (0.001).
             rolling_resistance: w.num_or("rolling resistance", ASPHALT_ROLLING_RESISTANCE)?,
             inertia: w.num_or("inertia", 1.5)? + brake.num_or("inertia", 0.13)?,
+            skid: SKID_FACTOR,
         })
     };
     let brake = |name: &str| -> Result<Brake> {
@@ -228,6 +277,89 @@ pub fn from_params(p: &Params) -> Result<Car> {
             piston_area: positive(b, "piston area", b.num_or("piston area", 0.002)?)?,
             pad_mu: positive(b, "mu", b.num_or("mu", DEFAULT_PAD_MU)?)?,
         })
+    };
+    // The suspension of the right-hand wheels (simuv2's `susp.cpp` and `wheel.cpp`): spring
+    // rate K, bellcrank b, course c and the wheel's ride height x₀ under its static load.
+    let ride = {
+        let axle = |susp: &str, wheel: &str| -> Result<(f64, f64, f64)> {
+            let (s, w) = (sec(susp), sec(wheel));
+            let bellcrank = positive(s, "bellcrank", s.num_or("bellcrank", 1.0)?)?;
+            let spring = positive(s, "spring", s.num_or("spring", 175_000.0)?)?;
+            let course = positive(s, "suspension course", s.num_or("suspension course", 0.5)?)?;
+            let height = positive(w, "ride height", w.num_or("ride height", 0.2)?)?;
+            Ok((height, spring * bellcrank * bellcrank, course / bellcrank))
+        };
+        let f = axle("Front Right Suspension", "Front Right Wheel")?;
+        let r = axle("Rear Right Suspension", "Rear Right Wheel")?;
+        Ride {
+            height: [f.0, r.0],
+            load: static_wheel_load,
+            rate: [f.1, r.1],
+            travel: [f.2, r.2],
+        }
+    };
+    // The axles as simuv2 loads their wheels in a corner (`axle.cpp`, `susp.cpp`, `car.cpp`):
+    // the wheels' |y|, the roll centres (0.15 m by default), and each wheel's rate in roll,
+    // K·b² of its spring plus 2·K_arb·b of the axle's anti-roll bar (0 by default).
+    let axles = {
+        let axle = |axle: &str, wheel: &str, susp: &str, arb: &str| -> Result<(f64, f64, f64)> {
+            let (a, w, s) = (sec(axle), sec(wheel), sec(susp));
+            let bellcrank = positive(s, "bellcrank", s.num_or("bellcrank", 1.0)?)?;
+            let spring = s.num_or("spring", 175_000.0)?;
+            let bar = sec(arb).num_or("spring", 0.0)?;
+            let rate = spring * bellcrank * bellcrank + 2.0 * bar * bellcrank;
+            if !(rate >= 0.0 && rate.is_finite()) {
+                return Err(s.value_error("spring", format!("must be non-negative, got {spring}")));
+            }
+            Ok((
+                w.num_or("ypos", 0.0)?.abs(),
+                a.num_or("roll center height", 0.15)?,
+                rate,
+            ))
+        };
+        let f = axle(
+            "Front Axle",
+            "Front Right Wheel",
+            "Front Right Suspension",
+            "Front Anti-Roll Bar",
+        )?;
+        let r = axle(
+            "Rear Axle",
+            "Rear Right Wheel",
+            "Rear Right Suspension",
+            "Rear Anti-Roll Bar",
+        )?;
+        Axles {
+            half_track: [f.0, r.0],
+            roll_centre: [f.1, r.1],
+            roll_rate: [f.2, r.2],
+            pitch_height: cg_height + 0.5 * (ride.height[0] + ride.height[1]),
+        }
+    };
+    // The rear differential (`differential.cpp`; defaults of TORCS 1.3's simuv2). A viscous
+    // coupler or none on a driven axle is taken as a free differential.
+    let differential = {
+        let d = sec("Rear Differential");
+        let kind = match d.str("type").unwrap_or("NONE") {
+            "SPOOL" => DiffKind::Spool,
+            "LIMITED SLIP" => DiffKind::LimitedSlip,
+            _ => DiffKind::Free,
+        };
+        let lock_torque = positive(
+            d,
+            "locking input torque",
+            d.num_or("locking input torque", 3000.0)?,
+        )?;
+        Differential {
+            kind,
+            slip_max: d.num_or("max slip bias", 0.03)?.max(0.0),
+            lock_torque,
+            lock_brake_torque: positive(
+                d,
+                "locking brake input torque",
+                d.num_or("locking brake input torque", 0.33 * lock_torque)?,
+            )?,
+        }
     };
     let brakes = sec("Brake System");
     Ok(Car {
@@ -241,6 +373,9 @@ pub fn from_params(p: &Params) -> Result<Car> {
         front_area,
         clift,
         wings,
+        ride: Some(ride),
+        axles,
+        differential,
         torque_curve,
         rev_limiter,
         tickover,
@@ -248,11 +383,11 @@ pub fn from_params(p: &Params) -> Result<Car> {
         engine_brake,
         engine_inertia,
         gears,
-        final_drive: positive(sec(differential), "ratio", final_drive)?,
+        final_drive: positive(sec(diff_section), "ratio", final_drive)?,
         shift_time,
         drive,
-        front_tyre: tyre("Front Right Wheel")?,
-        rear_tyre: tyre("Rear Right Wheel")?,
+        front_tyre: tyre("Front Right Wheel", static_wheel_load[0])?,
+        rear_tyre: tyre("Rear Right Wheel", static_wheel_load[1])?,
         brake_pressure: positive(
             brakes,
             "max pressure",
@@ -271,6 +406,7 @@ pub fn from_params(p: &Params) -> Result<Car> {
             sec("Steer").num_or("steer lock", 0.43)?,
         )?,
         width: positive(car, "overall width", car_width(car)?)?,
+        torcs_robot: true,
         scales: super::Scales::ONE,
     })
 }
@@ -331,8 +467,9 @@ mod tests {
     /// the car inherits from it, the car file for one the car sets.
     #[test]
     fn a_bad_value_names_the_file_it_came_from() {
+        // simuv2 moves the mass and the fuel, 80 (kg) when neither file names a fuel.
         let (car, _) = car_over_category("ok", "", "");
-        assert_eq!(read(&car, None).unwrap().mass, 1000.0);
+        assert_eq!(read(&car, None).unwrap().mass, 1080.0);
 
         let bad_number = r#"<attnum name="GC height" val="-0.3"/>"#;
         let (car, _) = car_over_category("cat", bad_number, "");

@@ -296,7 +296,8 @@ mod tests {
     /// The closed-form steady state (see the module): on a circle of radius 100 m, with a line
     /// 3 m inside it (and outside it) at 15 m/s (0.23 g), the car settles on the line (e = 0
     /// within 5 mm) with the steering δ = (L + K·v²)·κ of the linear single-track car (within
-    /// 0.2 %) and its heading error Δψ_ss = κ·(m·a·v²/(L·C_r) − b) (within 2.5 % of κ·b, the
+    /// 0.5 %, as the front wheels' mean angle: the outer wheel steers by its Ackermann angle)
+    /// and its heading error Δψ_ss = κ·(m·a·v²/(L·C_r) − b) (within 2.5 % of κ·b, the
     /// two terms nearly cancelling at this speed; the drive force on the rear tyres' budget
     /// moves the rear slip a little), κ = 1/(R − d) the line's curvature.
     #[test]
@@ -353,9 +354,15 @@ mod tests {
                 (heading_error - heading).abs() < 0.025 * b * kappa,
                 "d {offset}: Δψ {heading_error} against {heading}"
             );
+            // The bicycle's steer is the mean of the front wheels' angles: the inner one's δ
+            // and the outer one's Ackermann angle (`sim::vehicle`); the lateral load transfer
+            // leaves 0.3 % more.
+            let track = car.axles.half_track[0] + car.axles.half_track[1];
+            let outer = (l * delta.tan() / (l + track * delta.tan().abs())).atan();
+            let mean = 0.5 * (delta + outer);
             assert!(
-                (delta / steer - 1.0).abs() < 0.002,
-                "d {offset}: δ {delta} against {steer}"
+                (mean / steer - 1.0).abs() < 0.005,
+                "d {offset}: δ {delta} (mean {mean}) against {steer}"
             );
         }
     }

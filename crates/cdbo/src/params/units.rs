@@ -37,7 +37,9 @@ fn token_factor(token: &str) -> Option<f64> {
         "MPa" => 1.0e6,
         "bar" => 1.0e5,
         "psi" | "PSI" => 6_894.757_293_168,
-        "l" | "L" => 0.001,
+        // TORCS's GfParmGetNum knows no litres: a value in `l` stays as written (simuv2 then
+        // counts a car's fuel, in litres, as kilograms of mass).
+        "l" | "L" => 1.0,
         "W" => 1.0,
         "kW" => 1000.0,
         "hp" | "HP" => 745.699_871_582_270_2,

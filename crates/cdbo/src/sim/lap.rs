@@ -356,6 +356,8 @@ impl Simulator {
                 let steer = steering.update(track, &self.vehicle, &state, &proj, &line, driver_dt);
                 controls = Controls::new(steer, a.max(0.0), (-a).max(0.0));
                 self.vehicle.shift(&mut state, controls.throttle());
+                self.vehicle
+                    .clutch(&mut state, controls.throttle(), driver_dt);
                 if cfg.trace {
                     trace.push(TracePoint {
                         t,

@@ -10,8 +10,9 @@
 //! Longitudinal and lateral forces share this one budget along the slip vector:
 //! Fₓ = F·sₓ/s, F_y = F·s_y/s (the friction ellipse of combined slip).
 //!
-//! The single-track model lumps an axle's two tyres: its budget is F_z·μ·μ_surface·λ(F_z/2),
-//! the load sensitivity taken at the load of one tyre, as TORCS applies it per wheel.
+//! The vehicle ([`super::vehicle`]) gives each wheel its own budget F_z·μ·μ_surface·λ(F_z)
+//! under its own load, as TORCS applies it per wheel; the limit solver and the cornering
+//! stiffness lump an axle's two tyres at equal loads, F_z·μ·μ_surface·λ(F_z/2).
 //!
 //! In the hot loop the shape is read as g(u) = f(√u)/√u on u = s² = sₓ² + s_y²: f is odd, so
 //! g is smooth in u, and Fₓ = F_max·g(u)·sₓ, F_y = F_max·g(u)·s_y need neither a square root
@@ -24,6 +25,8 @@ use crate::car::Tyre;
 pub const LOAD_FACTOR_MIN: f64 = 0.8;
 /// λ_max of the load sensitivity (TORCS default).
 pub const LOAD_FACTOR_MAX: f64 = 1.6;
+/// The slip beyond which simuv2's skid factor grows no more (`wheel.cpp`: min(s, 1.5)).
+pub const SKID_SLIP_CAP: f64 = 1.5;
 
 /// Pre-computed Magic-Formula constants of one tyre.
 #[derive(Debug, Clone, PartialEq)]
@@ -42,8 +45,13 @@ pub struct TyreModel {
     load_k: f64,
     /// 1 / F_op.
     inv_operating_load: f64,
-    /// Slip magnitude at which the force peaks.
+    /// Slip magnitude at which the Magic-Formula shape peaks (the skid factor left out).
     pub peak_slip: f64,
+    /// The skid factor k ([`Tyre::skid`]): the force is f(s)·(1 + k·min(s, [`SKID_SLIP_CAP`])).
+    pub skid: f64,
+    /// The largest force per unit budget: 1 without a skid factor, else the largest
+    /// f(s)·(1 + k·min(s, [`SKID_SLIP_CAP`])).
+    pub force_cap: f64,
     /// g(u) = f(√u)/√u and g′(u), tabulated on u = s² ∈ [0, 1].
     ratio_table: HermiteTable,
     /// λ and dλ/dz of the load sensitivity, tabulated on z = F_z/F_op ∈ [0, 8].
@@ -65,10 +73,20 @@ impl TyreModel {
             load_k,
             inv_operating_load: 1.0 / t.operating_load,
             peak_slip: 0.0,
+            skid: t.skid,
+            force_cap: 1.0,
             ratio_table: HermiteTable::new(1.0, 0, |_| (0.0, 0.0)),
             load_table: HermiteTable::new(1.0, 0, |_| (0.0, 0.0)),
         };
         m.peak_slip = m.find_peak_slip();
+        if m.skid > 0.0 {
+            m.force_cap = (0..=3000)
+                .map(|i| {
+                    let s = i as f64 * 1e-3;
+                    m.shape_exact(s).0 * m.skid_multiplier(s * s).0
+                })
+                .fold(1.0, f64::max);
+        }
         // Steps 1/16384 and 1/256 keep the interpolation error of the force below 1e-10 of
         // the budget, and of λ below 1e-11.
         m.ratio_table = HermiteTable::new(1.0 / 16384.0, 16384, |u| m.ratio_exact(u));
@@ -87,6 +105,13 @@ impl TyreModel {
             Some((l, _)) => l,
             None => LOAD_FACTOR_MIN + (LOAD_FACTOR_MAX - LOAD_FACTOR_MIN) * (self.load_k * z).exp(),
         }
+    }
+
+    /// Largest force one tyre can give under its load `fz` on a surface of friction `surface`
+    /// (N): F_z·μ·μ_surface·λ(F_z), as simuv2's `wheel.cpp` has it per wheel.
+    #[inline]
+    pub fn wheel_max_force(&self, fz: f64, surface: f64) -> f64 {
+        fz * self.mu * surface * self.load_factor(fz)
     }
 
     /// Largest force an axle of two such tyres can give under its load `fz` on a surface of
@@ -136,13 +161,34 @@ impl TyreModel {
     /// ∂Fₓ/∂sₓ = fmax·[g + 2sₓ²·g′], ∂F_y/∂sₓ = fmax·2sₓs_y·g′.
     #[inline]
     pub fn forces(&self, sx: f64, sy: f64, fmax: f64) -> Forces {
-        let (g, dg) = self.ratio(sx * sx + sy * sy);
+        let u = sx * sx + sy * sy;
+        let (g, dg) = self.ratio(u);
+        let (g, dg) = if self.skid > 0.0 {
+            // g·m and its derivative in u, m = 1 + k·min(√u, cap).
+            let (m, dm) = self.skid_multiplier(u);
+            (g * m, dg * m + g * dm)
+        } else {
+            (g, dg)
+        };
         let (fg, two_dg_sx) = (fmax * g, fmax * 2.0 * dg * sx);
         Forces {
             fx: fg * sx,
             fy: fg * sy,
             dfx_dsx: fg + two_dg_sx * sx,
             dfy_dsx: two_dg_sx * sy,
+        }
+    }
+
+    /// The skid factor's multiplier m(u) = 1 + k·min(√u, [`SKID_SLIP_CAP`]) and dm/du.
+    #[inline]
+    pub fn skid_multiplier(&self, u: f64) -> (f64, f64) {
+        let s = u.sqrt();
+        if s >= SKID_SLIP_CAP {
+            (1.0 + self.skid * SKID_SLIP_CAP, 0.0)
+        } else if s > 0.0 {
+            (1.0 + self.skid * s, 0.5 * self.skid / s)
+        } else {
+            (1.0, 0.0)
         }
     }
 
@@ -177,7 +223,7 @@ pub struct Forces {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::car::Car;
+    use crate::car::{Car, Tyre};
 
     #[test]
     fn shape_constants_follow_torcs() {
@@ -210,6 +256,58 @@ mod tests {
             );
             assert!(f.fx.hypot(f.fy) <= 5000.0 + 1e-9);
         }
+    }
+
+    /// simuv2's skid factor k: the force is f(s)·(1 + k·min(s, 1.5)), its derivatives follow,
+    /// the force's cap is the largest such value (1.45·f(1.5) for car1-trb1's shape), and
+    /// without the factor the cap is 1 and the peak slip the shape's own.
+    #[test]
+    fn the_skid_factor_grows_the_force_with_the_slip() {
+        let plain = Car::spirit_300().rear_tyre;
+        let skid = TyreModel::new(&Tyre { skid: 0.3, ..plain });
+        let plain = TyreModel::new(&plain);
+        assert_eq!(plain.force_cap, 1.0);
+        assert_eq!(skid.peak_slip, plain.peak_slip);
+        for (sx, sy) in [
+            (0.05, 0.0),
+            (0.2, 0.1),
+            (-0.7, 0.3),
+            (1.2, -1.0),
+            (2.0, 0.0),
+        ] {
+            let s: f64 = f64::hypot(sx, sy);
+            let f = skid.forces(sx, sy, 1000.0);
+            let want = 1000.0 * skid.shape_exact(s).0 * (1.0 + 0.3 * s.min(1.5));
+            assert!((f.fx.hypot(f.fy) - want).abs() < 1e-6 * want, "{s}");
+            assert!(f.fx.hypot(f.fy) <= 1000.0 * skid.force_cap + 1e-9);
+            let h = 1e-7;
+            let (p, q) = (
+                skid.forces(sx + h, sy, 1000.0),
+                skid.forces(sx - h, sy, 1000.0),
+            );
+            let scale = f.dfx_dsx.abs().max(1.0);
+            assert!(
+                (f.dfx_dsx - (p.fx - q.fx) / (2.0 * h)).abs() < 1e-3 * scale,
+                "{s}"
+            );
+            assert!(
+                (f.dfy_dsx - (p.fy - q.fy) / (2.0 * h)).abs() < 1e-3 * scale,
+                "{s}"
+            );
+        }
+        let torcs = TyreModel::new(&Tyre {
+            stiffness: 20.0,
+            dynamic_friction: 0.8,
+            elasticity: 0.7,
+            skid: 0.3,
+            ..Car::spirit_300().rear_tyre
+        });
+        let at_cap = torcs.shape_exact(1.5).0 * 1.45;
+        assert!(
+            (torcs.force_cap - at_cap).abs() < 1e-9,
+            "{}",
+            torcs.force_cap
+        );
     }
 
     #[test]

@@ -1,17 +1,31 @@
-//! The dynamic single-track ("bicycle") model with longitudinal load transfer, wheel spin
-//! dynamics and the TORCS tyre, integrated at a fixed step.
+//! A two-track model with load transfer, wheel spin dynamics and the TORCS tyre, integrated
+//! at a fixed step: the front wheels share one spin, the rear wheels turn each on its own
+//! through the car's differential, as TORCS's simuv2 drives them.
 //!
-//! State: position (X, Y), yaw ψ, body velocities (vₓ, v_y), yaw rate r, and the spin ω of
-//! each axle's wheels. With a = CG→front axle, b = CG→rear axle, L = a + b, h = CG height:
+//! State: position (X, Y), yaw ψ, body velocities (vₓ, v_y), yaw rate r, the spin ω of the
+//! front wheels and of each rear wheel. With a = CG→front axle, b = CG→rear axle, L = a + b:
 //!
-//! - Loads: F_zf = m·n·b/L − m·aₓ·h/L + D_f, F_zr = m·n·a/L + m·aₓ·h/L + D_r, with aₓ the
-//!   last step's longitudinal acceleration, D the downforce and n = g·cos φ·cos β + vₓ²·κ_v
+//! - Axle loads: F_zf = m·n·b/L − m·Āₓ·h_p/L + D_f, F_zr = m·n·a/L + m·Āₓ·h_p/L + D_r, with
+//!   m·Āₓ the tyres' longitudinal force (lagged 50 ms), h_p the pitch height
+//!   ([`crate::car::Axles::pitch_height`]: simuv2's `car.cpp` pitches the body by Fₓ·(h +
+//!   ride height)), D the downforce and n = g·cos φ·cos β + vₓ²·κ_v
 //!   the road's push per unit mass: gravity on the grade φ and the banking β, and the road's
 //!   vertical curvature κ_v = dφ/ds (negative over a crest, which unloads the car: at 31 m/s
 //!   over Ruudskogen's crest at 320 m, κ_v ≈ −0.004 /m takes 40 % of the weight off, and the
 //!   game's car1-trb1 slides out of the corner there as cdbo's now does). The banking's share
 //!   of the cornering acceleration (vₓ·r·sin β) is left out: measured against the game, adding
 //!   it places fewer of the game's failures (4 of 21 road tracks against 8).
+//! - Wheel loads: each axle's inner wheel gives ΔF_a = M·κ_a·y_a/(2·Σ_b κ_b·y_b²) to its outer
+//!   one, M = Σ_a Fᵧ,a·h_rc,a the tyres' lateral forces at the roll centres (simuv2's
+//!   `car.cpp`; [`crate::car::Axles`]), lagged 70 ms.
+//! - Tyres: each wheel's budget F_z·μ·μ_r·λ(F_z) ([`super::tyre`]) under its own load. The
+//!   front wheels share one spin; the inner one is steered by δ, the outer one by simuv2's
+//!   Ackermann angle (`steer.cpp`), tan δ_o = L·tan|δ|/(L + T·tan|δ|), T = y_f + y_r (at
+//!   δ = 0.15 rad, 0.013 rad less). The rear wheels' slips take each wheel's own velocity,
+//!   vₓ ∓ r·y_r. The wheels' longitudinal forces at ±y add a yaw moment
+//!   Σ y·(Fₓ,right − Fₓ,left) (simuv2's `car.cpp`: M_z = Σ −Fₓ·y + Fᵧ·x).
+//! - Rear wheels: driven through a spool, a free or a limited-slip differential as simuv2's
+//!   `differential.cpp` ([`Vehicle::rear_wheels`]).
 //! - Wheel slip: for the wheel-frame velocity (v_t, v_l), sₓ = (ωR − v_t)/max(|v_t|, v₀),
 //!   s_y = −v_l/max(|v_t|, v₀) with v₀ = [`SLIP_SPEED_FLOOR`]; the tyre ([`super::tyre`])
 //!   gives (Fₓ, F_y).
@@ -21,18 +35,29 @@
 //!   the engine's inertia does not load the wheels: the engine speed follows them.
 //! - Body: m(v̇ₓ − v_y r) = F_xf cos δ − F_yf sin δ + F_xr − F_drag − F_roll − m g sin φ,
 //!   m(v̇_y + vₓ r) = F_xf sin δ + F_yf cos δ + F_yr − m g sin β,
-//!   I_z ṙ = a(F_xf sin δ + F_yf cos δ) − b F_yr, with β the banking.
+//!   I_z ṙ = a(F_xf sin δ + F_yf cos δ) − b F_yr + y_r(F_x,rr − F_x,rl), with β the banking
+//!   and F_xr, F_yr the rear wheels' sums.
 //! - Drag F = 0.645·Cx·A·v², downforce Dᵢ = 0.645·Clᵢ·A·v², rolling resistance
 //!   F = c_rr·(F_zf + F_zr)·sgn vₓ, c_rr the road surface's where the track gives one (as
 //!   TORCS's simuv2 does), else the tyres'; a calibrated car ([`crate::car::calibration`])
 //!   scales drag, downforce and c_rr, and the drive torque in first gear (its launch).
 //! - Brakes: T = p·share·A_piston·μ_pad·r_disc per wheel, with ABS easing the pressure while an
 //!   axle's slip exceeds half the tyre's peak slip; traction control eases the throttle
-//!   likewise (the Spirit 300 has both; TORCS robots implement them in the driver).
+//!   likewise (the Spirit 300 has both; TORCS robots implement them in the driver), and for a
+//!   car the TORCS robot drives as the robot does, on the driven wheels' slip speed in every
+//!   gear.
+//! - Launch of a car the TORCS robot drives ([`Car::torcs_robot`]): as simuv2 does, a
+//!   slipping clutch (transfer τ = 1 − c, c the robot's launch clutch, [`Vehicle::clutch`])
+//!   leaves the engine unloaded, ω̇_e = T_e(ω_e)/I_e, blended with the wheels' speed by τ⁴,
+//!   and gives the wheels its full torque T_e(ω_e)·g·min(3τ, 1): the engine revs towards its
+//!   peak while the car pulls away (car1-trb1: 7500 rpm at 0.5 m, where a closed clutch turns
+//!   it at idle, 900 rpm, and gives 100 of its 483 N·m). With the tyre's skid factor and the
+//!   robot's traction control in first gear, cdbo's car1-trb1 reaches 100 m of full throttle
+//!   within 0.02 s and 0.1 m/s of the game's on E-Track 2 and Ruudskogen (0.4 s behind before).
 
 use super::powertrain::{EngineMap, Gearbox, ShiftMap};
 use super::tyre::TyreModel;
-use crate::car::{Car, Drive};
+use crate::car::{Car, DiffKind, Drive};
 use crate::track::Frame;
 
 /// Gravity (m/s²).
@@ -102,16 +127,25 @@ pub struct State {
     pub vy: f64,
     /// Yaw rate (rad/s).
     pub yaw_rate: f64,
-    /// Spin of the front and rear wheels (rad/s).
-    pub omega: [f64; 2],
-    /// Longitudinal acceleration of the last step (m/s²), for load transfer.
+    /// Spin of the front wheels (one for both) and of the rear left and rear right wheels
+    /// (rad/s).
+    pub omega: [f64; 3],
+    /// The tyres' longitudinal force in the body frame per unit mass (m/s²), lagged, for the
+    /// longitudinal load transfer.
     pub ax: f64,
+    /// The tyres' roll moment Σ Fᵧ·h_rc (N·m), lagged, for the lateral load transfer.
+    pub roll: f64,
     /// Gearbox.
     pub gearbox: Gearbox,
     /// Engine speed (rad/s).
     pub engine_speed: f64,
     /// (sin, cos) of the yaw.
     pub yaw_sin_cos: (f64, f64),
+    /// The clutch command c ∈ [0, 1] (1 = open), set at the driver's steps by
+    /// [`Vehicle::clutch`]; 0 (closed) unless a lap's driver pulls away with it.
+    pub clutch: f64,
+    /// Time with the throttle open in first gear so far (s), the launch clutch's clock.
+    pub launch_time: f64,
 }
 
 impl State {
@@ -144,14 +178,30 @@ pub struct Vehicle {
     launch_scale: f64,
     /// m·g·b/L and m·g·a/L: the axles' static loads on level ground (N).
     static_load: [f64; 2],
-    /// m·h/L: load moved from front to rear per m/s² of acceleration (kg).
+    /// m·h_p/L: load moved from front to rear per m/s² of the tyres' longitudinal force per
+    /// unit mass, h_p the pitch height ([`crate::car::Axles::pitch_height`]) (kg).
     transfer_per_accel: f64,
+    /// Load moved from each axle's inner wheel to its outer one per N·m of roll moment,
+    /// κ_a·y_a/(2·Σ_b κ_b·y_b²) (1/m) ([`crate::car::Axles`]).
+    roll_share: [f64; 2],
+    /// Roll centre heights of the front and rear axles (m).
+    roll_centre: [f64; 2],
+    /// |y| of the rear wheels (m).
+    rear_half_track: f64,
+    /// |y| of the front wheels (m).
+    front_half_track: f64,
+    /// The wheelbase L (m).
+    wheelbase: f64,
+    /// The mean track T = y_f + y_r (m), of simuv2's Ackermann steering.
+    track: f64,
     /// Slip at which ABS and traction control start easing, per axle.
     aid_threshold: [f64; 2],
     /// 0.645·Cx·A (kg/m).
     drag_per_v2: f64,
-    /// 0.645·Clᵢ·A per axle (kg/m).
-    downforce_per_v2: [f64; 2],
+    /// Downforce per v² per axle (kg/m) at speeds 0, [`DOWNFORCE_SPEED_STEP`], 2·… m/s
+    /// ([`Car::downforce`]: constant, 0.645·Clᵢ·A plus the wings', without a ride height; a
+    /// function of the speed with one), linear in between, the last held beyond.
+    downforce_per_v2: Vec<[f64; 2]>,
 }
 
 impl Vehicle {
@@ -173,13 +223,36 @@ impl Vehicle {
                 tyres[1].peak_slip * AID_SLIP_RATIO,
             ],
             static_load: [car.mass * G * b / l, car.mass * G * a / l],
-            transfer_per_accel: car.mass * car.cg_height / l,
+            transfer_per_accel: car.mass * car.axles.pitch_height / l,
+            roll_share: {
+                let (y, k) = (car.axles.half_track, car.axles.roll_rate);
+                let sum = 2.0 * (k[0] * y[0] * y[0] + k[1] * y[1] * y[1]);
+                if sum > 0.0 {
+                    [k[0] * y[0] / sum, k[1] * y[1] / sum]
+                } else {
+                    [0.0; 2]
+                }
+            },
+            roll_centre: car.axles.roll_centre,
+            rear_half_track: car.axles.half_track[1],
+            front_half_track: car.axles.half_track[0],
+            wheelbase: car.wheelbase,
+            track: car.axles.half_track[0] + car.axles.half_track[1],
             drag_per_v2: car.drag(1.0),
-            downforce_per_v2: car.downforce(1.0),
+            downforce_per_v2: match car.ride {
+                None => vec![car.downforce(1.0)],
+                Some(_) => (0..=DOWNFORCE_SPEEDS)
+                    .map(|i| {
+                        // At v → 0 the coefficient tends to its value at rest: take it at 1 mm/s.
+                        let v = (i as f64 * DOWNFORCE_SPEED_STEP).max(1e-3);
+                        car.downforce(v).map(|f| f / (v * v))
+                    })
+                    .collect(),
+            },
             tyres,
             radius: [car.front_tyre.radius, car.rear_tyre.radius],
-            wheel_inertia: [2.0 * car.front_tyre.inertia, 2.0 * car.rear_tyre.inertia],
-            max_brake: [2.0 * car.brake_torque(true), 2.0 * car.brake_torque(false)],
+            wheel_inertia: [2.0 * car.front_tyre.inertia, car.rear_tyre.inertia],
+            max_brake: [2.0 * car.brake_torque(true), car.brake_torque(false)],
             driven,
             shift_map: ShiftMap::new(car),
             engine_map: EngineMap::new(car),
@@ -194,6 +267,23 @@ impl Vehicle {
         }
     }
 
+    /// Downforce per v² (kg/m) of the front and rear axles at speed v (m/s).
+    #[inline]
+    pub fn downforce_per_v2(&self, v: f64) -> [f64; 2] {
+        let table = &self.downforce_per_v2;
+        if table.len() == 1 {
+            return table[0];
+        }
+        let x = v / DOWNFORCE_SPEED_STEP;
+        let i = x as usize;
+        if i + 1 >= table.len() {
+            return table[table.len() - 1];
+        }
+        let w = x - i as f64;
+        let (a, b) = (table[i], table[i + 1]);
+        [a[0] + w * (b[0] - a[0]), a[1] + w * (b[1] - a[1])]
+    }
+
     /// The tyre models of the front and rear axles.
     pub fn tyres(&self) -> &[TyreModel; 2] {
         &self.tyres
@@ -205,7 +295,7 @@ impl Vehicle {
     pub fn cornering_stiffness(&self, speed: f64, friction: f64) -> [f64; 2] {
         let v2 = speed * speed;
         [0, 1].map(|k| {
-            let fz = self.static_load[k] + self.downforce_per_v2[k] * v2;
+            let fz = self.static_load[k] + self.downforce_per_v2(speed)[k] * v2;
             let tyre = &self.tyres[k];
             tyre.axle_max_force(fz, friction) * tyre.b * tyre.c
         })
@@ -245,8 +335,35 @@ impl Vehicle {
         s.gearbox.update(&self.car, &self.shift_map, w, throttle);
     }
 
+    /// The launch clutch for the driver's throttle, taken at the driver's rate `dt` after
+    /// its last step, after [`Vehicle::shift`]; for a car the TORCS robot drives
+    /// ([`Car::torcs_robot`]; else the clutch stays closed), the robot's law
+    /// ([`crate::torcs::launch::launch_clutch`]), which opens the clutch while pulling away in
+    /// first gear and closes it over [`crate::torcs::launch::LAUNCH_TIME`] of throttle.
+    pub fn clutch(&self, s: &mut State, throttle: f64, dt: f64) {
+        let car = &self.car;
+        if !car.torcs_robot {
+            return;
+        }
+        let k = if self.driven[1] > 0.0 { 1 } else { 0 };
+        let launch = crate::torcs::launch::LaunchCar {
+            engine_speed: s.engine_speed,
+            red_line: car.rev_limiter,
+            first_ratio: car.gears[0] * car.final_drive,
+            wheel_radius: self.radius[k],
+            speed_x: s.vx,
+        };
+        s.clutch = crate::torcs::launch::launch_clutch(
+            s.gearbox.gear,
+            throttle,
+            dt,
+            &mut s.launch_time,
+            &launch,
+        );
+    }
+
     fn driven_omega(&self, s: &State) -> f64 {
-        self.driven[0] * s.omega[0] + self.driven[1] * s.omega[1]
+        self.driven[0] * s.omega[0] + self.driven[1] * rear_omega(s)
     }
 
     /// Advances the state by `dt` seconds on the road described by `frame`.
@@ -254,7 +371,8 @@ impl Vehicle {
         let car = &self.car;
         let m = car.mass;
         let v2 = s.vx * s.vx + s.vy * s.vy;
-        let down = [self.downforce_per_v2[0] * v2, self.downforce_per_v2[1] * v2];
+        let per_v2 = self.downforce_per_v2(v2.sqrt());
+        let down = [per_v2[0] * v2, per_v2[1] * v2];
         // The road's push per unit of the car's weight: gravity's share on the grade and the
         // banking, and the vertical curvature's vₓ²κ_v (a crest unloads the car).
         let normal =
@@ -264,35 +382,74 @@ impl Vehicle {
             (self.static_load[0] * normal - transfer + down[0]).max(0.0),
             (self.static_load[1] * normal + transfer + down[1]).max(0.0),
         ];
+        // The wheels' loads, left and right: the roll moment moves ΔF_a from each axle's inner
+        // wheel to its outer one (the left wheel is the inner one while the roll moment is
+        // positive, in a left-hand corner).
+        let wheel_loads = |k: usize| {
+            let shift = self.roll_share[k] * s.roll;
+            [
+                (0.5 * fz[k] - shift).max(0.0),
+                (0.5 * fz[k] + shift).max(0.0),
+            ]
+        };
+        let (front_loads, rear_loads) = (wheel_loads(0), wheel_loads(1));
 
-        // Wheel-frame velocities of the front (steered) and rear axles.
-        let (sin_d, cos_d) = c.steer_sin_cos;
+        // Wheel-frame velocities of the front (steered) axle and the rear wheels, the left one
+        // at y = +y_r (simuv2's `car.cpp`: vₓ − r·y).
         let front_lat = s.vy + self.a * s.yaw_rate;
-        let vt = [s.vx * cos_d + front_lat * sin_d, s.vx];
-        let vl = [
-            -s.vx * sin_d + front_lat * cos_d,
-            s.vy - self.b * s.yaw_rate,
+        let turn = self.rear_half_track * s.yaw_rate;
+        let vt_rear = [s.vx - turn, s.vx + turn];
+        let vl_rear = s.vy - self.b * s.yaw_rate;
+        // 1 / max(|v_t|, v₀): the slips' common denominator, per wheel.
+        let inv_rear = [
+            1.0 / vt_rear[0].abs().max(SLIP_SPEED_FLOOR),
+            1.0 / vt_rear[1].abs().max(SLIP_SPEED_FLOOR),
         ];
-        // 1 / max(|v_t|, v₀): the slips' common denominator, per axle.
-        let inv_denom = [
-            1.0 / vt[0].abs().max(SLIP_SPEED_FLOOR),
-            1.0 / vt[1].abs().max(SLIP_SPEED_FLOOR),
-        ];
+        // An axle as the robot reads it: its wheels' mean spin against vₓ.
+        let inv_axle = 1.0 / s.vx.abs().max(SLIP_SPEED_FLOOR);
 
-        // Drive torque. Traction control eases the throttle while the driven axle's combined
-        // slip, with the wheel spinning faster than the road, passes the aid threshold.
+        // Drive torque. A car the TORCS robot drives gets the robot's traction control in
+        // every gear, on the driven wheels' mean slip speed ωR − vₓ
+        // ([`crate::torcs::traction`]), as the game's car does: with the rear wheels modelled
+        // one by one, the inner wheel's spin on a corner's exit is the tyres' own. Another car
+        // has its throttle eased while the driven axle's combined slip, with the wheels
+        // spinning faster than the road, passes the aid threshold.
         let mut throttle = c.throttle();
         let k = if self.driven[1] > 0.0 { 1 } else { 0 };
-        let spin = (s.omega[k] * self.radius[k] - vt[k]) * inv_denom[k];
-        let lateral = vl[k] * inv_denom[k];
+        let (spin_speed, lateral) = if k == 1 {
+            (rear_omega(s) * self.radius[1] - s.vx, vl_rear * inv_axle)
+        } else {
+            (s.omega[0] * self.radius[0] - s.vx, front_lat * inv_axle)
+        };
+        let spin = spin_speed * inv_axle;
         let combined2 = spin * spin + lateral * lateral;
         let threshold = self.aid_threshold[k];
-        if spin > 0.0 && combined2 > threshold * threshold {
+        if self.car.torcs_robot {
+            throttle = crate::torcs::traction::traction_throttle(throttle, spin_speed);
+        } else if spin > 0.0 && combined2 > threshold * threshold {
             throttle *= (2.0 - combined2.sqrt() / threshold).clamp(0.0, 1.0);
         }
-        let (drive_torque, engine_speed) =
+        // A slipping clutch (simuv2's transmission.cpp and engine.cpp): the engine turns at
+        // its own speed ω_e, unloaded by the clutch, and the wheels get its torque
+        // T_e(ω_e)·g·min(3τ, 1) for the clutch's transfer τ = 1 − c; closed (τ = 1), ω_e
+        // follows the wheels as below.
+        let transfer = 1.0 - s.clutch;
+        let slipping = transfer < 1.0 && s.gearbox.gear == 0;
+        let mut engine_torque = 0.0;
+        let (drive_torque, engine_speed) = if slipping {
+            let w = s.engine_speed.min(car.rev_limiter);
+            engine_torque = car.part_throttle_torque(self.engine_map.torque(w), throttle, w);
+            let ratio = s.gearbox.ratio(car);
+            let torque = if s.gearbox.shifting > 0.0 {
+                0.0
+            } else {
+                engine_torque * ratio * (3.0 * transfer).min(1.0)
+            };
+            (torque, w)
+        } else {
             s.gearbox
-                .wheel_torque(car, &self.engine_map, throttle, self.driven_omega(s));
+                .wheel_torque(car, &self.engine_map, throttle, self.driven_omega(s))
+        };
         s.engine_speed = engine_speed;
         let drive_torque = if s.gearbox.gear == 0 {
             drive_torque * self.launch_scale
@@ -301,42 +458,104 @@ impl Vehicle {
         };
         s.gearbox.shifting = (s.gearbox.shifting - dt).max(0.0);
 
-        let mut fx = [0.0; 2];
-        let mut fy = [0.0; 2];
-        for k in 0..2 {
-            let tyre = &self.tyres[k];
-            let r = self.radius[k];
-            let inv_denom = inv_denom[k];
-            let fmax = tyre.axle_max_force(fz[k], frame.friction);
-            let sx = (s.omega[k] * r - vt[k]) * inv_denom;
-            let sy = -vl[k] * inv_denom;
-            // ABS: ease the pressure while the wheel slides backwards past the threshold.
-            let mut brake = c.brake() * self.max_brake[k];
-            let threshold = self.aid_threshold[k];
-            if -sx > threshold {
-                brake *= (2.0 + sx / threshold).clamp(0.0, 1.0);
+        // The front wheels: one spin for both, each steered, loaded and gripping on its own;
+        // the inner wheel turned by δ, the outer by simuv2's Ackermann angle (`steer.cpp`),
+        // tan δ_o = L·tan|δ|/(L + T·tan|δ|), T = y_f + y_r.
+        let (sin_d, cos_d) = c.steer_sin_cos;
+        let tan_d = (sin_d / cos_d).abs();
+        let tan_o = self.wheelbase * tan_d / (self.wheelbase + self.track * tan_d);
+        let cos_o = 1.0 / (1.0 + tan_o * tan_o).sqrt();
+        let outer = ((tan_o * cos_o).copysign(sin_d), cos_o);
+        // Left first: the left wheel is the inner one in a left-hand turn (δ > 0).
+        let angles = if sin_d >= 0.0 {
+            [(sin_d, cos_d), outer]
+        } else {
+            [outer, (sin_d, cos_d)]
+        };
+        let (front_x, front_y, front_moment) = {
+            let tyre = &self.tyres[0];
+            let r = self.radius[0];
+            let wheel = |i: usize| {
+                let (sn, cs) = angles[i];
+                let vt = s.vx * cs + front_lat * sn;
+                let vl = -s.vx * sn + front_lat * cs;
+                let inv = 1.0 / vt.abs().max(SLIP_SPEED_FLOOR);
+                let fmax = tyre.wheel_max_force(front_loads[i], frame.friction);
+                let sx = (s.omega[0] * r - vt) * inv;
+                (tyre.forces(sx, -vl * inv, fmax), fmax, inv)
+            };
+            let wheels = [wheel(0), wheel(1)];
+            // ABS: ease the pressure while the axle slides backwards past the threshold.
+            let mut brake = c.brake() * self.max_brake[0];
+            let threshold = self.aid_threshold[0];
+            let slide = -(s.omega[0] * r - s.vx) * inv_axle;
+            if slide > threshold {
+                brake *= (2.0 - slide / threshold).clamp(0.0, 1.0);
             }
-            let f = tyre.forces(sx, sy, fmax);
-            // Implicit step of I·dω/dt = T − T_b·sgn ω − R·Fₓ(ω), with Fₓ linear in ω.
-            let dfx_domega = f.dfx_dsx * r * inv_denom;
-            let inertia = self.wheel_inertia[k];
-            let torque = self.driven[k] * drive_torque - r * f.fx;
-            let free = torque - brake * s.omega[k].signum() * f64::from(s.omega[k] != 0.0);
-            let mut new_omega = s.omega[k] + dt * free / (inertia + dt * r * dfx_domega.max(0.0));
+            // Implicit step of I·dω/dt = T − T_b·sgn ω − R·ΣFₓ(ω), with Fₓ linear in ω.
+            let dfx_domega: f64 = wheels
+                .iter()
+                .map(|(f, _, inv)| (f.dfx_dsx * r * inv).max(0.0))
+                .sum();
+            let inertia = self.wheel_inertia[0];
+            let torque = self.driven[0] * drive_torque - r * (wheels[0].0.fx + wheels[1].0.fx);
+            let free = torque - brake * s.omega[0].signum() * f64::from(s.omega[0] != 0.0);
+            let mut new_omega = s.omega[0] + dt * free / (inertia + dt * r * dfx_domega);
             // Brakes can stop a wheel but never spin it backwards.
-            if (brake > 0.0 && new_omega * s.omega[k] < 0.0)
-                || (s.omega[k] == 0.0 && brake > torque.abs())
+            if (brake > 0.0 && new_omega * s.omega[0] < 0.0)
+                || (s.omega[0] == 0.0 && brake > torque.abs())
             {
                 new_omega = 0.0;
             }
-            let dsx = (new_omega - s.omega[k]) * r * inv_denom;
-            s.omega[k] = new_omega;
-            // Forces at the new spin, to first order, kept inside the grip budget.
-            let (x, y) = (f.fx + f.dfx_dsx * dsx, f.fy + f.dfy_dsx * dsx);
-            (fx[k], fy[k]) = if x * x + y * y > fmax * fmax {
-                scale_to_budget(x, y, fmax)
+            let domega = new_omega - s.omega[0];
+            s.omega[0] = new_omega;
+            // Forces at the new spin, to first order, kept inside the grip budget, turned
+            // into the body's frame.
+            let mut body = [(0.0, 0.0); 2];
+            for (i, (f, fmax, inv)) in wheels.iter().enumerate() {
+                let dsx = domega * r * inv;
+                let (x, y) = (f.fx + f.dfx_dsx * dsx, f.fy + f.dfy_dsx * dsx);
+                let cap = fmax * tyre.force_cap;
+                let (x, y) = if x * x + y * y > cap * cap {
+                    scale_to_budget(x, y, cap)
+                } else {
+                    (x, y)
+                };
+                let (sn, cs) = angles[i];
+                body[i] = (x * cs - y * sn, x * sn + y * cs);
+            }
+            (
+                body[0].0 + body[1].0,
+                body[0].1 + body[1].1,
+                self.front_half_track * (body[1].0 - body[0].0),
+            )
+        };
+
+        let (fx_rear, fy_rear) = self.rear_wheels(
+            s,
+            c.brake(),
+            self.driven[1] * drive_torque,
+            &RearWheels {
+                loads: rear_loads,
+                vt: vt_rear,
+                vl: vl_rear,
+                inv_denom: inv_rear,
+                inv_axle,
+            },
+            frame.friction,
+            dt,
+        );
+
+        if slipping {
+            // ω_e ← ω_axle·g·τ⁴ + (ω_e + T_e·dt/I_e)·(1 − τ⁴), within idle and the revs
+            // maximum; free (τ ≤ 0.01), ω_e + T_e·dt/I_e.
+            let free = s.engine_speed + engine_torque * dt / car.engine_inertia;
+            s.engine_speed = if transfer > 0.01 {
+                let t4 = transfer.powi(4);
+                let w = self.driven_omega(s) * s.gearbox.ratio(car) * t4 + free * (1.0 - t4);
+                w.clamp(car.tickover, car.revs_max)
             } else {
-                (x, y)
+                free
             };
         }
 
@@ -347,12 +566,18 @@ impl Vehicle {
         let roll = c_rr * (fz[0] + fz[1]) * (s.vx / 0.5).clamp(-1.0, 1.0);
         // Drag 0.645·Cx·A·v² along the velocity: its x component is 0.645·Cx·A·v·vₓ.
         let drag = self.drag_per_v2 * v2.sqrt() * s.vx;
-        let force_x = fx[0] * cos_d - fy[0] * sin_d + fx[1] - drag - roll - m * G * frame.sin_pitch;
+        let tyres_x = front_x + fx_rear[0] + fx_rear[1];
+        let force_x = tyres_x - drag - roll - m * G * frame.sin_pitch;
         // cos(ψ − θ) of the car's yaw against the road's heading.
         let (sy, cy) = s.yaw_sin_cos;
         let along = cy * frame.cos_heading + sy * frame.sin_heading;
-        let force_y = fx[0] * sin_d + fy[0] * cos_d + fy[1] - m * G * frame.sin_banking * along;
-        let moment = self.a * (fx[0] * sin_d + fy[0] * cos_d) - self.b * fy[1];
+        let rear_y = fy_rear[0] + fy_rear[1];
+        let force_y = front_y + rear_y - m * G * frame.sin_banking * along;
+        // The rear wheels' longitudinal forces at ±y_r turn the car too (simuv2's `car.cpp`:
+        // M_z = Σ −Fₓ·y + Fᵧ·x).
+        let moment = self.a * front_y - self.b * rear_y
+            + front_moment
+            + self.rear_half_track * (fx_rear[1] - fx_rear[0]);
 
         let inv_m = self.inv_mass;
         let ax = force_x * inv_m;
@@ -380,9 +605,168 @@ impl Vehicle {
         let (sin_y, cos_y) = s.yaw_sin_cos;
         s.x += dt * (s.vx * cos_y - s.vy * sin_y);
         s.y += dt * (s.vx * sin_y + s.vy * cos_y);
-        // Load transfer follows the acceleration with a short lag (suspension pitch).
-        s.ax += (ax - s.ax) * (dt * PITCH_RATE).min(1.0);
+        // Load transfer follows the tyres' forces with a short lag (the body's pitch and roll).
+        s.ax += (tyres_x * inv_m - s.ax) * (dt * PITCH_RATE).min(1.0);
+        let roll_moment = front_y * self.roll_centre[0] + rear_y * self.roll_centre[1];
+        s.roll += (roll_moment - s.roll) * (dt * ROLL_RATE).min(1.0);
     }
+}
+
+/// The rear wheels' loads and wheel-frame velocities at a step.
+struct RearWheels {
+    /// Normal loads of the left and right wheels (N).
+    loads: [f64; 2],
+    /// Tangential velocities (m/s).
+    vt: [f64; 2],
+    /// Lateral velocity, the same for both (m/s).
+    vl: f64,
+    /// 1 / max(|v_t|, v₀) of each wheel.
+    inv_denom: [f64; 2],
+    /// 1 / max(|vₓ|, v₀) of the car.
+    inv_axle: f64,
+}
+
+impl Vehicle {
+    /// Steps the rear wheels' spins under the drive torque `drive` at the axle (N·m), the
+    /// brake pedal and their tyres' forces, and returns their forces (Fₓ and Fᵧ of the left
+    /// and right wheels, N), as simuv2's `differential.cpp` drives them:
+    ///
+    /// - **Spool** (and a limited slip past its locking torque, T > T_lock or
+    ///   T < −T_lock,brake): one shaft, 2I·dω/dt = T − Σ R·Fₓ,i − Σ T_b,i, both wheels at
+    ///   their mean spin.
+    /// - **Limited slip** below it: the wheels' speed ratio ρ = |ω₀ − ω₁|/(|ω₀| + |ω₁|) is held
+    ///   to ρ_max = ρ_s·(1 − |T|/T_lock) (ρ_s the `max slip bias`, T_lock of the torque's sign)
+    ///   by moving both spins (ρ − ρ_max)·(|ω₀| + |ω₁|)/2 towards each other, and the torque
+    ///   is split T·(1 ± (ρ − ρ_max))/2, more to the slower wheel under drive; then as free.
+    /// - **Free**: each wheel gets T_i plus simuv2's spider torque, I·dω_i/dt = T_i +
+    ///   (τ_j − τ_i)/2 − τ_i − T_b,i with τ = R·Fₓ the tyre's reaction (T_i = T/2).
+    /// - A rear axle without drive rolls free: I·dω_i/dt = −τ_i − T_b,i.
+    ///
+    /// Integrated implicitly in the spins (each τ linear in its wheel's ω, a 2×2 system),
+    /// stable at the 4 ms step where simuv2 steps explicitly at 2 ms. ABS eases both brakes
+    /// on the axle's mean slip (ω̄R − vₓ)/max(|vₓ|, v₀), as the robot reads it.
+    fn rear_wheels(
+        &self,
+        s: &mut State,
+        brake_pedal: f64,
+        drive: f64,
+        w: &RearWheels,
+        friction: f64,
+        dt: f64,
+    ) -> ([f64; 2], [f64; 2]) {
+        let tyre = &self.tyres[1];
+        let r = self.radius[1];
+        let inertia = self.wheel_inertia[1];
+        let diff = &self.car.differential;
+        let mut omega = [s.omega[1], s.omega[2]];
+        // The differential's mode, its torque split and its speed constraint.
+        let driven = self.driven[1] > 0.0;
+        let rigid = driven
+            && match diff.kind {
+                DiffKind::Spool => true,
+                DiffKind::LimitedSlip => {
+                    drive > diff.lock_torque || drive < -diff.lock_brake_torque
+                }
+                DiffKind::Free => false,
+            };
+        let mut split = [0.5 * drive; 2];
+        let spider = if driven { 0.5 } else { 0.0 };
+        if rigid {
+            let mean = 0.5 * (omega[0] + omega[1]);
+            omega = [mean; 2];
+        } else if driven && diff.kind == DiffKind::LimitedSlip {
+            let sum = omega[0].abs() + omega[1].abs();
+            if sum > 0.0 {
+                let ratio = (omega[0] - omega[1]).abs() / sum;
+                let lock = if drive >= 0.0 {
+                    diff.lock_torque
+                } else {
+                    diff.lock_brake_torque
+                };
+                let max = diff.slip_max * (1.0 - drive.abs() / lock);
+                if ratio > max {
+                    let excess = ratio - max;
+                    let delta = excess * 0.5 * sum;
+                    // The faster wheel slows, the slower speeds up, and the torque favours
+                    // the slower one under drive (the faster one under the engine brake).
+                    let faster = if omega[0] > omega[1] { 0 } else { 1 };
+                    omega[faster] -= delta;
+                    omega[1 - faster] += delta;
+                    let bias = excess * drive.signum();
+                    split[faster] = 0.5 * drive * (1.0 - bias);
+                    split[1 - faster] = 0.5 * drive * (1.0 + bias);
+                }
+            }
+        }
+
+        // ABS on the axle's mean slip.
+        let mut brake = brake_pedal * self.max_brake[1];
+        let threshold = self.aid_threshold[1];
+        let slide = -(0.5 * (omega[0] + omega[1]) * r - s.vx) * w.inv_axle;
+        if slide > threshold {
+            brake *= (2.0 - slide / threshold).clamp(0.0, 1.0);
+        }
+
+        // Tyre forces at the spins, their reaction torques τ and dτ/dω.
+        let forces = [0, 1].map(|i| {
+            let fmax = tyre.wheel_max_force(w.loads[i], friction);
+            let sx = (omega[i] * r - w.vt[i]) * w.inv_denom[i];
+            let sy = -w.vl * w.inv_denom[i];
+            (tyre.forces(sx, sy, fmax), fmax)
+        });
+        let tau = [r * forces[0].0.fx, r * forces[1].0.fx];
+        let dtau = [0, 1].map(|i| (forces[i].0.dfx_dsx * r * r * w.inv_denom[i]).max(0.0));
+        let brake_torque = [0, 1].map(|i| brake * omega[i].signum() * f64::from(omega[i] != 0.0));
+        let step = if rigid {
+            let d = dt * (drive - tau[0] - tau[1] - brake_torque[0] - brake_torque[1])
+                / (2.0 * inertia + dt * (dtau[0] + dtau[1]));
+            [d; 2]
+        } else {
+            // (I + dt·d_i·(1 + h))·Δ_i − dt·h·d_j·Δ_j = dt·(T_i + h·(τ_j − τ_i) − τ_i − T_b,i),
+            // h the spider's half.
+            let h = spider;
+            let rhs = [0, 1].map(|i| {
+                let j = 1 - i;
+                dt * (split[i] + h * (tau[j] - tau[i]) - tau[i] - brake_torque[i])
+            });
+            let a = [0, 1].map(|i| inertia + dt * dtau[i] * (1.0 + h));
+            let b = [0, 1].map(|i| -dt * h * dtau[i]);
+            let det = a[0] * a[1] - b[0] * b[1];
+            [
+                (rhs[0] * a[1] - b[1] * rhs[1]) / det,
+                (a[0] * rhs[1] - b[0] * rhs[0]) / det,
+            ]
+        };
+        let mut fx = [0.0; 2];
+        let mut fy = [0.0; 2];
+        for i in 0..2 {
+            let (f, fmax) = forces[i];
+            let mut new_omega = omega[i] + step[i];
+            // Brakes can stop a wheel but never spin it backwards.
+            let torque = split[i] - tau[i];
+            if (brake > 0.0 && new_omega * omega[i] < 0.0)
+                || (omega[i] == 0.0 && brake > torque.abs())
+            {
+                new_omega = 0.0;
+            }
+            let dsx = (new_omega - omega[i]) * r * w.inv_denom[i];
+            s.omega[1 + i] = new_omega;
+            let (x, y) = (f.fx + f.dfx_dsx * dsx, f.fy + f.dfy_dsx * dsx);
+            let cap = fmax * tyre.force_cap;
+            (fx[i], fy[i]) = if x * x + y * y > cap * cap {
+                scale_to_budget(x, y, cap)
+            } else {
+                (x, y)
+            };
+        }
+        (fx, fy)
+    }
+}
+
+/// The rear wheels' mean spin (rad/s).
+#[inline]
+pub fn rear_omega(s: &State) -> f64 {
+    0.5 * (s.omega[1] + s.omega[2])
 }
 
 /// (x, y) scaled to the length `fmax`. Rarely needed, so kept out of line: the hot path
@@ -394,6 +778,168 @@ fn scale_to_budget(x: f64, y: f64, fmax: f64) -> (f64, f64) {
     (x * scale, y * scale)
 }
 
+/// Speed step (m/s) of the table of downforce per v².
+const DOWNFORCE_SPEED_STEP: f64 = 0.5;
+/// Steps of the table: up to 150 m/s.
+const DOWNFORCE_SPEEDS: usize = 300;
+
 /// 1 / time constant of the longitudinal load transfer (1/s): the pitch dynamics follow
 /// the acceleration with a 50 ms lag.
 const PITCH_RATE: f64 = 20.0;
+/// 1 / time constant of the lateral load transfer (1/s): simuv2's body rolls against springs
+/// and dampers that, for car1-trb1 (κ = 1.17 MN/m a wheel, slow bump and rebound some
+/// 0.08 MN·s/m), settle it over c/κ ≈ 70 ms.
+const ROLL_RATE: f64 = 14.0;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::car::Ride;
+
+    /// A level straight's frame.
+    fn level() -> Frame {
+        let t = crate::track::Track::from_pieces(
+            "straight",
+            "test",
+            &[crate::track::Piece::flat(500.0, 0.0)],
+            vec![],
+        );
+        *t.frame(0)
+    }
+
+    /// The car mirrored: steering, lateral velocity, yaw rate, roll moment and the rear wheels
+    /// swapped left for right give the mirrored step, to the last bits (the Ackermann wheel,
+    /// the wheels' loads and the rear wheels' yaw moment take the right sides), for a limited
+    /// slip, a spool and a free differential, under drive and under the brakes.
+    #[test]
+    fn a_left_hand_turn_mirrors_a_right_hand_one() {
+        for kind in [DiffKind::LimitedSlip, DiffKind::Spool, DiffKind::Free] {
+            let mut car = Car::spirit_300();
+            car.differential.kind = kind;
+            let v = Vehicle::new(&car);
+            let frame = level();
+            for (throttle, brake) in [(0.8, 0.0), (0.0, 0.6)] {
+                let mut left = v.at_rest(0.0, 0.0, 0.0);
+                left.vx = 30.0;
+                left.vy = 0.4;
+                left.yaw_rate = 0.5;
+                left.roll = 2000.0;
+                left.omega = [30.0 / v.radius[0], 31.0 / v.radius[1], 32.0 / v.radius[1]];
+                left.yaw_sin_cos = left.yaw.sin_cos();
+                v.shift(&mut left, throttle);
+                let mut right = left;
+                right.vy = -left.vy;
+                right.yaw_rate = -left.yaw_rate;
+                right.roll = -left.roll;
+                right.omega = [left.omega[0], left.omega[2], left.omega[1]];
+                for _ in 0..50 {
+                    v.step(
+                        &mut left,
+                        &Controls::new(0.1, throttle, brake),
+                        &frame,
+                        0.004,
+                    );
+                    v.step(
+                        &mut right,
+                        &Controls::new(-0.1, throttle, brake),
+                        &frame,
+                        0.004,
+                    );
+                }
+                let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(1.0);
+                assert!(close(left.vx, right.vx), "{kind:?}: {left:?} {right:?}");
+                assert!(close(left.vy, -right.vy), "{kind:?}: {left:?} {right:?}");
+                assert!(close(left.yaw_rate, -right.yaw_rate), "{kind:?}");
+                assert!(close(left.roll, -right.roll), "{kind:?}");
+                assert!(close(left.omega[1], right.omega[2]), "{kind:?}");
+                assert!(close(left.omega[2], right.omega[1]), "{kind:?}");
+                assert!(left.yaw_rate > 0.0 && left.roll > 0.0, "{kind:?}: {left:?}");
+            }
+        }
+    }
+
+    /// The lateral load transfer takes the roll moment up: the axles' transfers ΔF_a at ±y_a
+    /// give back M (Σ 2·ΔF_a·y_a = M), shared as the rates in roll times the tracks.
+    #[test]
+    fn the_wheels_take_up_the_roll_moment() {
+        let car = Car::spirit_300();
+        let v = Vehicle::new(&car);
+        let (y, k) = (car.axles.half_track, car.axles.roll_rate);
+        let moment = 2.0 * (v.roll_share[0] * y[0] + v.roll_share[1] * y[1]);
+        assert!((moment - 1.0).abs() < 1e-12, "{moment}");
+        let ratio = v.roll_share[0] / v.roll_share[1];
+        assert!((ratio - k[0] * y[0] / (k[1] * y[1])).abs() < 1e-12);
+    }
+
+    /// Through a spool the rear wheels turn as one; through a limited slip under a drive
+    /// torque T below its locking torque their speed ratio ends within ρ_s·(1 − T/T_lock);
+    /// through a free one, on a slippery road, the drive spins both up alike.
+    #[test]
+    fn the_differential_holds_the_rear_wheels_as_its_kind() {
+        let r = Car::spirit_300().rear_tyre.radius;
+        let rear = RearWheels {
+            loads: [3000.0, 3000.0],
+            vt: [30.0, 30.0],
+            vl: 0.0,
+            inv_denom: [1.0 / 30.0; 2],
+            inv_axle: 1.0 / 30.0,
+        };
+        let spun = |kind: DiffKind, drive: f64, omega: [f64; 2], friction: f64| {
+            let mut car = Car::spirit_300();
+            car.differential.kind = kind;
+            let v = Vehicle::new(&car);
+            let mut s = v.at_rest(0.0, 0.0, 0.0);
+            s.vx = 30.0;
+            s.omega = [30.0 / r, omega[0], omega[1]];
+            v.rear_wheels(&mut s, 0.0, drive, &rear, friction, 0.004);
+            [s.omega[1], s.omega[2]]
+        };
+        let w = spun(DiffKind::Spool, 500.0, [30.0 / r, 33.0 / r], 1.0);
+        assert_eq!(w[0], w[1]);
+        let diff = Car::spirit_300().differential;
+        let drive = 600.0;
+        let w = spun(DiffKind::LimitedSlip, drive, [30.0 / r, 36.0 / r], 1.0);
+        let ratio = (w[0] - w[1]).abs() / (w[0].abs() + w[1].abs());
+        assert!(
+            ratio <= diff.slip_max * (1.0 - drive / diff.lock_torque) + 1e-12,
+            "{ratio}"
+        );
+        // Both wheels on a road of friction 0.05, from rolling.
+        let w = spun(DiffKind::Free, 800.0, [30.0 / r, 30.0 / r], 0.05);
+        assert!(w[0] > 30.0 / r && (w[0] - w[1]).abs() < 1e-9, "{w:?}");
+    }
+
+    /// Between the table's speeds the downforce per v² is the car's within 0.1 %, and a car
+    /// without a ride height keeps its constant.
+    #[test]
+    fn the_downforce_table_follows_the_car() {
+        let rate = 5500.0 * 0.453_592_37 / 0.0254 * 1.21;
+        let car = Car {
+            mass: 1244.0,
+            clift: [0.69, 0.7],
+            ride: Some(Ride {
+                height: [0.09, 0.105],
+                load: [2932.0, 2706.0],
+                rate: [rate, rate],
+                travel: [0.18, 0.18],
+            }),
+            ..Car::spirit_300()
+        };
+        let v = Vehicle::new(&car);
+        for speed in [0.3, 7.77, 31.1, 55.55, 89.9, 149.0] {
+            let exact = car.downforce(speed).map(|f| f / (speed * speed));
+            let table = v.downforce_per_v2(speed);
+            for k in 0..2 {
+                assert!(
+                    (table[k] - exact[k]).abs() < 1e-3 * exact[k],
+                    "{speed}: {table:?} vs {exact:?}"
+                );
+            }
+        }
+        let plain = Vehicle::new(&Car::spirit_300());
+        assert_eq!(
+            plain.downforce_per_v2(42.0),
+            Car::spirit_300().downforce(1.0)
+        );
+    }
+}
