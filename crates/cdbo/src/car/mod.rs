@@ -465,11 +465,11 @@ pub const DEFAULT_ENGINE_BRAKE: f64 = 0.33;
 pub const DEFAULT_PAD_MU: f64 = 0.30;
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// A car with simuv2's ride height: car1-trb1's figures (its file is not in the repository).
-    fn on_springs() -> Car {
+    pub(crate) fn on_springs() -> Car {
         let rate = 5500.0 * 0.453_592_37 / 0.0254 * 1.1 * 1.1;
         Car {
             mass: 1244.0,

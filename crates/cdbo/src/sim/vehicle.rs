@@ -184,16 +184,6 @@ pub struct Vehicle {
     /// Load moved from each axle's inner wheel to its outer one per N·m of roll moment,
     /// κ_a·y_a/(2·Σ_b κ_b·y_b²) (1/m) ([`crate::car::Axles`]).
     roll_share: [f64; 2],
-    /// Roll centre heights of the front and rear axles (m).
-    roll_centre: [f64; 2],
-    /// |y| of the rear wheels (m).
-    rear_half_track: f64,
-    /// |y| of the front wheels (m).
-    front_half_track: f64,
-    /// The wheelbase L (m).
-    wheelbase: f64,
-    /// The mean track T = y_f + y_r (m), of simuv2's Ackermann steering.
-    track: f64,
     /// Slip at which ABS and traction control start easing, per axle.
     aid_threshold: [f64; 2],
     /// 0.645·Cx·A (kg/m).
@@ -233,11 +223,6 @@ impl Vehicle {
                     [0.0; 2]
                 }
             },
-            roll_centre: car.axles.roll_centre,
-            rear_half_track: car.axles.half_track[1],
-            front_half_track: car.axles.half_track[0],
-            wheelbase: car.wheelbase,
-            track: car.axles.half_track[0] + car.axles.half_track[1],
             drag_per_v2: car.drag(1.0),
             downforce_per_v2: match car.ride {
                 None => vec![car.downforce(1.0)],
@@ -397,7 +382,7 @@ impl Vehicle {
         // Wheel-frame velocities of the front (steered) axle and the rear wheels, the left one
         // at y = +y_r (simuv2's `car.cpp`: vₓ − r·y).
         let front_lat = s.vy + self.a * s.yaw_rate;
-        let turn = self.rear_half_track * s.yaw_rate;
+        let turn = self.car.axles.half_track[1] * s.yaw_rate;
         let vt_rear = [s.vx - turn, s.vx + turn];
         let vl_rear = s.vy - self.b * s.yaw_rate;
         // 1 / max(|v_t|, v₀): the slips' common denominator, per wheel.
@@ -463,7 +448,8 @@ impl Vehicle {
         // tan δ_o = L·tan|δ|/(L + T·tan|δ|), T = y_f + y_r.
         let (sin_d, cos_d) = c.steer_sin_cos;
         let tan_d = (sin_d / cos_d).abs();
-        let tan_o = self.wheelbase * tan_d / (self.wheelbase + self.track * tan_d);
+        let (l, [y_f, y_r]) = (self.car.wheelbase, self.car.axles.half_track);
+        let tan_o = l * tan_d / (l + (y_f + y_r) * tan_d);
         let cos_o = 1.0 / (1.0 + tan_o * tan_o).sqrt();
         let outer = ((tan_o * cos_o).copysign(sin_d), cos_o);
         // Left first: the left wheel is the inner one in a left-hand turn (δ > 0).
@@ -527,7 +513,7 @@ impl Vehicle {
             (
                 body[0].0 + body[1].0,
                 body[0].1 + body[1].1,
-                self.front_half_track * (body[1].0 - body[0].0),
+                self.car.axles.half_track[0] * (body[1].0 - body[0].0),
             )
         };
 
@@ -577,7 +563,7 @@ impl Vehicle {
         // M_z = Σ −Fₓ·y + Fᵧ·x).
         let moment = self.a * front_y - self.b * rear_y
             + front_moment
-            + self.rear_half_track * (fx_rear[1] - fx_rear[0]);
+            + self.car.axles.half_track[1] * (fx_rear[1] - fx_rear[0]);
 
         let inv_m = self.inv_mass;
         let ax = force_x * inv_m;
@@ -607,7 +593,8 @@ impl Vehicle {
         s.y += dt * (s.vx * sin_y + s.vy * cos_y);
         // Load transfer follows the tyres' forces with a short lag (the body's pitch and roll).
         s.ax += (tyres_x * inv_m - s.ax) * (dt * PITCH_RATE).min(1.0);
-        let roll_moment = front_y * self.roll_centre[0] + rear_y * self.roll_centre[1];
+        let [h_f, h_r] = self.car.axles.roll_centre;
+        let roll_moment = front_y * h_f + rear_y * h_r;
         s.roll += (roll_moment - s.roll) * (dt * ROLL_RATE).min(1.0);
     }
 }
@@ -794,7 +781,6 @@ const ROLL_RATE: f64 = 14.0;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::car::Ride;
 
     /// A level straight's frame.
     fn level() -> Frame {
@@ -913,18 +899,7 @@ mod tests {
     /// without a ride height keeps its constant.
     #[test]
     fn the_downforce_table_follows_the_car() {
-        let rate = 5500.0 * 0.453_592_37 / 0.0254 * 1.21;
-        let car = Car {
-            mass: 1244.0,
-            clift: [0.69, 0.7],
-            ride: Some(Ride {
-                height: [0.09, 0.105],
-                load: [2932.0, 2706.0],
-                rate: [rate, rate],
-                travel: [0.18, 0.18],
-            }),
-            ..Car::spirit_300()
-        };
+        let car = crate::car::tests::on_springs();
         let v = Vehicle::new(&car);
         for speed in [0.3, 7.77, 31.1, 55.55, 89.9, 149.0] {
             let exact = car.downforce(speed).map(|f| f / (speed * speed));
