@@ -8,10 +8,13 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyType};
 
+use cdbo::drive::steering::SteeringLaw;
+use cdbo::experiment::line::LineKind;
 use cdbo::policy::rkhs::default_lengthscale;
 use cdbo::study::{Outcome, Study, StudyConfig, Trial};
 
 use crate::convert::{IntoPy, array, lock, vector};
+use crate::race::line_setting;
 
 /// One trial of a study: `id`, the `weights` to drive, and once told its `reward`,
 /// `lap_time` (s), `failure` and `x_fail`.
@@ -64,8 +67,13 @@ impl PyTrial {
 /// so a study created here can be driven by the command line and back.
 ///
 /// `Study.create(path, w0, method="cdbo", lengthscale=None, seed=0, beta=1.0,
-/// track_length=None)` (M = len(w0) kernels, length-scale 1/(M − 1) by default; the lap's
-/// length in metres, if known, lets pattern search repair over road), `Study.open(path)`;
+/// track_length=None, knob=None, max_failed=None, line="centre", line_kernels=None,
+/// line_start=None, steering="pi")` (M = len(w0) kernels, length-scale 1/(M − 1) by default;
+/// the lap's length in metres, if known, lets pattern search repair over road; `max_failed`
+/// is `cdbo study create --max-failed-laps`; `line`, `line_kernels`, `line_start` and
+/// `steering` as `cdbo.race`'s, stored with the study: with `line="learn"` w0 is [w_a, w_d]
+/// as `RaceEnv(line="learn").w0`, the line's M_d = `line_kernels` weights last, half of w0 by
+/// default), `Study.open(path)`;
 /// then `ask()` → `Trial`,
 /// `tell(trial, reward)`, `tell(trial, lap_time=T, length=L)` or `tell(trial, failed=True,
 /// at=x, reason=...)`; every told result is on disk when `tell` returns.
@@ -77,7 +85,7 @@ pub struct PyStudy {
 #[pymethods]
 impl PyStudy {
     #[classmethod]
-    #[pyo3(signature = (path, w0, *, method = "cdbo", lengthscale = None, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, track_length = None, knob = None))]
+    #[pyo3(signature = (path, w0, *, method = "cdbo", lengthscale = None, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, track_length = None, knob = None, max_failed = None, line = "centre", line_kernels = None, line_start = None, steering = "pi"))]
     #[allow(clippy::too_many_arguments)]
     fn create(
         _cls: &Bound<'_, PyType>,
@@ -90,23 +98,49 @@ impl PyStudy {
         beta: f64,
         track_length: Option<f64>,
         knob: Option<f64>,
+        max_failed: Option<usize>,
+        line: &str,
+        line_kernels: Option<usize>,
+        line_start: Option<&str>,
+        steering: &str,
     ) -> PyResult<Self> {
         let w0 = vector(w0, "w0")?;
+        let steering: SteeringLaw = steering.parse().py()?;
+        let learned = line.parse::<LineKind>().py()? == LineKind::Learn;
+        // A learned line's weights follow the pedal's in w0, half of them by default (as
+        // `RaceEnv(line="learn").w0`).
+        let line_kernels = match learned {
+            true => Some(line_kernels.unwrap_or(w0.len() / 2)),
+            false => line_kernels,
+        };
+        let kernels = match line_kernels.filter(|_| learned) {
+            Some(m) if m < w0.len() => w0.len() - m,
+            Some(m) => {
+                return Err(PyValueError::new_err(format!(
+                    "w0 has {} weights: too few for a line of {m} kernels after the pedal's",
+                    w0.len()
+                )));
+            }
+            None => w0.len(),
+        };
+        let (base_line, line_kernels) = line_setting(line, line_kernels, line_start)?
+            .resolve(kernels)
+            .py()?;
         let config = StudyConfig {
             method: method.parse::<cdbo::method::Method>().py()?,
-            kernels: w0.len(),
-            lengthscale: lengthscale.unwrap_or_else(|| default_lengthscale(w0.len())),
+            kernels,
+            lengthscale: lengthscale.unwrap_or_else(|| default_lengthscale(kernels)),
             seed,
             beta,
             w0,
             track: None,
             track_length,
             knob,
-            max_failed_laps: None,
+            max_failed_laps: max_failed,
             warm_start: None,
-            line_kernels: None,
-            base_line: Default::default(),
-            steering: Default::default(),
+            line_kernels,
+            base_line,
+            steering,
         };
         let study = py.detach(|| Study::create(&path, config)).py()?;
         Ok(PyStudy {
@@ -182,7 +216,9 @@ impl PyStudy {
         lock(&self.study)?.told().py()
     }
 
-    /// The study's settings as a dict (method, kernels, lengthscale, seed, beta, w0).
+    /// The study's settings as a dict (method, kernels, lengthscale, seed, beta, w0, track,
+    /// track_length, knob, max_failed_laps, warm_start, line_kernels, base_line, steering;
+    /// None where unset).
     #[getter]
     fn config<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let c = lock(&self.study)?.config().clone();
@@ -193,6 +229,14 @@ impl PyStudy {
         d.set_item("seed", c.seed)?;
         d.set_item("beta", c.beta)?;
         d.set_item("w0", array(py, c.w0))?;
+        d.set_item("track", c.track)?;
+        d.set_item("track_length", c.track_length)?;
+        d.set_item("knob", c.knob)?;
+        d.set_item("max_failed_laps", c.max_failed_laps)?;
+        d.set_item("warm_start", c.warm_start)?;
+        d.set_item("line_kernels", c.line_kernels)?;
+        d.set_item("base_line", c.base_line.name())?;
+        d.set_item("steering", c.steering.name())?;
         Ok(d)
     }
 

@@ -121,3 +121,29 @@ def test_bad_input_raises_and_loses_nothing(tmp_path):
     with pytest.raises(ValueError, match="already told"):
         study.tell(t, 4.0)
     assert study.best.reward == 3.0
+
+
+def test_a_study_keeps_the_race_settings_and_its_budget(tmp_path):
+    env = cdbo.RaceEnv("ridgeway", kernels=8, line="learn", line_start="min-curvature")
+    study = cdbo.Study.create(
+        tmp_path / "line.db", env.w0, method="pattern-search", line="learn",
+        line_start="min-curvature", steering="tracker", max_failed=1,
+    )
+    c = study.config
+    assert (c["kernels"], c["line_kernels"], c["max_failed_laps"]) == (8, 8, 1)
+    assert (c["base_line"], c["steering"]) == ("min-curvature", "tracker")
+    first = study.ask()
+    assert np.array_equal(first.weights, env.w0)
+    study.tell(first, 10.0)
+    second = study.ask()
+    assert not np.array_equal(second.weights, env.w0)
+    study.tell(second, failed=True, at=0.5, reason="off_track")
+    # The budget of one failed lap is spent: only the best lap is driven again.
+    assert np.array_equal(study.ask().weights, env.w0)
+    with pytest.raises(ValueError, match="too few for a line of 16 kernels"):
+        cdbo.Study.create(tmp_path / "short.db", env.w0, line="learn", line_kernels=16)
+    with pytest.raises(ValueError, match="line kernels of line centre"):
+        cdbo.Study.create(tmp_path / "centre.db", env.w0, line_kernels=4)
+    with pytest.raises(ValueError, match="steering"):
+        cdbo.Study.create(tmp_path / "steer.db", env.w0, steering="wheel")
+    assert not any((tmp_path / f).exists() for f in ("short.db", "centre.db", "steer.db"))
