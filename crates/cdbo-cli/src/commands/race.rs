@@ -68,8 +68,8 @@ pub struct RaceArgs {
     /// Where a lap leaves the road: once the car's centre is this far past the road's edge
     /// (m; 1, the game's rule). A negative margin keeps the car that far inside the road while
     /// it learns, for a policy that must survive a world harsher than the simulator: learned
-    /// so with -1 (-2), the pattern search's best policy completes in the game on 10 (18) of
-    /// TORCS's 21 road tracks, against 2, for 4 % (8 %) of its pace (docs/results/torcs.md,
+    /// so with -1 (-2), the pattern search's best policy completes in the game on 17 (20) of
+    /// TORCS's 21 road tracks, against 5, for 4.4 % (8.0 %) of its pace (docs/results/torcs.md,
     /// "Robust learning")
     #[arg(long, default_value_t = 1.0, allow_negative_numbers = true, value_parser = super::value::off_track_margin)]
     off_track_margin: f64,
