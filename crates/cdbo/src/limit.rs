@@ -39,10 +39,10 @@
 
 use serde::Serialize;
 
+use crate::car::G;
 use crate::car::{Car, Drive};
 use crate::line::RacingLine;
 use crate::sim::tyre::TyreModel;
-use crate::sim::vehicle::G;
 use crate::track::Track;
 
 /// The limit lap.
@@ -176,8 +176,8 @@ pub fn limit_lap_with(track: &Track, car: &Car, options: LimitOptions) -> Limit 
         TyreModel::new(&car.front_tyre),
         TyreModel::new(&car.rear_tyre),
     ];
-    let (a, b, l) = (car.cg_to_front(), car.cg_to_rear(), car.wheelbase);
-    let static_load = [m * G * b / l, m * G * a / l];
+    let l = car.wheelbase;
+    let static_load = car.static_axle_loads();
     let rolling = 0.5 * (car.front_tyre.rolling_resistance + car.rear_tyre.rolling_resistance);
     let grip = |axle: usize, fz: f64, friction: f64| tyres[axle].axle_max_force(fz, friction);
     // n(v) at station i: the road's push per unit of the car's weight (module documentation).
@@ -335,10 +335,8 @@ mod tests {
             TyreModel::new(&car.rear_tyre),
         ];
         let d = car.downforce(v);
-        let loads = [
-            car.mass * G * car.cg_to_rear() / car.wheelbase + d[0],
-            car.mass * G * car.cg_to_front() / car.wheelbase + d[1],
-        ];
+        let weight = car.static_axle_loads();
+        let loads = [weight[0] + d[0], weight[1] + d[1]];
         let grip: f64 = (0..2)
             .map(|k| loads[k] * tyres[k].mu * tyres[k].load_factor(loads[k] / 2.0))
             .sum();

@@ -3,10 +3,11 @@
 mod common;
 
 use cdbo::car::Car;
+use cdbo::car::G;
 use cdbo::drive::demo::SpeedHold;
 use cdbo::drive::{ConstantPedal, Observation, Pedal};
 use cdbo::limit::limit_lap;
-use cdbo::sim::vehicle::{Controls, G, Vehicle};
+use cdbo::sim::vehicle::{Controls, Vehicle};
 use cdbo::sim::{FailureReason, Simulator};
 use cdbo::track::{Piece, Track};
 use common::{builtin, shared_track};

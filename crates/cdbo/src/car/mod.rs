@@ -369,6 +369,15 @@ impl Car {
         self.front_weight * self.wheelbase
     }
 
+    /// The axles' static loads [m·g·b/L, m·g·a/L] (N): the car's weight shared between the
+    /// axles as its centre of gravity sits between them.
+    pub fn static_axle_loads(&self) -> [f64; 2] {
+        [
+            self.mass * G * self.cg_to_rear() / self.wheelbase,
+            self.mass * G * self.cg_to_front() / self.wheelbase,
+        ]
+    }
+
     /// Yaw inertia I_z = k·m·a·b (kg·m²).
     pub fn yaw_inertia(&self) -> f64 {
         self.yaw_inertia_factor * self.mass * self.cg_to_front() * self.cg_to_rear()
@@ -434,10 +443,7 @@ impl Car {
             let q = AIR_HALF_RHO * self.front_area * v2;
             return [0, 1].map(|k| (q * self.clift[k] + wings[k]) * s);
         };
-        let weight = [
-            self.mass * crate::sim::vehicle::G * self.cg_to_rear() / self.wheelbase,
-            self.mass * crate::sim::vehicle::G * self.cg_to_front() / self.wheelbase,
-        ];
+        let weight = self.static_axle_loads();
         let total = |sum: f64| {
             let h = Ride::ground_effect(sum);
             [0, 1].map(|k| (self.clift[k] * v2 * h + wings[k]) * s)
@@ -454,6 +460,9 @@ impl Car {
         total(0.5 * (lo + hi))
     }
 }
+
+/// Gravity g (m/s²).
+pub const G: f64 = 9.81;
 
 /// Half the air density, ρ/2 (kg/m³), the 0.645 of TORCS's aerodynamics.
 pub const AIR_HALF_RHO: f64 = 0.645;
@@ -507,15 +516,14 @@ pub(crate) mod tests {
             }
             w
         };
-        let g = crate::sim::vehicle::G;
         let mut last = 0.0;
         for v in [1.0, 20.0, 40.0, 60.0, 80.0] {
             let d = car.downforce(v);
             let w = wings(v);
             let (a, b, l) = (car.cg_to_front(), car.cg_to_rear(), car.wheelbase);
             let sum = ride.height_sum(
-                0.5 * (car.mass * g * b / l + d[0]),
-                0.5 * (car.mass * g * a / l + d[1]),
+                0.5 * (car.mass * G * b / l + d[0]),
+                0.5 * (car.mass * G * a / l + d[1]),
             );
             let h = Ride::ground_effect(sum);
             for k in 0..2 {

@@ -57,11 +57,9 @@
 
 use super::powertrain::{EngineMap, Gearbox, ShiftMap};
 use super::tyre::TyreModel;
-use crate::car::{Car, DiffKind, Drive};
+use crate::car::{Car, DiffKind, Drive, G};
 use crate::track::Frame;
 
-/// Gravity (m/s²).
-pub const G: f64 = 9.81;
 /// Floor of the speed that normalises slip (m/s): keeps slip finite when standing.
 pub const SLIP_SPEED_FLOOR: f64 = 2.0;
 /// ABS and traction control start easing at this fraction of the tyre's peak slip, and
@@ -202,7 +200,7 @@ impl Vehicle {
             Drive::Front => [1.0, 0.0],
             Drive::All => [0.5, 0.5],
         };
-        let (a, b, l) = (car.cg_to_front(), car.cg_to_rear(), car.wheelbase);
+        let l = car.wheelbase;
         let tyres = [
             TyreModel::new(&car.front_tyre),
             TyreModel::new(&car.rear_tyre),
@@ -212,7 +210,7 @@ impl Vehicle {
                 tyres[0].peak_slip * AID_SLIP_RATIO,
                 tyres[1].peak_slip * AID_SLIP_RATIO,
             ],
-            static_load: [car.mass * G * b / l, car.mass * G * a / l],
+            static_load: car.static_axle_loads(),
             transfer_per_accel: car.mass * car.axles.pitch_height / l,
             roll_share: {
                 let (y, k) = (car.axles.half_track, car.axles.roll_rate);
