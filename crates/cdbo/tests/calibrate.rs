@@ -64,15 +64,17 @@ fn the_fit_recovers_known_scales_from_its_own_laps() {
 }
 
 /// All six scales of car1-trb1 perturbed at once, fitted on Forza and E-Track 2 (150
-/// evaluations, the coarse scan first): the cost falls more than tenfold, grip, drag and the
-/// launch come within 3-5 % and the downforce within 20 % (measured: grip 0.9153 / 0.93, drag
-/// 1.0765 / 1.1, launch 0.7786 / 0.8, downforce 0.914 / 0.8, cost 1.066 → 0.0463, 23-fold;
-/// peak slip 1.281 / 1.2 and rolling 1.277 / 1.5 only printed: drag and rolling resistance
-/// partly trade against each other, and so do grip, its peak slip and the downforce). Since
-/// the fast probe is closed loop (the profile hold at k = 0.8 on Forza, 0.7 on E-Track 2) the
-/// truth's car completes it as the stock car does; as an open-loop pedal table it stalled on
-/// E-Track 2 under the truth's drag and rolling scales, a cliff in the cost that COBYLA
-/// stopped at (grip 0.901, drag 1.114, launch 1.01, downforce 1.03; cost 2.16 → 0.87).
+/// evaluations, the coarse scan first): the cost falls more than tenfold, grip and drag come
+/// within 3 %, the launch within 10 % and the downforce within 20 % (measured: grip 0.9091 /
+/// 0.93, drag 1.0706 / 1.1, launch 0.8074 / 0.8, downforce 0.940 / 0.8, cost 0.970 → 0.0490,
+/// 19.8-fold; peak slip 1.241 / 1.2 and rolling 1.245 / 1.5 only printed: drag and rolling
+/// resistance partly trade against each other, and so do grip, its peak slip and the
+/// downforce). Since the fast probe is closed loop (the profile hold at k = 0.8 on Forza, 0.7
+/// on E-Track 2) the truth's car completes it as the stock car does; as an open-loop pedal
+/// table it stalled on E-Track 2 under the truth's drag and rolling scales, a cliff in the
+/// cost that COBYLA stopped at (grip 0.901, drag 1.114, launch 1.01, downforce 1.03; cost
+/// 2.16 → 0.87). E-Track 2 has no 20 m/s speed hold (the derated car leaves the road in its
+/// hairpin).
 #[test]
 #[ignore = "slow: a minute or more of simulator laps"]
 fn the_fit_recovers_all_six_scales_on_two_tracks() {
@@ -94,15 +96,15 @@ fn the_fit_recovers_all_six_scales_on_two_tracks() {
         .iter()
         .map(|t| observed_with(&common::shared_track(t), &base, &truth))
         .collect();
-    // From the stock car, with the coarse scan (without it, measured: launch 0.980, downforce
-    // 0.943, cost 0.098).
+    // From the stock car, with the coarse scan (without it, with E-Track 2's 20 m/s hold,
+    // measured: launch 0.980, downforce 0.943, cost 0.098).
     let fit = calibrate::fit(&base, &observed, &FitConfig::default()).unwrap();
     eprintln!("truth {truth:?}\nfit {fit:?}");
     assert!(fit.cost < 0.1 * fit.cost_start, "{fit:?}");
     let tolerances = [
         ("grip", 0.03),
         ("drag", 0.03),
-        ("launch", 0.05),
+        ("launch", 0.1),
         ("downforce", 0.2),
     ];
     for (name, tolerance) in tolerances {

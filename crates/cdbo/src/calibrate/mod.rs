@@ -4,7 +4,9 @@
 //! 1. **Probes** ([`probes`]): a small set of laps, each chosen so that some scale shows in
 //!    it. The PI speed hold at 10, 15 and 20 m/s: the pedal it needs to hold a speed is the
 //!    resistance at that speed (rolling at 10, drag at 20), and each pulls away from standing
-//!    (launch). A launch-and-brake table: full throttle from the start line to the first
+//!    (launch); each kept where its lap completes with the stock car and with [`FAST_MARGIN`]'s
+//!    (E-Track 2's 20 m/s hold slides wide in its hairpin, at the limit there, and a scale a
+//!    percent off moved its cost by a whole lap's). A launch-and-brake table: full throttle from the start line to the first
 //!    braking point of the QSS limit or [`LAUNCH_M`], full brake for [`BRAKE_M`], then
 //!    coasting, compared over [`COAST_M`] of it: the pull-away (launch), the speed at the end of
 //!    the straight (drag), an ABS stop at the tyre's longitudinal limit (grip and its peak
@@ -83,6 +85,10 @@ pub struct Sigma {
     /// Pedal command.
     pub pedal: f64,
 }
+
+/// The speeds of the speed-hold probes (m/s), each kept where its lap completes in cdbo's
+/// simulator with the stock car and with [`FAST_MARGIN`]'s.
+pub const DEMO_SPEEDS: [f64; 3] = [10.0, 15.0, 20.0];
 
 /// The speed-profile fraction of the fast probe, and the lower ones tried while its lap fails
 /// in cdbo's simulator with the stock car or with [`FAST_MARGIN`]'s.
@@ -173,13 +179,18 @@ impl Probe {
 /// The probes for `car` on `track` (module documentation): demos at 10, 15 and 20 m/s, the
 /// launch-and-brake table and the fast table.
 pub fn probes(track: &Track, car: &Car) -> Result<Vec<Probe>> {
-    let mut out: Vec<Probe> = [10.0, 15.0, 20.0]
+    let sim = Simulator::new(track.clone(), car);
+    let derated = Simulator::new(track.clone(), &FAST_MARGIN.apply(car));
+    let completes = |p: &Probe| p.drive(&sim).completed && p.drive(&derated).completed;
+    let mut out: Vec<Probe> = DEMO_SPEEDS
         .map(|v| Probe {
             name: format!("demo {v}"),
             pedal: ProbePedal::Demo(v),
             window: 1.0,
         })
-        .to_vec();
+        .into_iter()
+        .filter(completes)
+        .collect();
     let limit = crate::limit::limit_lap(track, car);
     let brake = first_braking_point(&limit.speed);
     let n = (limit.speed.len() - 1) as f64;
@@ -199,8 +210,6 @@ pub fn probes(track: &Track, car: &Car) -> Result<Vec<Probe>> {
         window: (xe + COAST_M / track.length).min(1.0),
     });
     let profile = crate::ceiling::profile(track, car, None);
-    let sim = Simulator::new(track.clone(), car);
-    let derated = Simulator::new(track.clone(), &FAST_MARGIN.apply(car));
     for k in FAST_PROFILE {
         let probe = Probe {
             name: format!("fast {k}"),
@@ -210,7 +219,7 @@ pub fn probes(track: &Track, car: &Car) -> Result<Vec<Probe>> {
             },
             window: 1.0,
         };
-        if probe.drive(&sim).completed && probe.drive(&derated).completed {
+        if completes(&probe) {
             out.push(probe);
             break;
         }
