@@ -65,16 +65,17 @@ fn the_fit_recovers_known_scales_from_its_own_laps() {
 
 /// All six scales of car1-trb1 perturbed at once, fitted on Forza and E-Track 2 (150
 /// evaluations, the coarse scan first): the cost falls more than tenfold, grip and drag come
-/// within 3 %, the launch within 10 % and the downforce within 20 % (measured: grip 0.9091 /
-/// 0.93, drag 1.0706 / 1.1, launch 0.8074 / 0.8, downforce 0.940 / 0.8, cost 0.970 → 0.0490,
-/// 19.8-fold; peak slip 1.241 / 1.2 and rolling 1.245 / 1.5 only printed: drag and rolling
-/// resistance partly trade against each other, and so do grip, its peak slip and the
-/// downforce). Since the fast probe is closed loop (the profile hold at k = 0.8 on Forza, 0.7
-/// on E-Track 2) the truth's car completes it as the stock car does; as an open-loop pedal
-/// table it stalled on E-Track 2 under the truth's drag and rolling scales, a cliff in the
-/// cost that COBYLA stopped at (grip 0.901, drag 1.114, launch 1.01, downforce 1.03; cost
-/// 2.16 → 0.87). E-Track 2 has no 20 m/s speed hold (the derated car leaves the road in its
-/// hairpin).
+/// within 3 %, the launch within 10 % and the downforce within 20 % (measured with each wheel
+/// on its own surface: grip 0.9201 / 0.93, drag 1.0900 / 1.1, launch 0.7455 / 0.8, downforce
+/// 0.936 / 0.8, cost 0.873 → 0.0590, 14.8-fold; the road's surface for all four wheels: grip
+/// 0.9091, drag 1.0706, launch 0.8074, downforce 0.940, cost 0.970 → 0.0490; peak slip and
+/// rolling resistance only printed: drag and rolling resistance partly trade against each
+/// other, and so do grip, its peak slip and the downforce). Since the fast probe is closed
+/// loop (the profile hold at k = 0.75 on Forza, 0.7 on E-Track 2) the truth's car completes
+/// it as the stock car does; as an open-loop pedal table it stalled on E-Track 2 under the
+/// truth's drag and rolling scales, a cliff in the cost that COBYLA stopped at (grip 0.901,
+/// drag 1.114, launch 1.01, downforce 1.03; cost 2.16 → 0.87). E-Track 2 has no 20 m/s speed
+/// hold (the derated car leaves the road in its hairpin).
 #[test]
 #[ignore = "slow: a minute or more of simulator laps"]
 fn the_fit_recovers_all_six_scales_on_two_tracks() {
