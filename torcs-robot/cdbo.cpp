@@ -8,7 +8,8 @@
  * 2 of the License, or (at your option) any later version. See COPYING.
  *
  * Throttle and brake follow a pedal a in [-1, 1] (a policy pi(x) of the lap fraction x, the
- * demonstrator's PI speed hold, or a constant); steering is cdbo's look-ahead PI law
+ * demonstrator's PI speed hold, the profile hold of the calibration's fast probe, or a
+ * constant); steering is cdbo's look-ahead PI law
  * (crates/cdbo/src/drive/steering.rs) or its path tracker (crates/cdbo/src/drive/tracker.rs),
  * either holding the path P(s) = c(s) + d(s) n(s) of a line d(s) metres left of the centre
  * line c(s) (n the left normal; the centre line itself unless the settings give a line); the gear is chosen by cdbo's automatic gearbox
@@ -25,6 +26,10 @@
  *   output PATH                  the JSON line goes here (appended)
  *   trace PATH                   optional: every driver step (50 Hz) as CSV
  *   pedal demo V | pedal constant A | pedal rkhs L W1 ... WM | pedal table X1 A1 X2 A2 ...
+ *     | pedal profile K L V0 ... VN   the profile hold (drive::profile_hold): k times the
+ *                                speeds V0 ... VN (m/s) at N + 1 >= 2 stations spaced evenly
+ *                                over a lap of L m (the first on the start line, the last at
+ *                                the finish), linear in between
  *   wheelbase L                  (m), the steering gain's L
  *   line L D1 ... DN             optional: the line both steerings hold, offsets (m, positive
  *                                left of the centre line) at the N >= 2 stations (j - 1) L / N
@@ -236,13 +241,14 @@ bool read_settings(const std::string &path, Settings *s, std::string *error) {
     bool pedal_ok = (p == "demo" && s->pedal_args.size() == 1 && s->pedal_args[0] > 0) ||
                     (p == "constant" && s->pedal_args.size() == 1) ||
                     (p == "rkhs" && s->pedal_args.size() >= 3 && s->pedal_args[0] > 0) ||
-                    (p == "table" && s->pedal_args.size() >= 2 && s->pedal_args.size() % 2 == 0);
+                    (p == "table" && s->pedal_args.size() >= 2 && s->pedal_args.size() % 2 == 0) ||
+                    (p == "profile" && s->pedal_args.size() >= 4 && s->pedal_args[1] > 0);
     for (size_t i = 2; pedal_ok && p == "table" && i < s->pedal_args.size(); i += 2) {
         pedal_ok = s->pedal_args[i] > s->pedal_args[i - 2];
     }
     if (!pedal_ok) {
-        *error = path + ": pedal must be 'demo V', 'constant A', 'rkhs L W1 W2 ...' or "
-                        "'table X1 A1 ...' with x increasing";
+        *error = path + ": pedal must be 'demo V', 'constant A', 'rkhs L W1 W2 ...', "
+                        "'table X1 A1 ...' with x increasing or 'profile K L V0 V1 ...' with L > 0";
         return false;
     }
     return true;
@@ -256,6 +262,8 @@ double pedal(double x, double speed, double dt) {
         v = drive::speed_hold(a[0], speed, dt, lap.demo_integral);
     } else if (lap.cfg.pedal == "constant") {
         v = a[0];
+    } else if (lap.cfg.pedal == "profile") {
+        v = drive::profile_hold(a.data() + 2, a.size() - 3, a[1], a[0], x, speed);
     } else if (lap.cfg.pedal == "rkhs") {
         v = drive::rkhs_raw(a.data() + 1, a.size() - 1, a[0], x);
     } else {

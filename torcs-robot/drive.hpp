@@ -8,8 +8,8 @@
  * 2 of the License, or (at your option) any later version. See COPYING.
  *
  * Everything the robot (cdbo.cpp) decides from numbers it has gathered: the pedal (the policy
- * pi(x), the demonstrator's speed hold), the line it holds, the steering laws (the PI law and
- * the path tracker), the gearbox, the launch clutch and the traction control.
+ * pi(x), the demonstrator's speed hold, the profile hold), the line it holds, the steering laws
+ * (the PI law and the path tracker), the gearbox, the launch clutch and the traction control.
  * No TORCS header is needed: cdbo.cpp reads the game's car and track and calls these, and
  * crates/cdbo/tests/robot_drive.rs compiles this header alone into a harness
  * (tests/harness.cpp) and checks each function against its Rust definition, named on each,
@@ -84,6 +84,42 @@ constexpr double kSpeedHoldKi = 0.1;
 /// PI control of the speed error with limit 1.
 inline double speed_hold(double target, double speed, double dt, double &integral) {
     return pi_control(kSpeedHoldKp, kSpeedHoldKi, 1.0, integral, target - speed, dt);
+}
+
+/// The profile hold's gain (per m/s), preview (s) and floor (m/s) (drive/profile.rs, the
+/// ceiling's tracker constants ceiling.rs TRACKER_GAIN, PREVIEW_S, TRACKER_FLOOR_MPS).
+constexpr double kProfileGain = 1.0;
+constexpr double kProfilePreview = 0.3;
+constexpr double kProfileFloor = 10.0;
+
+/// v(u) of a profile of n + 1 >= 2 values, linear between them, u in [0, n]
+/// (drive/profile.rs ProfileHold::at).
+inline double profile_at(const double *profile, std::size_t n, double u) {
+    std::size_t j = std::min(std::size_t(std::floor(u)), n - 1);
+    return profile[j] + (profile[j + 1] - profile[j]) * (u - double(j));
+}
+
+/// The profile hold's target (drive/profile.rs ProfileHold::target): k times the minimum of
+/// the profile of n + 1 >= 2 values (linear between them, spaced evenly over a lap of
+/// `length` m) over the lap fractions [x, x + speed kProfilePreview / length], each clamped to
+/// [0, 1], at least kProfileFloor.
+inline double profile_target(const double *profile, std::size_t n, double length, double k,
+                             double x, double speed) {
+    double nn = double(n);
+    double u0 = clamp(x, 0.0, 1.0) * nn;
+    double u1 = clamp(x + speed * kProfilePreview / length, 0.0, 1.0) * nn;
+    double v = std::fmin(profile_at(profile, n, u0), profile_at(profile, n, u1));
+    for (std::size_t i = std::size_t(std::floor(u0)) + 1; double(i) < u1; i++) {
+        v = std::fmin(v, profile[i]);
+    }
+    return std::fmax(k * v, kProfileFloor);
+}
+
+/// The profile hold's pedal (drive/profile.rs ProfileHold::pedal):
+/// clamp(kProfileGain (target - speed), -1, 1).
+inline double profile_hold(const double *profile, std::size_t n, double length, double k, double x,
+                           double speed) {
+    return clamp(kProfileGain * (profile_target(profile, n, length, k, x, speed) - speed), -1.0, 1.0);
 }
 
 /// The pedal command a driver step uses (sim/lap.rs Simulator::lap): the pedal's value held

@@ -49,6 +49,8 @@ using Case = std::function<std::vector<double>(Args &)>;
 /// The line's table periodic_linear reads (set by line_table; a table is long, the calls many).
 std::vector<double> line_values;
 double line_period = 0.0;
+/// The speed profile profile_hold reads (set by profile_table).
+std::vector<double> profile_values;
 
 /// Each function of drive.hpp: its inputs as read, its outputs (then updated state) as printed.
 const std::map<std::string, Case> kCases = {
@@ -64,6 +66,28 @@ const std::map<std::string, Case> kCases = {
          std::size_t n = a.count();
          std::vector<double> xa = a.list(2 * n);
          return std::vector<double>{drive::table_action(xa.data(), n, a.num())};
+     }},
+    {"profile_constants",  // -> kProfileGain kProfilePreview kProfileFloor
+     [](Args &) {
+         return std::vector<double>{drive::kProfileGain, drive::kProfilePreview,
+                                    drive::kProfileFloor};
+     }},
+    {"profile_table",  // N V0..VN -> N: the profile profile_hold reads from now on
+     [](Args &a) {
+         std::size_t n = a.count();
+         std::vector<double> v = a.list(n + 1);
+         if (a.short_line || n < 1) return std::vector<double>{};
+         profile_values = v;
+         return std::vector<double>{double(n)};
+     }},
+    {"profile_hold",  // K L X SPEED -> target a, of the last profile_table
+     [](Args &a) {
+         double k = a.num(), length = a.num(), x = a.num(), speed = a.num();
+         if (profile_values.size() < 2) return std::vector<double>{};
+         const double *v = profile_values.data();
+         std::size_t n = profile_values.size() - 1;
+         return std::vector<double>{drive::profile_target(v, n, length, k, x, speed),
+                                    drive::profile_hold(v, n, length, k, x, speed)};
      }},
     {"pedal_command",  // V -> a
      [](Args &a) { return std::vector<double>{drive::pedal_command(a.num())}; }},

@@ -31,11 +31,12 @@ fn observed_with(track: &Track, base: &Car, truth: &Scales) -> TrackLaps {
 }
 
 /// Grip 15 % down and the launch 15 % up on the Spirit 300 round Ridgeway: the fit of those
-/// two from the stock car, on all five probes, finds both within 2 % (0.8505 and 1.139), and
-/// its cost falls some hundredfold (99-fold since the rear wheels turn each on its own,
-/// 2.99 to 0.0303); the same fit again gives the same scales to the bit. (On the
-/// launch-and-brake and the fast probes alone, since the road's vertical curvature loads the
-/// car, it stops at a launch of 1.18.)
+/// two from the stock car, on all five probes, finds both within 2 % (0.8506 and 1.131), and
+/// its cost falls some two-thousandfold (1.87 to 0.00086, since the fast probe is closed loop
+/// and the residuals are means over each station's 10 m; 99-fold before, 2.99 to 0.0303); the
+/// same fit again gives the same scales to the bit. (On the launch-and-brake and the open-loop
+/// fast probe alone, since the road's vertical curvature loads the car, it stopped at a launch
+/// of 1.18.)
 #[test]
 fn the_fit_recovers_known_scales_from_its_own_laps() {
     let track = common::builtin("ridgeway");
@@ -55,21 +56,26 @@ fn the_fit_recovers_known_scales_from_its_own_laps() {
         ..FitConfig::default()
     };
     let fit = calibrate::fit(&base, &observed, &config).unwrap();
-    assert!(fit.cost < 0.015 * fit.cost_start, "{fit:?}");
+    eprintln!("{fit:?}");
+    assert!(fit.cost < 0.005 * fit.cost_start, "{fit:?}");
     assert!((fit.scales.grip / 0.85 - 1.0).abs() < 0.02, "{fit:?}");
     assert!((fit.scales.launch / 1.15 - 1.0).abs() < 0.02, "{fit:?}");
     assert_eq!(calibrate::fit(&base, &observed, &config).unwrap(), fit);
 }
 
 /// All six scales of car1-trb1 perturbed at once, fitted on Forza and E-Track 2 (150
-/// evaluations, no coarse scan): the cost falls by more than half, and grip and drag come
-/// within 5 % (measured with the two-track car: 0.901 / 0.93, 1.114 / 1.1, cost 0.87 of
-/// 2.16). The launch, downforce, peak slip and rolling resistance are only printed: with the
-/// single-track car the launch and downforce came within 10 % (0.848 / 0.8, 0.852 / 0.8) and
-/// the cost fell tenfold, but since the car is simuv2's (heavier with its fuel, two rear
-/// wheels) E-Track 2's fast probe, an open-loop pedal table, stalls under the truth's drag and
-/// rolling scales: a cliff in the cost that COBYLA stops at (launch 1.01, downforce 1.03).
-/// The probes need a closed loop (docs/results/torcs.md, issue 34).
+/// evaluations, the coarse scan first): the cost falls more than tenfold, grip and drag come
+/// within 3 %, the launch within 10 % and the downforce within 20 % (measured with each wheel
+/// on its own surface: grip 0.9201 / 0.93, drag 1.0900 / 1.1, launch 0.7455 / 0.8, downforce
+/// 0.936 / 0.8, cost 0.873 → 0.0590, 14.8-fold; the road's surface for all four wheels: grip
+/// 0.9091, drag 1.0706, launch 0.8074, downforce 0.940, cost 0.970 → 0.0490; peak slip and
+/// rolling resistance only printed: drag and rolling resistance partly trade against each
+/// other, and so do grip, its peak slip and the downforce). Since the fast probe is closed
+/// loop (the profile hold at k = 0.75 on Forza, 0.7 on E-Track 2) the truth's car completes
+/// it as the stock car does; as an open-loop pedal table it stalled on E-Track 2 under the
+/// truth's drag and rolling scales, a cliff in the cost that COBYLA stopped at (grip 0.901,
+/// drag 1.114, launch 1.01, downforce 1.03; cost 2.16 → 0.87). E-Track 2 has no 20 m/s speed
+/// hold (the derated car leaves the road in its hairpin).
 #[test]
 #[ignore = "slow: a minute or more of simulator laps"]
 fn the_fit_recovers_all_six_scales_on_two_tracks() {
@@ -91,17 +97,18 @@ fn the_fit_recovers_all_six_scales_on_two_tracks() {
         .iter()
         .map(|t| observed_with(&common::shared_track(t), &base, &truth))
         .collect();
-    // From the stock car without the coarse scan: since the road's crests load the car, the
-    // scan's best point leads COBYLA to a poorer optimum here (cost 0.35 of 1.54, only the
-    // grip recovered).
-    let config = FitConfig {
-        scan: false,
-        ..FitConfig::default()
-    };
-    let fit = calibrate::fit(&base, &observed, &config).unwrap();
+    // From the stock car, with the coarse scan (without it, with E-Track 2's 20 m/s hold,
+    // measured: launch 0.980, downforce 0.943, cost 0.098).
+    let fit = calibrate::fit(&base, &observed, &FitConfig::default()).unwrap();
     eprintln!("truth {truth:?}\nfit {fit:?}");
-    assert!(fit.cost < 0.5 * fit.cost_start, "{fit:?}");
-    for (name, tolerance) in [("grip", 0.05), ("drag", 0.05)] {
+    assert!(fit.cost < 0.1 * fit.cost_start, "{fit:?}");
+    let tolerances = [
+        ("grip", 0.03),
+        ("drag", 0.03),
+        ("launch", 0.1),
+        ("downforce", 0.2),
+    ];
+    for (name, tolerance) in tolerances {
         let i = Scales::index(name).unwrap();
         let ratio = fit.scales.get(i) / truth.get(i);
         assert!((ratio - 1.0).abs() < tolerance, "{name}: {fit:?}");
@@ -185,11 +192,12 @@ fn in_the_game_the_fit_brings_the_laps_closer() {
         .into_iter()
         .map(|p| {
             let req = cdbo::torcs::LapRequest {
-                pedal: p.game_pedal(),
+                pedal: p.game_pedal(track.length),
                 ..req.clone()
             };
             let lap = cdbo::torcs::evaluator::drive(&game, &req).unwrap();
             assert!(!lap.trace.is_empty(), "{}: no trace", p.name);
+            eprintln!("{}: {:?} {:?}", p.name, lap.lap_time_s, lap.failure);
             Observed::of_lap(p, &lap)
         })
         .collect();
@@ -202,5 +210,6 @@ fn in_the_game_the_fit_brings_the_laps_closer() {
         ..FitConfig::default()
     };
     let fit = calibrate::fit(&req.car, &observed, &config).unwrap();
+    eprintln!("{fit:?}");
     assert!(fit.cost < 0.9 * fit.cost_start, "{fit:?}");
 }

@@ -230,7 +230,7 @@ fn in_game(
             .into_par_iter()
             .map(|p| {
                 let req = cdbo::torcs::LapRequest {
-                    pedal: p.game_pedal(),
+                    pedal: p.game_pedal(track.length),
                     ..req.clone()
                 };
                 let lap = cdbo::torcs::evaluator::drive(game, &req)?;

@@ -4,23 +4,40 @@
 //! 1. **Probes** ([`probes`]): a small set of laps, each chosen so that some scale shows in
 //!    it. The PI speed hold at 10, 15 and 20 m/s: the pedal it needs to hold a speed is the
 //!    resistance at that speed (rolling at 10, drag at 20), and each pulls away from standing
-//!    (launch). A launch-and-brake table: full throttle from the start line to the first
+//!    (launch); each kept where its lap completes with the stock car and with [`FAST_MARGIN`]'s
+//!    (E-Track 2's 20 m/s hold slides wide in its hairpin, at the limit there, and a scale a
+//!    percent off moved its cost by a whole lap's). A launch-and-brake table: full throttle from the start line to the first
 //!    braking point of the QSS limit or [`LAUNCH_M`], full brake for [`BRAKE_M`], then
 //!    coasting, compared over [`COAST_M`] of it: the pull-away (launch), the speed at the end of
 //!    the straight (drag), an ABS stop at the tyre's longitudinal limit (grip and its peak
-//!    slip, where ABS works), and the coast-down (rolling resistance and drag). A fast table: the pedal of cdbo's own lap tracking 0.8× the limit's
-//!    speed profile (as the ceiling does; at most [`TABLE_POINTS`] of its driver steps),
-//!    replayed open loop like a learned policy: the
-//!    corners near the grip limit, where the steering's lateral offset and the yaw rate show
-//!    the tyre's grip, its shape and the downforce at speed.
+//!    slip, where ABS works), and the coast-down (rolling resistance and drag); the pedal
+//!    ramps over [`RAMP_M`] between its levels, so that where a driver step falls on a ramp
+//!    moves the lap a little, not by a whole step of the pedal. A fast lap, closed loop: the
+//!    profile hold ([`ProfileHold`](crate::drive::profile::ProfileHold)) following k times the
+//!    stock car's crest-aware limit profile v(s) ([`crate::ceiling::profile`]),
+//!    a = clamp(K_p·(max(k·min_{s ≤ s′ ≤ s + v·τ} v(s′), v_min) − v), −1, 1) with the
+//!    ceiling's K_p = 1 per m/s, τ = 0.3 s and v_min = 10 m/s, v(s) linear between the
+//!    profile's 1 m stations; k the first of [`FAST_PROFILE`] (0.8, 0.75, …) whose lap
+//!    completes with the stock car and with [`FAST_MARGIN`]'s less grippy one. The corners
+//!    near the grip limit: the steering's lateral offset and the yaw rate show the tyre's grip,
+//!    its shape and the downforce at speed, and the pedal the car needs to hold the profile
+//!    its drag. The same law drives every car, the game's robot too (`pedal profile`,
+//!    `torcs-robot/drive.hpp`), so that a car with more drag or less grip still completes the
+//!    lap, slower: an open-loop replay of the stock car's pedal stalls or leaves the road
+//!    instead, a cliff in the cost.
 //! 2. **Residuals** ([`compare`]): at stations every [`STATION_M`] m along the lap, up to the
 //!    probe's window, the differences in speed, lateral offset, yaw rate and (for the closed-
-//!    loop speed hold; a table's pedal is the same in both) pedal between the observed lap and
-//!    cdbo's lap of the same probe, each divided by its scale ([`SIGMA`]); a
-//!    station that only one of the two laps reached (one failed or stopped earlier) counts
-//!    as a residual of [`MISSING`]: bounded, so that a lap that leaves the road does not
-//!    swamp the rest, and growing with the distance the two laps disagree over. A lap's cost
-//!    is the mean square over its stations; the total is the mean over laps.
+//!    loop probes, the speed holds and the profile hold; a table's pedal is the same in both)
+//!    pedal between the observed lap and cdbo's lap of the same probe, each the mean over the
+//!    [`STATION_M`] before the station (the samples linear in distance in between: a pedal
+//!    that moves within a driver step, read at a station, would change with where the steps
+//!    fall) and divided by its scale ([`SIGMA`]); a station that only one of the two laps
+//!    reached (the other failed or stopped earlier; a completed lap reached every station to
+//!    the finish) counts as the speed there of the lap that reached it, in σ, at most
+//!    [`MISSING`]: bounded, so that a lap that leaves the road does not swamp the rest, growing
+//!    with the distance the two laps disagree over, and small where the other lap was about to
+//!    stop too. A lap's cost is the mean square over its stations; the total is the mean over
+//!    laps.
 //! 3. **Fit** ([`fit`]): first a coarse scan, one free scale at a time over [`SCAN_POINTS`]
 //!    log-spaced values of its bounds (a scale can be masked near 1: a launch torque scale
 //!    changes nothing while traction control caps the drive), then COBYLA (derivative-free;
@@ -33,7 +50,6 @@ pub mod log;
 use serde::Serialize;
 
 use crate::car::{Car, Scales};
-use crate::ceiling::ProfileTracker;
 use crate::drive::demo::SpeedHold;
 use crate::error::{Error, Result};
 use crate::policy::PolicyTable;
@@ -70,9 +86,22 @@ pub struct Sigma {
     pub pedal: f64,
 }
 
-/// The speed-profile fraction of the fast probe, and the lower ones tried if its lap fails
-/// in cdbo's simulator with the stock car.
-pub const FAST_PROFILE: [f64; 3] = [0.8, 0.7, 0.6];
+/// The speeds of the speed-hold probes (m/s), each kept where its lap completes in cdbo's
+/// simulator with the stock car and with [`FAST_MARGIN`]'s.
+pub const DEMO_SPEEDS: [f64; 3] = [10.0, 15.0, 20.0];
+
+/// The speed-profile fraction of the fast probe, and the lower ones tried while its lap fails
+/// in cdbo's simulator with the stock car or with [`FAST_MARGIN`]'s.
+pub const FAST_PROFILE: [f64; 5] = [0.8, 0.75, 0.7, 0.65, 0.6];
+
+/// The scales of the car the fast probe must complete with besides the stock one: a car this
+/// much less grippy (than the base) still finishes the lap, so that the fit meets no cliff
+/// near the truth.
+pub const FAST_MARGIN: Scales = Scales {
+    grip: 0.85,
+    downforce: 0.7,
+    ..Scales::ONE
+};
 
 /// The launch-and-brake probe's full throttle ends at the limit's first braking point or
 /// after this distance (m), whichever comes first: early enough that the car stays on the
@@ -84,18 +113,26 @@ pub const LAUNCH_M: f64 = 400.0;
 pub const BRAKE_M: f64 = 50.0;
 /// ... and it is compared up to this distance (m) past the end of the brake: the coast-down.
 pub const COAST_M: f64 = 300.0;
-/// The residual (in σ of speed) of a station only one of the two laps reached.
+/// The largest residual (in σ of speed) of a station only one of the two laps reached.
 pub const MISSING: f64 = 3.0;
-
-/// Points of the fast probe's table at most: its lap's pedal at every n-th driver step, so
-/// that the table fits the robot's settings line (64 KiB).
-pub const TABLE_POINTS: usize = 800;
+/// The launch-and-brake table's pedal ramps between full throttle, full brake and coasting
+/// over this distance (m).
+pub const RAMP_M: f64 = 10.0;
 
 /// What a probe's pedal follows.
 #[derive(Debug, Clone, PartialEq)]
 pub enum ProbePedal {
     /// The PI speed hold at this speed (m/s): closed loop, the game's robot drives the same law.
     Demo(f64),
+    /// The profile tracker ([`ProfileTracker`]) following k times a speed profile: closed
+    /// loop, the game's robot drives the same law.
+    Profile {
+        /// The scale k.
+        k: f64,
+        /// The speed profile (m/s) at the track's samples, plus the finish: the stock car's
+        /// limit, the same for every car driven.
+        speed: Vec<f64>,
+    },
     /// A pedal over the lap fraction, open loop.
     Table(PolicyTable),
 }
@@ -116,14 +153,24 @@ impl Probe {
     pub fn drive(&self, sim: &Simulator) -> LapResult {
         match &self.pedal {
             ProbePedal::Demo(v) => sim.lap(&mut SpeedHold::new(*v)),
+            ProbePedal::Profile { k, speed } => sim.lap(&mut crate::drive::profile::ProfileHold {
+                profile: speed,
+                length: sim.track.length,
+                k: *k,
+            }),
             ProbePedal::Table(t) => sim.lap(&mut t.clone()),
         }
     }
 
-    /// Its pedal for the game's robot.
-    pub fn game_pedal(&self) -> crate::torcs::GamePedal {
+    /// Its pedal for the game's robot on a track of `length` metres as cdbo reads it.
+    pub fn game_pedal(&self, length: f64) -> crate::torcs::GamePedal {
         match &self.pedal {
             ProbePedal::Demo(v) => crate::torcs::GamePedal::Demo(*v),
+            ProbePedal::Profile { k, speed } => crate::torcs::GamePedal::Profile {
+                k: *k,
+                length,
+                speed: speed.clone(),
+            },
             ProbePedal::Table(t) => crate::torcs::GamePedal::Table(t.points().to_vec()),
         }
     }
@@ -132,44 +179,48 @@ impl Probe {
 /// The probes for `car` on `track` (module documentation): demos at 10, 15 and 20 m/s, the
 /// launch-and-brake table and the fast table.
 pub fn probes(track: &Track, car: &Car) -> Result<Vec<Probe>> {
-    let mut out: Vec<Probe> = [10.0, 15.0, 20.0]
+    let sim = Simulator::new(track.clone(), car);
+    let derated = Simulator::new(track.clone(), &FAST_MARGIN.apply(car));
+    let completes = |p: &Probe| p.drive(&sim).completed && p.drive(&derated).completed;
+    let mut out: Vec<Probe> = DEMO_SPEEDS
         .map(|v| Probe {
             name: format!("demo {v}"),
             pedal: ProbePedal::Demo(v),
             window: 1.0,
         })
-        .to_vec();
+        .into_iter()
+        .filter(completes)
+        .collect();
     let limit = crate::limit::limit_lap(track, car);
     let brake = first_braking_point(&limit.speed);
     let n = (limit.speed.len() - 1) as f64;
     let xb = (brake as f64 / n).min(LAUNCH_M / track.length);
-    let xe = (xb + BRAKE_M / track.length).min(1.0 - 1e-3);
-    let eps = 1e-4;
+    let ramp = RAMP_M / track.length;
+    let xe = (xb + BRAKE_M / track.length).min(1.0 - 1e-3 - ramp);
     let table = PolicyTable::new(vec![
         (0.0, 1.0),
         (xb, 1.0),
-        (xb + eps, -1.0),
+        (xb + ramp, -1.0),
         (xe, -1.0),
-        (xe + eps, 0.0),
+        (xe + ramp, 0.0),
     ])?;
     out.push(Probe {
         name: "launch-brake".into(),
         pedal: ProbePedal::Table(table),
         window: (xe + COAST_M / track.length).min(1.0),
     });
-    let mut sim = Simulator::new(track.clone(), car);
-    sim.config.trace = true;
+    let profile = crate::ceiling::profile(track, car, None);
     for k in FAST_PROFILE {
-        let lap = sim.lap(&mut ProfileTracker::new(&limit, track.length, k));
-        let every = lap.trace.len().div_ceil(TABLE_POINTS).max(1);
-        let points = strictly_increasing(lap.trace.iter().step_by(every).map(|p| (p.x, p.pedal)));
-        let table = PolicyTable::new(points)?;
-        if lap.completed && sim.lap(&mut table.clone()).completed {
-            out.push(Probe {
-                name: format!("fast {k}"),
-                pedal: ProbePedal::Table(table),
-                window: 1.0,
-            });
+        let probe = Probe {
+            name: format!("fast {k}"),
+            pedal: ProbePedal::Profile {
+                k,
+                speed: profile.speed.clone(),
+            },
+            window: 1.0,
+        };
+        if completes(&probe) {
+            out.push(probe);
             break;
         }
     }
@@ -182,17 +233,6 @@ fn first_braking_point(speed: &[f64]) -> usize {
         .find(|&i| speed[i] < speed[i - 1])
         .unwrap_or(speed.len().max(1) - 1)
         .saturating_sub(1)
-}
-
-/// Points with strictly increasing x (a later point at the same x is dropped).
-fn strictly_increasing(points: impl Iterator<Item = (f64, f64)>) -> Vec<(f64, f64)> {
-    let mut out: Vec<(f64, f64)> = Vec::new();
-    for (x, a) in points {
-        if out.last().is_none_or(|&(last, _)| x > last) {
-            out.push((x, a));
-        }
-    }
-    out
 }
 
 /// One observed lap of a probe.
@@ -297,6 +337,44 @@ impl<'a> Reader<'a> {
         Reader { samples, i: 0, end }
     }
 
+    /// The mean of (speed, lateral, yaw rate, pedal) over [s − STATION_M, s], the samples
+    /// linear in distance in between, if the lap reached s.
+    fn mean(&mut self, s: f64) -> Option<[f64; 4]> {
+        let p = self.samples;
+        if p.is_empty() || s > self.end {
+            return None;
+        }
+        let lo = (s - STATION_M).max(p[0].distance_m);
+        if s <= lo || p.len() < 2 {
+            return self.at(s);
+        }
+        let v = |q: &Sample| [q.speed, q.lateral, q.yaw_rate, q.pedal];
+        while self.i + 1 < p.len() && p[self.i + 1].distance_m < lo {
+            self.i += 1;
+        }
+        let mut sum = [0.0; 4];
+        let mut covered = 0.0;
+        let mut j = self.i;
+        while j + 1 < p.len() && p[j].distance_m < s {
+            let (a, b) = (&p[j], &p[j + 1]);
+            let (d0, d1) = (a.distance_m.max(lo), b.distance_m.min(s));
+            let span = b.distance_m - a.distance_m;
+            if d1 > d0 && span > 0.0 {
+                let (va, vb) = (v(a), v(b));
+                let f = |d: f64, k: usize| va[k] + (vb[k] - va[k]) * (d - a.distance_m) / span;
+                for (k, total) in sum.iter_mut().enumerate() {
+                    *total += 0.5 * (f(d0, k) + f(d1, k)) * (d1 - d0);
+                }
+                covered += d1 - d0;
+            }
+            j += 1;
+        }
+        if covered <= 0.0 {
+            return self.at(s);
+        }
+        Some(sum.map(|x| x / covered))
+    }
+
     /// (speed, lateral, yaw rate, pedal) at station `s`, if the lap reached it.
     fn at(&mut self, s: f64) -> Option<[f64; 4]> {
         let p = self.samples;
@@ -330,25 +408,34 @@ pub fn compare(obs: &Observed, sim: &LapResult, length: f64) -> LapComparison {
     let ours: Vec<Sample> = sim.trace.iter().map(sample).collect();
     let (mut a, mut b) = (Reader::new(&obs.samples), Reader::new(&ours));
     let window = obs.probe.window * length;
+    // A completed lap reached every station up to the finish, its last sample or not.
+    if obs.completed {
+        a.end = a.end.max(window);
+    }
+    if sim.completed {
+        b.end = b.end.max(window);
+    }
     let sg = SIGMA;
     // An open-loop table's pedal is the same in both laps: only where the steps fall between
     // two driver steps differs, which says nothing about the car.
     let pedal_weight = match obs.probe.pedal {
         ProbePedal::Demo(_) => 1.0 / sg.pedal,
+        ProbePedal::Profile { .. } => 1.0 / sg.pedal,
         ProbePedal::Table(_) => 0.0,
     };
     let (mut sum, mut speed_sq, mut stations, mut one_sided) = (0.0, 0.0, 0usize, 0usize);
     let mut s = 0.0;
     while s <= window {
-        let r = match (a.at(s), b.at(s)) {
+        let r = match (a.mean(s), b.mean(s)) {
             (Some(o), Some(c)) => Some([
                 (c[0] - o[0]) / sg.speed,
                 (c[1] - o[1]) / sg.lateral,
                 (c[2] - o[2]) / sg.yaw_rate,
                 (c[3] - o[3]) * pedal_weight,
             ]),
-            (Some(_), None) | (None, Some(_)) => {
-                sum += MISSING * MISSING;
+            (Some(o), None) | (None, Some(o)) => {
+                let m = (o[0].abs() / sg.speed).min(MISSING);
+                sum += m * m;
                 one_sided += 1;
                 None
             }
@@ -612,9 +699,5 @@ mod tests {
         let v = [0.0, 10.0, 20.0, 30.0, 25.0, 18.0, 18.0, 25.0];
         assert_eq!(first_braking_point(&v), 3);
         assert_eq!(first_braking_point(&[0.0, 1.0]), 0);
-        assert_eq!(
-            strictly_increasing([(0.0, 1.0), (0.0, 2.0), (0.5, 3.0)].into_iter()),
-            vec![(0.0, 1.0), (0.5, 3.0)]
-        );
     }
 }

@@ -7,6 +7,7 @@
 
 pub mod demo;
 pub mod geometry;
+pub mod profile;
 pub mod steering;
 pub mod tracker;
 

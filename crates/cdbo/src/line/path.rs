@@ -69,6 +69,7 @@ impl RacingLine {
                 width: c.width,
                 friction: c.friction,
                 rolling_resistance: c.rolling_resistance,
+                verges: c.verges,
             });
         }
         let z: Vec<f64> = samples.iter().map(|c| c.z).collect();

@@ -18,7 +18,10 @@
 //! - Wheel loads: each axle's inner wheel gives ΔF_a = M·κ_a·y_a/(2·Σ_b κ_b·y_b²) to its outer
 //!   one, M = Σ_a Fᵧ,a·h_rc,a the tyres' lateral forces at the roll centres (simuv2's
 //!   `car.cpp`; [`crate::car::Axles`]), lagged 70 ms.
-//! - Tyres: each wheel's budget F_z·μ·μ_r·λ(F_z) ([`super::tyre`]) under its own load. The
+//! - Tyres: each wheel's budget F_z·μ·μ_r·λ(F_z) ([`super::tyre`]) under its own load, μ_r
+//!   the friction of the surface under the wheel's centre: the road's, or past the road's
+//!   edge its border's or side's ([`crate::track::Verge`], [`Vehicle::wheel_surfaces`]), as
+//!   simuv2's `wheel.cpp` takes each wheel's segment's surface. The
 //!   front wheels share one spin; the inner one is steered by δ, the outer one by simuv2's
 //!   Ackermann angle (`steer.cpp`), tan δ_o = L·tan|δ|/(L + T·tan|δ|), T = y_f + y_r (at
 //!   δ = 0.15 rad, 0.013 rad less). The rear wheels' slips take each wheel's own velocity,
@@ -38,8 +41,9 @@
 //!   I_z ṙ = a(F_xf sin δ + F_yf cos δ) − b F_yr + y_r(F_x,rr − F_x,rl), with β the banking
 //!   and F_xr, F_yr the rear wheels' sums.
 //! - Drag F = 0.645·Cx·A·v², downforce Dᵢ = 0.645·Clᵢ·A·v², rolling resistance
-//!   F = c_rr·(F_zf + F_zr)·sgn vₓ, c_rr the road surface's where the track gives one (as
-//!   TORCS's simuv2 does), else the tyres'; a calibrated car ([`crate::car::calibration`])
+//!   F = Σᵢ c_rr,i·F_z,i·sgn vₓ, c_rr,i the surface's under wheel i where the track gives one
+//!   (as TORCS's simuv2 does, `wheel.cpp`: F_z·`kRollRes` of the wheel's segment), else the
+//!   tyres'; a calibrated car ([`crate::car::calibration`])
 //!   scales drag, downforce and c_rr, and the drive torque in first gear (its launch).
 //! - Brakes: T = p·share·A_piston·μ_pad·r_disc per wheel, with ABS easing the pressure while an
 //!   axle's slip exceeds half the tyre's peak slip; traction control eases the throttle
@@ -182,6 +186,8 @@ pub struct Vehicle {
     /// Load moved from each axle's inner wheel to its outer one per N·m of roll moment,
     /// κ_a·y_a/(2·Σ_b κ_b·y_b²) (1/m) ([`crate::car::Axles`]).
     roll_share: [f64; 2],
+    /// The farthest a wheel's centre is from the CG, √(max(a, b)² + max(y_f, y_r)²) (m).
+    reach: f64,
     /// Slip at which ABS and traction control start easing, per axle.
     aid_threshold: [f64; 2],
     /// 0.645·Cx·A (kg/m).
@@ -221,6 +227,10 @@ impl Vehicle {
                     [0.0; 2]
                 }
             },
+            reach: car
+                .cg_to_front()
+                .max(car.cg_to_rear())
+                .hypot(car.axles.half_track[0].max(car.axles.half_track[1])),
             drag_per_v2: car.drag(1.0),
             downforce_per_v2: match car.ride {
                 None => vec![car.downforce(1.0)],
@@ -345,6 +355,60 @@ impl Vehicle {
         );
     }
 
+    /// Each wheel's surface, front left, front right, rear left, rear right: its friction and
+    /// rolling resistance coefficient (the tyres' where the surface gives none); `None` while
+    /// all four stand on the road, as they do whenever the road has no verges of its own
+    /// ([`Frame::has_verges`]) or the car is more than its reach inside both edges.
+    ///
+    /// As simuv2's `wheel.cpp` (`SimWheelUpdateRide`: `RtTrackGlobal2Local` of the wheel's
+    /// position, then the segment's `surface->kFriction` and `kRollRes`), a wheel takes the
+    /// surface under its centre: at body coordinates (x_w, y_w) = (a, ±y_f), (−b, ±y_r), with
+    /// e = ψ − θ the car's heading against the road's, d = (X − Xᵢ, Y − Yᵢ) its position from the
+    /// frame's station and t, n the road's tangent and left normal there, the wheel lies
+    /// a = d·t + x_w·cos e − y_w·sin e along the road and l = d·n + x_w·sin e + y_w·cos e − κa²/2
+    /// to the left of the centre line (the projection's second-order arc correction,
+    /// [`crate::track::Track::project`]); past an edge by l − w/2 > 0 (or −l − w/2 on the
+    /// right) it is on that side's [`crate::track::Verge`], border then side.
+    #[inline]
+    fn wheel_surfaces(&self, s: &State, f: &Frame) -> Option<[(f64, f64); 4]> {
+        if !f.has_verges {
+            return None;
+        }
+        let (dx, dy) = (s.x - f.x, s.y - f.y);
+        let along = dx * f.cos_heading + dy * f.sin_heading;
+        let lateral = -dx * f.sin_heading + dy * f.cos_heading;
+        let far = along.abs() + self.reach;
+        if lateral.abs() + self.reach + 0.5 * f.curvature.abs() * far * far < f.half_width {
+            return None;
+        }
+        let (sy, cy) = s.yaw_sin_cos;
+        let (se, ce) = (
+            sy * f.cos_heading - cy * f.sin_heading,
+            cy * f.cos_heading + sy * f.sin_heading,
+        );
+        let road = (f.friction, f.rolling_resistance.unwrap_or(self.rolling));
+        let [yf, yr] = self.car.axles.half_track;
+        let wheels = [(self.a, yf), (self.a, -yf), (-self.b, yr), (-self.b, -yr)];
+        let mut out = [road; 4];
+        let mut off = false;
+        for (i, (xw, yw)) in wheels.into_iter().enumerate() {
+            let a = along + xw * ce - yw * se;
+            let l = lateral + xw * se + yw * ce - 0.5 * f.curvature * a * a;
+            let excess = l.abs() - f.half_width;
+            if excess > 0.0 {
+                let verge = &f.verges[if l > 0.0 { 0 } else { 1 }];
+                if let Some(surface) = verge.surface_at(excess) {
+                    out[i] = (
+                        surface.friction,
+                        surface.rolling_resistance.unwrap_or(self.rolling),
+                    );
+                    off = true;
+                }
+            }
+        }
+        off.then_some(out)
+    }
+
     fn driven_omega(&self, s: &State) -> f64 {
         self.driven[0] * s.omega[0] + self.driven[1] * rear_omega(s)
     }
@@ -376,6 +440,12 @@ impl Vehicle {
             ]
         };
         let (front_loads, rear_loads) = (wheel_loads(0), wheel_loads(1));
+        // Each wheel's surface: the road's, or a verge's past the road's edge.
+        let surfaces = self.wheel_surfaces(s, frame);
+        let friction = match &surfaces {
+            None => [frame.friction; 4],
+            Some(w) => w.map(|(f, _)| f),
+        };
 
         // Wheel-frame velocities of the front (steered) axle and the rear wheels, the left one
         // at y = +y_r (simuv2's `car.cpp`: vₓ − r·y).
@@ -464,7 +534,7 @@ impl Vehicle {
                 let vt = s.vx * cs + front_lat * sn;
                 let vl = -s.vx * sn + front_lat * cs;
                 let inv = 1.0 / vt.abs().max(SLIP_SPEED_FLOOR);
-                let fmax = tyre.wheel_max_force(front_loads[i], frame.friction);
+                let fmax = tyre.wheel_max_force(front_loads[i], friction[i]);
                 let sx = (s.omega[0] * r - vt) * inv;
                 (tyre.forces(sx, -vl * inv, fmax), fmax, inv)
             };
@@ -526,7 +596,7 @@ impl Vehicle {
                 inv_denom: inv_rear,
                 inv_axle,
             },
-            frame.friction,
+            [friction[2], friction[3]],
             dt,
         );
 
@@ -546,8 +616,17 @@ impl Vehicle {
         // Body forces and moments.
         // Rolling resistance opposes motion; sgn vₓ is smoothed over ±0.5 m/s for standing starts.
         // The road's coefficient where the track gives one (simuv2), else the tyres'.
+        // A wheel on a verge rolls against its surface's coefficient: Σᵢ c_rr,i·F_z,i, taken as
+        // the road's c_rr·(F_zf + F_zr) plus Σᵢ (c_rr,i − c_rr)·F_z,i.
         let c_rr = frame.rolling_resistance.unwrap_or(self.rolling) * self.rolling_scale;
-        let roll = c_rr * (fz[0] + fz[1]) * (s.vx / 0.5).clamp(-1.0, 1.0);
+        let mut rolling_force = c_rr * (fz[0] + fz[1]);
+        if let Some(w) = &surfaces {
+            let loads = [front_loads[0], front_loads[1], rear_loads[0], rear_loads[1]];
+            for (i, (_, c)) in w.iter().enumerate() {
+                rolling_force += (c * self.rolling_scale - c_rr) * loads[i];
+            }
+        }
+        let roll = rolling_force * (s.vx / 0.5).clamp(-1.0, 1.0);
         // Drag 0.645·Cx·A·v² along the velocity: its x component is 0.645·Cx·A·v·vₓ.
         let drag = self.drag_per_v2 * v2.sqrt() * s.vx;
         let tyres_x = front_x + fx_rear[0] + fx_rear[1];
@@ -636,7 +715,7 @@ impl Vehicle {
         brake_pedal: f64,
         drive: f64,
         w: &RearWheels,
-        friction: f64,
+        friction: [f64; 2],
         dt: f64,
     ) -> ([f64; 2], [f64; 2]) {
         let tyre = &self.tyres[1];
@@ -694,7 +773,7 @@ impl Vehicle {
 
         // Tyre forces at the spins, their reaction torques τ and dτ/dω.
         let forces = [0, 1].map(|i| {
-            let fmax = tyre.wheel_max_force(w.loads[i], friction);
+            let fmax = tyre.wheel_max_force(w.loads[i], friction[i]);
             let sx = (omega[i] * r - w.vt[i]) * w.inv_denom[i];
             let sy = -w.vl * w.inv_denom[i];
             (tyre.forces(sx, sy, fmax), fmax)
@@ -842,6 +921,66 @@ mod tests {
         }
     }
 
+    /// A wheel takes the surface under its centre: on a straight 12 m wide with a 2 m border
+    /// of friction 0.4 on the left and a sand side of 0.6 on the right, a car whose centre is
+    /// 5.5 m left of the centre line has its left wheels (0.7 to 0.8 m further out) on the
+    /// border and its right ones on the road; turned 90° to the left, its front wheels are on
+    /// the border and its rear ones on the road; 6.5 m right, its right wheels are on the
+    /// side; on the centre line, or on a road without verges, all four are on the road.
+    #[test]
+    fn each_wheel_takes_the_surface_under_it() {
+        use crate::track::{Piece, Surface, Track, Verge};
+        let border = Surface {
+            friction: 0.4,
+            rolling_resistance: Some(0.05),
+        };
+        let sand = Surface {
+            friction: 0.6,
+            rolling_resistance: None,
+        };
+        let piece = Piece {
+            verges: [
+                Verge {
+                    border_width: 2.0,
+                    border,
+                    ..Verge::NONE
+                },
+                Verge {
+                    side_width: 5.0,
+                    side: sand,
+                    ..Verge::NONE
+                },
+            ],
+            ..Piece::flat(500.0, 0.0)
+        };
+        let t = Track::from_pieces("verges", "test", &[piece], vec![]);
+        let frame = *t.frame(100);
+        let v = Vehicle::new(&Car::spirit_300());
+        let at = |y: f64, yaw: f64| {
+            let mut s = v.at_rest(100.0, y, yaw);
+            s.yaw_sin_cos = yaw.sin_cos();
+            v.wheel_surfaces(&s, &frame)
+        };
+        let (road, rr) = (1.0, v.rolling);
+        assert_eq!(at(0.0, 0.0), None);
+        assert_eq!(
+            at(5.5, 0.0),
+            Some([(0.4, 0.05), (road, rr), (0.4, 0.05), (road, rr)])
+        );
+        assert_eq!(
+            at(5.0, std::f64::consts::FRAC_PI_2),
+            Some([(0.4, 0.05), (0.4, 0.05), (road, rr), (road, rr)])
+        );
+        assert_eq!(
+            at(-6.5, 0.0),
+            Some([(road, rr), (0.6, rr), (road, rr), (0.6, rr)])
+        );
+        let plain = Track::from_pieces("plain", "test", &[Piece::flat(500.0, 0.0)], vec![]);
+        let mut s = v.at_rest(100.0, 5.5, 0.0);
+        s.yaw_sin_cos = (0.0, 1.0);
+        assert_eq!(v.wheel_surfaces(&s, plain.frame(100)), None);
+    }
+
     /// The lateral load transfer takes the roll moment up: the axles' transfers ΔF_a at ±y_a
     /// give back M (Σ 2·ΔF_a·y_a = M), shared as the rates in roll times the tracks.
     #[test]
@@ -875,7 +1014,7 @@ mod tests {
             let mut s = v.at_rest(0.0, 0.0, 0.0);
             s.vx = 30.0;
             s.omega = [30.0 / r, omega[0], omega[1]];
-            v.rear_wheels(&mut s, 0.0, drive, &rear, friction, 0.004);
+            v.rear_wheels(&mut s, 0.0, drive, &rear, [friction; 2], 0.004);
             [s.omega[1], s.omega[2]]
         };
         let w = spun(DiffKind::Spool, 500.0, [30.0 / r, 33.0 / r], 1.0);

@@ -39,6 +39,17 @@ pub enum GamePedal {
     Rkhs(RkhsPolicy),
     /// An (x, a) table, linear in between.
     Table(Vec<(f64, f64)>),
+    /// The profile hold ([`crate::drive::profile::ProfileHold`]): k times these speeds (m/s) at
+    /// stations spaced evenly over a lap of this length (m), the first on the start line, the
+    /// last at the finish.
+    Profile {
+        /// The scale k.
+        k: f64,
+        /// The lap's length (m) the stations span, cdbo's length of the track.
+        length: f64,
+        /// The speeds (m/s), at least 2.
+        speed: Vec<f64>,
+    },
 }
 
 /// One lap to drive.
@@ -245,6 +256,10 @@ fn settings(
         GamePedal::Table(points) => format!(
             "table {}",
             list(&mut points.iter().flat_map(|&(x, a)| [x, a]))
+        ),
+        GamePedal::Profile { k, length, speed } => format!(
+            "profile {k:e} {length:e} {}",
+            list(&mut speed.iter().copied())
         ),
     };
     let _ = writeln!(s, "pedal {pedal}");

@@ -39,6 +39,68 @@ pub struct Sample {
     /// simuv2 takes it from the road, F = c_rr·F_z), when the track names one; else the
     /// car's tyres give it.
     pub rolling_resistance: Option<f64>,
+    /// What lies past the road's left and right edges ([`Verge`]), `[left, right]`.
+    #[serde(skip)]
+    pub verges: [Verge; 2],
+}
+
+/// A surface a wheel can stand on: its TORCS `friction` and `rolling resistance` (`None`: the
+/// car's tyres give the rolling resistance).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Surface {
+    /// Friction coefficient, scales the tyre's grip.
+    pub friction: f64,
+    /// Rolling resistance coefficient, F = c_rr·F_z, if the track gives one.
+    pub rolling_resistance: Option<f64>,
+}
+
+/// What lies past one edge of the road, as TORCS's `track4.cpp` builds it (`AddSides`): next
+/// to the road a border (`Left Border` / `Right Border`: `width`, `surface`; a kerb, a strip of
+/// grass), then a side (`Left Side` / `Right Side`: `start width` … `end width`, `surface`;
+/// grass, gravel, a run-off), then the barrier. simuv2 finds each wheel's segment (road, border
+/// or side) under the wheel's centre (`wheel.cpp`: `RtTrackGlobal2Local` of the wheel's
+/// position) and takes that segment's surface's `kFriction` and `kRollRes` for the wheel.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Verge {
+    /// Width of the border (m); 0 without one.
+    pub border_width: f64,
+    /// The border's surface.
+    pub border: Surface,
+    /// Width of the side past the border (m); 0 without one.
+    pub side_width: f64,
+    /// The side's surface.
+    pub side: Surface,
+}
+
+impl Verge {
+    /// No border and no side: the road's surface is taken on past its edge (the built-in and
+    /// CSV tracks, TORCS version-3 files).
+    pub const NONE: Verge = Verge {
+        border_width: 0.0,
+        border: Surface {
+            friction: 1.0,
+            rolling_resistance: None,
+        },
+        side_width: 0.0,
+        side: Surface {
+            friction: 1.0,
+            rolling_resistance: None,
+        },
+    };
+
+    /// The surface `excess` metres past the road's edge (excess > 0): the border's within its
+    /// width, then the side's; past the side (at the barrier) the side's, or the border's when
+    /// there is no side; `None` (the road's) when there is neither.
+    #[inline]
+    pub fn surface_at(&self, excess: f64) -> Option<&Surface> {
+        if self.border_width > 0.0 && (excess <= self.border_width || self.side_width <= 0.0) {
+            Some(&self.border)
+        } else if self.side_width > 0.0 {
+            Some(&self.side)
+        } else {
+            None
+        }
+    }
 }
 
 /// How far the centre line's end is from its start: a closed track has both near zero.
@@ -89,6 +151,10 @@ pub struct Frame {
     pub friction: f64,
     /// The surface's rolling resistance coefficient, if the track gives one.
     pub rolling_resistance: Option<f64>,
+    /// What lies past the road's left and right edges, `[left, right]`.
+    pub verges: [Verge; 2],
+    /// Whether either verge differs from the road: a border or side of its own.
+    pub has_verges: bool,
     /// sin of the heading.
     pub sin_heading: f64,
     /// cos of the heading.
@@ -126,6 +192,11 @@ impl Frame {
             half_width: 0.5 * c.width,
             friction: c.friction,
             rolling_resistance: c.rolling_resistance,
+            verges: c.verges,
+            has_verges: c
+                .verges
+                .iter()
+                .any(|v| v.border_width > 0.0 || v.side_width > 0.0),
             sin_heading,
             cos_heading,
             sin_pitch,
@@ -388,6 +459,7 @@ impl Track {
                     width: p.width,
                     friction: p.friction,
                     rolling_resistance: p.rolling_resistance,
+                    verges: p.verges,
                 });
                 i += 1;
             }
@@ -467,6 +539,8 @@ pub struct Piece {
     pub friction: f64,
     /// Surface rolling resistance, if the track gives one.
     pub rolling_resistance: Option<f64>,
+    /// What lies past the left and right edges, `[left, right]`.
+    pub verges: [Verge; 2],
 }
 
 impl Piece {
@@ -483,6 +557,7 @@ impl Piece {
             width: 12.0,
             friction: 1.0,
             rolling_resistance: None,
+            verges: [Verge::NONE; 2],
         }
     }
 }

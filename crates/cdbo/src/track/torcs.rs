@@ -18,10 +18,20 @@
 //!   Banking is atan((z_left − z_right) / width).
 //! - Road friction and rolling resistance are the `friction` and `rolling resistance` of the
 //!   segment's `surface` in the `Surfaces` section (simuv2 takes both from the road).
+//! - Past each edge (version 4 and up; `track4.cpp`'s `InitSides` and `AddSides`), a border and
+//!   a side ([`super::Verge`]): `Main Track/Left Border` (`width`, default 0; `surface`,
+//!   default `grass`) and `Main Track/Left Side` (`width`, default 0; `surface`, default
+//!   `grass`) start them, and each segment's own `Left Border` / `Left Side` sections change
+//!   them from there on: the border's `width` and `surface` carry over; the side's width runs
+//!   from `start width` (default the previous end width) through `width` (default the start
+//!   width) to `end width` (default `width`), linearly over the segment's steps, and its
+//!   `surface` carries over. Likewise on the right.
 
 use std::path::Path;
 
-use super::{Ends, MAX_LENGTH_M, Piece, Track};
+use std::collections::HashMap;
+
+use super::{Ends, MAX_LENGTH_M, Piece, Surface, Track, Verge};
 use crate::bounded;
 use crate::error::Result;
 use crate::params::{Params, Section};
@@ -58,11 +68,18 @@ pub fn from_params(params: &Params, source: &str, ends: Ends) -> Result<Track> {
         ..ProfileState::default()
     };
     let mut pieces = Vec::new();
+    let mut sides = if layout == Layout::V4 {
+        Some(Sides::of(main)?)
+    } else {
+        None
+    };
+    let mut surfaces = HashMap::new();
     for seg in &segments.sections {
         if let Some(name) = seg.str("surface") {
             surface = name.to_owned();
         }
-        let friction = surface_friction(params, &surface, &mut warnings)?;
+        let friction = surface_friction(params, &surface, &mut warnings, false)?;
+        let first = pieces.len();
         segment_pieces(
             params,
             seg,
@@ -72,6 +89,18 @@ pub fn from_params(params: &Params, source: &str, ends: Ends) -> Result<Track> {
             &mut state,
             &mut pieces,
         )?;
+        if let Some(sides) = sides.as_mut() {
+            sides.update(seg)?;
+            let steps = pieces.len() - first;
+            for (i, piece) in pieces[first..].iter_mut().enumerate() {
+                let t = (i as f64 + 0.5) / steps as f64;
+                for k in 0..2 {
+                    piece.verges[k] = sides.verge(k, t, &mut |name: &str| {
+                        resolve(params, name, &mut surfaces, &mut warnings)
+                    })?;
+                }
+            }
+        }
     }
     let length: f64 = pieces.iter().map(|p| p.length).sum();
     if length > MAX_LENGTH_M {
@@ -147,11 +176,13 @@ impl Layout {
 
 /// Friction and rolling resistance of a named surface (in `Surfaces` or, for version 3,
 /// `Surfaces/List`); friction 1.0 and the tyres' rolling resistance, with a warning, when the
-/// surface is not defined.
+/// surface is not defined. A road's friction must be positive; a verge's may be 0 (the
+/// `armco` and `barrier` of a wall that stands as a border: Brondehach, Corkscrew).
 fn surface_friction(
     params: &Params,
     surface: &str,
     warnings: &mut Vec<String>,
+    verge: bool,
 ) -> Result<(f64, Option<f64>)> {
     let surfaces = params.section("Surfaces");
     let found = surfaces
@@ -160,7 +191,7 @@ fn surface_friction(
     match found {
         Some(sec) => {
             let f = sec.num_or("friction", 1.0)?;
-            if f <= 0.0 {
+            if f < 0.0 || (f == 0.0 && !verge) || !f.is_finite() {
                 return Err(params.error(
                     &format!("{}/friction", sec.path),
                     Some(sec.line_of("friction")),
@@ -189,6 +220,127 @@ fn surface_friction(
             }
             Ok((1.0, None))
         }
+    }
+}
+
+/// A named surface, looked up once per track.
+fn resolve(
+    params: &Params,
+    name: &str,
+    cache: &mut HashMap<String, Surface>,
+    warnings: &mut Vec<String>,
+) -> Result<Surface> {
+    if let Some(s) = cache.get(name) {
+        return Ok(*s);
+    }
+    let (friction, rolling_resistance) = surface_friction(params, name, warnings, true)?;
+    let s = Surface {
+        friction,
+        rolling_resistance,
+    };
+    cache.insert(name.to_owned(), s);
+    Ok(s)
+}
+
+/// The borders and sides as `track4.cpp` carries them from segment to segment, `[left, right]`.
+#[derive(Debug, Clone)]
+struct Sides {
+    border_width: [f64; 2],
+    border_surface: [String; 2],
+    side_start: [f64; 2],
+    side_end: [f64; 2],
+    side_surface: [String; 2],
+}
+
+impl Sides {
+    const SIDE: [&str; 2] = ["Left Side", "Right Side"];
+    const BORDER: [&str; 2] = ["Left Border", "Right Border"];
+
+    /// `InitSides`: the main track's `Left Side`, `Left Border` (and right), width 0 and
+    /// surface `grass` by default.
+    fn of(main: &Section) -> Result<Sides> {
+        let mut s = Sides {
+            border_width: [0.0; 2],
+            border_surface: [String::new(), String::new()],
+            side_start: [0.0; 2],
+            side_end: [0.0; 2],
+            side_surface: [String::new(), String::new()],
+        };
+        for k in 0..2 {
+            let side = main.section(Self::SIDE[k]);
+            let border = main.section(Self::BORDER[k]);
+            s.side_surface[k] = side
+                .and_then(|x| x.str("surface"))
+                .unwrap_or("grass")
+                .into();
+            s.side_end[k] = side
+                .map(|x| x.num_or("width", 0.0))
+                .transpose()?
+                .unwrap_or(0.0);
+            s.side_start[k] = s.side_end[k];
+            s.border_surface[k] = border
+                .and_then(|x| x.str("surface"))
+                .unwrap_or("grass")
+                .into();
+            s.border_width[k] = border
+                .map(|x| x.num_or("width", 0.0))
+                .transpose()?
+                .unwrap_or(0.0);
+        }
+        Ok(s)
+    }
+
+    /// `AddSides` at a segment's first step: its own `Left Side` / `Left Border` (and right).
+    fn update(&mut self, seg: &Section) -> Result<()> {
+        for k in 0..2 {
+            let end = self.side_end[k];
+            let (sw, ew) = match seg.section(Self::SIDE[k]) {
+                Some(side) => {
+                    let sw = side.num_or("start width", end)?;
+                    let w = side.num_or("width", sw)?;
+                    if let Some(name) = side.str("surface") {
+                        self.side_surface[k] = name.into();
+                    }
+                    (sw, side.num_or("end width", w)?)
+                }
+                None => (end, end),
+            };
+            (self.side_start[k], self.side_end[k]) = (sw, ew);
+            if let Some(border) = seg.section(Self::BORDER[k]) {
+                self.border_width[k] = border.num_or("width", self.border_width[k])?;
+                if let Some(name) = border.str("surface") {
+                    self.border_surface[k] = name.into();
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Side `k`'s verge at the fraction `t` of the segment; surfaces are looked up only where
+    /// their width is positive (an unused default `grass` needs no definition).
+    fn verge(
+        &self,
+        k: usize,
+        t: f64,
+        surface: &mut dyn FnMut(&str) -> Result<Surface>,
+    ) -> Result<Verge> {
+        let side_width =
+            (self.side_start[k] + t * (self.side_end[k] - self.side_start[k])).max(0.0);
+        let border_width = self.border_width[k].max(0.0);
+        Ok(Verge {
+            border_width,
+            border: if border_width > 0.0 {
+                surface(&self.border_surface[k])?
+            } else {
+                Verge::NONE.border
+            },
+            side_width,
+            side: if side_width > 0.0 {
+                surface(&self.side_surface[k])?
+            } else {
+                Verge::NONE.side
+            },
+        })
     }
 }
 
@@ -391,6 +543,7 @@ fn segment_pieces(
             width,
             friction,
             rolling_resistance,
+            verges: [Verge::NONE; 2],
         });
         (zl0, zr0) = (zl1, zr1);
         if sign != 0.0 {
@@ -508,6 +661,65 @@ mod tests {
             e.contains("Main Track/Track Segments: missing section"),
             "{e}"
         );
+    }
+
+    /// Borders and sides as `track4.cpp` carries them: the main track's start them, a
+    /// segment's change them from there on, a side's width runs from its start to its end width
+    /// over the segment's steps, and a surface is looked up only where it has a width.
+    #[test]
+    fn borders_and_sides_carry_from_segment_to_segment() {
+        let xml = format!(
+            r#"<params><section name="Surfaces">
+                 <section name="kerb"><attnum name="friction" val="0.4"/>
+                   <attnum name="rolling resistance" val="0.05"/></section>
+                 <section name="sand"><attnum name="friction" val="0.6"/></section></section>
+               <section name="Header"><attnum name="version" val="4"/></section>
+               <section name="Main Track"><attnum name="width" val="10"/>
+                 <attnum name="profil steps length" val="10"/>
+                 <section name="Left Border"><attnum name="width" val="2"/>
+                   <attstr name="surface" val="kerb"/></section>
+                 <section name="Right Side"><attnum name="width" val="5"/>
+                   <attstr name="surface" val="sand"/></section>
+                 <section name="Track Segments"><section name="a">{STRAIGHT}</section>
+                   <section name="b">{STRAIGHT}
+                     <section name="Left Border"><attnum name="width" val="0"/></section>
+                     <section name="Left Side"><attnum name="start width" val="4"/>
+                       <attnum name="end width" val="0"/><attstr name="surface" val="kerb"/>
+                     </section></section>
+                   <section name="c">{STRAIGHT}</section></section></section></params>"#
+        );
+        let p = Params::parse(&xml, "sides.xml", None).unwrap();
+        let t = from_params(&p, "sides.xml", Ends::MayMiss).unwrap();
+        assert!(
+            // Only the road's `asphalt` is missing; the unused default `grass` is not looked up.
+            t.warnings.iter().all(|w| !w.contains("grass")),
+            "{:?}",
+            t.warnings
+        );
+        let at = |s: f64| t.sample(t.index_at(s)).verges;
+        let [left, right] = at(50.0);
+        assert_eq!((left.border_width, left.border.friction), (2.0, 0.4));
+        assert_eq!(left.border.rolling_resistance, Some(0.05));
+        assert_eq!(left.side_width, 0.0);
+        assert_eq!((right.side_width, right.side.friction), (5.0, 0.6));
+        assert_eq!(right.border_width, 0.0);
+        assert_eq!(left.surface_at(1.0).unwrap().friction, 0.4);
+        assert_eq!(left.surface_at(3.0).unwrap().friction, 0.4);
+        assert_eq!(right.surface_at(0.5).unwrap().friction, 0.6);
+        // Segment b: no border; a side narrowing from 4 m to 0 over its 11 steps, step 0 at
+        // 4·(1 − 0.5/11).
+        let [left, right] = at(104.0);
+        assert_eq!(left.border_width, 0.0);
+        assert!(
+            (left.side_width - 4.0 * (1.0 - 0.5 / 11.0)).abs() < 1e-9,
+            "{left:?}"
+        );
+        assert_eq!(left.side.friction, 0.4);
+        assert_eq!(right.side.friction, 0.6);
+        // Segment c carries b's end: no side and no border on the left.
+        let [left, _] = at(250.0);
+        assert_eq!((left.border_width, left.side_width), (0.0, 0.0));
+        assert_eq!(left.surface_at(1.0), None);
     }
 
     #[test]
