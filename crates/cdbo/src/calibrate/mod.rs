@@ -124,8 +124,8 @@ pub const RAMP_M: f64 = 10.0;
 pub enum ProbePedal {
     /// The PI speed hold at this speed (m/s): closed loop, the game's robot drives the same law.
     Demo(f64),
-    /// The profile tracker ([`ProfileTracker`]) following k times a speed profile: closed
-    /// loop, the game's robot drives the same law.
+    /// The profile hold ([`ProfileHold`](crate::drive::profile::ProfileHold)) following k
+    /// times a speed profile: closed loop, the game's robot drives the same law.
     Profile {
         /// The scale k.
         k: f64,

@@ -267,27 +267,26 @@ impl Sides {
             side_surface: [String::new(), String::new()],
         };
         for k in 0..2 {
-            let side = main.section(Self::SIDE[k]);
-            let border = main.section(Self::BORDER[k]);
-            s.side_surface[k] = side
-                .and_then(|x| x.str("surface"))
-                .unwrap_or("grass")
-                .into();
-            s.side_end[k] = side
-                .map(|x| x.num_or("width", 0.0))
-                .transpose()?
-                .unwrap_or(0.0);
+            (s.side_surface[k], s.side_end[k]) = Self::part(main.section(Self::SIDE[k]))?;
             s.side_start[k] = s.side_end[k];
-            s.border_surface[k] = border
-                .and_then(|x| x.str("surface"))
-                .unwrap_or("grass")
-                .into();
-            s.border_width[k] = border
-                .map(|x| x.num_or("width", 0.0))
-                .transpose()?
-                .unwrap_or(0.0);
+            (s.border_surface[k], s.border_width[k]) = Self::part(main.section(Self::BORDER[k]))?;
         }
         Ok(s)
+    }
+
+    /// A side's or border's surface (`grass` where it names none) and width (0 where the
+    /// section or its width is absent) in the main track section.
+    fn part(section: Option<&Section>) -> Result<(String, f64)> {
+        Ok((
+            section
+                .and_then(|x| x.str("surface"))
+                .unwrap_or("grass")
+                .into(),
+            section
+                .map(|x| x.num_or("width", 0.0))
+                .transpose()?
+                .unwrap_or(0.0),
+        ))
     }
 
     /// `AddSides` at a segment's first step: its own `Left Side` / `Left Border` (and right).
