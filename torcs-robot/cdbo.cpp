@@ -523,6 +523,10 @@ void drive(int, tCarElt *car, tSituation *s) {
     const char *failure = nullptr;
     if (std::fabs(lateral) > half_width + lap.cfg.off_track_margin) {
         failure = "off_track";
+    } else if (car->priv.collision & SEM_COLLISION_XYSCENE) {
+        // simuv2 flags a corner of the body driven into a barrier (collide.cpp); only the
+        // sound module clears the flag, and a headless race has none.
+        failure = "hit_wall";
     } else if (std::cos(heading_error) < 0.0 ||
                (vx < std::fabs(vy) * kSpinSlipTan && speed > kSpinMinSpeed)) {
         failure = "spun";

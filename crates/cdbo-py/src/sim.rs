@@ -269,7 +269,7 @@ impl PyPolicy {
 }
 
 /// What a lap produced: `completed`, `time` (s, None if it failed), `reward` = L/T (m/s, 0 on
-/// failure), `failure` (`off_track`, `spun`, `backwards`, `stalled`, `time_limit` or None) and
+/// failure), `failure` (`off_track`, `hit_wall`, `spun`, `backwards`, `stalled`, `time_limit` or None) and
 /// where (`x_fail`, lap fraction), and the `trace` when asked for: a dict of NumPy arrays, one
 /// entry per driver step (t, distance_m, x, speed, pedal, steer, lateral, heading_error,
 /// slip_angle, gear, rpm, pos_x, pos_y). `Optimizer.tell(w, lap)` takes it whole, failure

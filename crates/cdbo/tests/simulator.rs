@@ -48,6 +48,51 @@ fn full_throttle_fails_on_forza_and_says_where() {
     assert!(f.x > 0.0 && f.x < 1.0 && f.distance_m > 100.0, "{f:?}");
 }
 
+/// A car running wide out of a bend ends its lap in the wall where the track has one, before
+/// its centre is past the edge by the off-track margin, and where the body reaches it.
+#[test]
+fn a_barrier_ends_the_lap_where_the_body_reaches_it() {
+    use cdbo::track::Verge;
+    // A 100 m straight into a 40 m-radius bend, 10 m wide; a border 0.5 m wide and no side.
+    let bend = |barrier: bool| {
+        let verge = Verge {
+            border_width: 0.5,
+            barrier,
+            ..Verge::NONE
+        };
+        let pieces = [
+            Piece {
+                width: 10.0,
+                verges: [verge; 2],
+                ..Piece::flat(100.0, 0.0)
+            },
+            Piece {
+                width: 10.0,
+                verges: [verge; 2],
+                ..Piece::flat(2.0 * std::f64::consts::PI * 40.0, 1.0 / 40.0)
+            },
+        ];
+        let track = Track::from_pieces("bend", "test", &pieces, vec![]);
+        let mut sim = Simulator::new(track, &Car::spirit_300());
+        sim.config.trace = true;
+        sim.lap(&mut ConstantPedal(1.0))
+    };
+    let (walled, open) = (bend(true), bend(false));
+    let (wall, edge) = (walled.failure.unwrap(), open.failure.unwrap());
+    assert_eq!(wall.reason, FailureReason::HitWall, "{wall:?}");
+    assert_eq!(edge.reason, FailureReason::OffTrack, "{edge:?}");
+    assert!(wall.distance_m < edge.distance_m, "{wall:?} {edge:?}");
+    // The same lap up to the wall; there the centre is inside 5.5 m less half the body's
+    // width (0.95 m) plus what its length adds turned by the heading error, and past 5.5 m
+    // less its reach √(2.1² + 0.95²).
+    let last = walled.trace.last().unwrap();
+    let lateral = last.lateral.abs();
+    assert!(
+        (5.5 - 2.1f64.hypot(0.95)..5.5 - 0.95 + 0.1).contains(&lateral),
+        "{last:?}"
+    );
+}
+
 /// Follows the limit's speed profile, scaled, with a look-ahead: a near-ideal pedal.
 struct LimitFollower {
     profile: Vec<f64>,

@@ -336,7 +336,7 @@ pub enum StudyCommand {
         at: Option<f64>,
         /// Why it failed: `stalled` or `time_limit` when the car was too slow there (the
         /// pattern search then adds pedal before the place), else how it left the road
-        /// (`off_track`, `spun`, `backwards`) or any note; kept with the trial.
+        /// (`off_track`, `hit_wall`, `spun`, `backwards`) or any note; kept with the trial.
         #[arg(long, requires = "failed")]
         reason: Option<String>,
     },

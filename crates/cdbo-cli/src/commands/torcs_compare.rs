@@ -121,6 +121,9 @@ struct Policies {
     lap_time_error_max: Option<f64>,
     lap_time_bias: Option<f64>,
     torcs_wall_s: f64,
+    /// The drawn policies one simulator completes and the other does not, with both outcomes:
+    /// where and why each failed.
+    disagreements: Vec<Pair>,
 }
 
 #[derive(Debug, Serialize)]
@@ -264,6 +267,17 @@ fn compare_track(
         lap_time_error_max: errors.iter().map(|e| e.abs()).reduce(f64::max),
         lap_time_bias: (n > 0.0).then(|| errors.iter().sum::<f64>() / n),
         torcs_wall_s,
+        disagreements: ours
+            .iter()
+            .zip(&theirs)
+            .enumerate()
+            .filter(|(_, (o, t))| o.completed != t.completed)
+            .map(|(i, (o, t))| Pair {
+                what: format!("policy {i}"),
+                cdbo: Lap::of(o),
+                torcs: Lap::of(t),
+            })
+            .collect(),
     };
 
     // Speed along the lap of the learned policy, in both.

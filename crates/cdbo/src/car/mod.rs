@@ -247,6 +247,10 @@ pub struct Car {
     /// Overall width of the body (m), TORCS `Car/overall width` (else `body width`): how
     /// much of the road a racing line leaves between the car's centre and the edge.
     pub width: f64,
+    /// Length of the body (m), TORCS `Car/body length`: with [`Car::width`] it places the
+    /// body's corners at (±length/2, ±width/2) from the centre of gravity, the four points
+    /// simuv2 collides with the barriers (`collide.cpp`, `SimCarCollideXYScene`).
+    pub length: f64,
     /// The axles' track, roll centres and roll rates: how the wheels share the load in a
     /// corner and under acceleration ([`Axles`]).
     pub axles: Axles,
@@ -339,6 +343,7 @@ impl Car {
             },
             steer_lock: 45f64.to_radians(),
             width: 1.90,
+            length: 4.2,
             // sc-spirit-300.xml: wheels at y = ±0.78 / ±0.80 m, roll centres 0.39 m, springs
             // 37 / 57 kN/m (bellcrank 1, no anti-roll bars), ride height 0.11 m; a limited-slip
             // differential with max slip bias 0.4 and simuv2's default locking torques.

@@ -406,6 +406,7 @@ pub fn from_params(p: &Params) -> Result<Car> {
             sec("Steer").num_or("steer lock", 0.43)?,
         )?,
         width: positive(car, "overall width", car_width(car)?)?,
+        length: body_length,
         torcs_robot: true,
         scales: super::Scales::ONE,
     })

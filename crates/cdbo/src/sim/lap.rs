@@ -9,6 +9,8 @@
 //! is clamped to ±max(0, w(s)/2 − w_car/2), the road's half-width less half the car's width.
 //! The lap ends when the car has covered the track's length, or fails when:
 //! - **off track**: the car's centre is more than width/2 + 1 m from the centre line;
+//! - **hit the wall**: a corner of the body is past a barrier, where a TORCS track has them
+//!   ([`super::barrier`]: the road, its border and its side; the game bounces the car off it);
 //! - **spun**: the car faces more than 90° away from the track, or slides with a body slip
 //!   angle above 60° at more than 3 m/s;
 //! - **backwards**: the car has moved 10 m back from the farthest point it reached;
@@ -21,6 +23,7 @@ use std::sync::Arc;
 
 use serde::Serialize;
 
+use super::barrier::Body;
 use super::vehicle::{Controls, State, Vehicle};
 use crate::car::Car;
 use crate::drive::demo::SpeedHold;
@@ -35,6 +38,8 @@ use crate::track::{Frame, Track};
 pub enum FailureReason {
     /// The car left the road.
     OffTrack,
+    /// The car's body hit a barrier.
+    HitWall,
     /// The car spun.
     Spun,
     /// The car drove backwards.
@@ -50,6 +55,7 @@ impl FailureReason {
     pub fn name(self) -> &'static str {
         match self {
             FailureReason::OffTrack => "off_track",
+            FailureReason::HitWall => "hit_wall",
             FailureReason::Spun => "spun",
             FailureReason::Backwards => "backwards",
             FailureReason::Stalled => "stalled",
@@ -67,6 +73,7 @@ impl FailureReason {
     pub fn from_name(name: &str) -> Option<FailureReason> {
         [
             FailureReason::OffTrack,
+            FailureReason::HitWall,
             FailureReason::Spun,
             FailureReason::Backwards,
             FailureReason::Stalled,
@@ -309,6 +316,7 @@ impl Simulator {
         let track = &self.track;
         let cfg = &self.config;
         let half_car = 0.5 * self.vehicle.car.width;
+        let body = Body::of(&self.vehicle.car);
         let start = track.sample(0);
         let mut state: State = self.vehicle.at_rest(start.x, start.y, start.heading);
         let mut steering = cfg.steering.clone();
@@ -407,6 +415,8 @@ impl Simulator {
             let road = track.frame(proj.index);
             let failure = if proj.lateral.abs() > road.half_width + cfg.off_track_margin {
                 Some(super::FailureReason::OffTrack)
+            } else if body.touches_barrier(&state, road) {
+                Some(super::FailureReason::HitWall)
             } else if facing_away(&state, road)
                 || (state.vx < state.vy.abs() * INV_TAN_SPIN_SLIP_ANGLE
                     && state.speed() > SPIN_MIN_SPEED)

@@ -2,6 +2,7 @@
 //! ([`lap`]), at a fixed 250 Hz physics step (TORCS: 500 Hz; see [`LapConfig::dt`]) with the driver at
 //! 50 Hz.
 
+pub mod barrier;
 pub mod lap;
 pub mod powertrain;
 pub mod table;

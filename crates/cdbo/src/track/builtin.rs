@@ -1,6 +1,9 @@
 //! Built-in circuits, embedded in the binary so that every command works with no data files.
 //!
-//! They are written in the TORCS track format and read by [`super::torcs`], like real tracks.
+//! They are written in the TORCS track format and read by [`super::torcs`], like real tracks,
+//! but they are open circuits: no barrier stands past their edges ([`super::Verge::barrier`];
+//! the game would put one at the edge of a road without sides), so a lap there leaves the road
+//! only by the off-track rule.
 
 use super::Track;
 use crate::error::{Error, Result};
@@ -23,7 +26,24 @@ pub fn load(name: &str) -> Option<Result<Track>> {
     let source = format!("builtin:{name}");
     Some(
         Params::parse(xml, &source, None)
-            .and_then(|p| super::torcs::from_params(&p, &source, super::Ends::MustMeet)),
+            .and_then(|p| super::torcs::from_params(&p, &source, super::Ends::MustMeet))
+            .map(without_barriers),
+    )
+}
+
+/// The track with every barrier taken away.
+fn without_barriers(track: Track) -> Track {
+    let mut samples = track.samples;
+    for verge in samples.iter_mut().flat_map(|s| s.verges.iter_mut()) {
+        verge.barrier = false;
+    }
+    Track::new(
+        &track.name,
+        &track.source,
+        track.length,
+        track.closure,
+        samples,
+        track.warnings,
     )
 }
 
@@ -48,6 +68,14 @@ mod tests {
     fn an_unknown_builtin_names_the_builtins() {
         let e = Track::builtin("monaco").unwrap_err().to_string();
         assert!(e.contains("\"monaco\"") && e.contains("ridgeway"), "{e}");
+    }
+
+    #[test]
+    fn a_builtin_track_has_no_barrier() {
+        for name in names() {
+            let t = load(name).unwrap().unwrap();
+            assert!((0..t.len()).all(|i| t.frame(i).barriers == [f64::INFINITY; 2]));
+        }
     }
 
     #[test]

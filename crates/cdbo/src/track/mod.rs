@@ -70,6 +70,10 @@ pub struct Verge {
     pub side_width: f64,
     /// The side's surface.
     pub side: Surface,
+    /// Whether a barrier stands past the side (TORCS version-4 files: `track4.cpp` closes
+    /// every side with one), at half the road's width plus the border's and the side's from
+    /// the centre line; simuv2 collides the body's corners with it (`collide.cpp`).
+    pub barrier: bool,
 }
 
 impl Verge {
@@ -86,6 +90,7 @@ impl Verge {
             friction: 1.0,
             rolling_resistance: None,
         },
+        barrier: false,
     };
 
     /// The surface `excess` metres past the road's edge (excess > 0): the border's within its
@@ -155,6 +160,10 @@ pub struct Frame {
     pub verges: [Verge; 2],
     /// Whether either verge differs from the road: a border or side of its own.
     pub has_verges: bool,
+    /// Distance from the centre line to the left and right barriers (m): half the road's
+    /// width plus the verge's border and side, or infinite where the verge has no barrier
+    /// ([`Verge::barrier`]).
+    pub barriers: [f64; 2],
     /// sin of the heading.
     pub sin_heading: f64,
     /// cos of the heading.
@@ -197,6 +206,13 @@ impl Frame {
                 .verges
                 .iter()
                 .any(|v| v.border_width > 0.0 || v.side_width > 0.0),
+            barriers: c.verges.map(|v| {
+                if v.barrier {
+                    0.5 * c.width + v.border_width + v.side_width
+                } else {
+                    f64::INFINITY
+                }
+            }),
             sin_heading,
             cos_heading,
             sin_pitch,

@@ -25,7 +25,8 @@
 //!   them from there on: the border's `width` and `surface` carry over; the side's width runs
 //!   from `start width` (default the previous end width) through `width` (default the start
 //!   width) to `end width` (default `width`), linearly over the segment's steps, and its
-//!   `surface` carries over. Likewise on the right.
+//!   `surface` carries over. Likewise on the right. A barrier closes each side
+//!   ([`super::Verge::barrier`]).
 
 use std::path::Path;
 
@@ -339,6 +340,7 @@ impl Sides {
             } else {
                 Verge::NONE.side
             },
+            barrier: true,
         })
     }
 }
@@ -664,7 +666,8 @@ mod tests {
 
     /// Borders and sides as `track4.cpp` carries them: the main track's start them, a
     /// segment's change them from there on, a side's width runs from its start to its end width
-    /// over the segment's steps, and a surface is looked up only where it has a width.
+    /// over the segment's steps, a surface is looked up only where it has a width, and a barrier
+    /// stands past them.
     #[test]
     fn borders_and_sides_carry_from_segment_to_segment() {
         let xml = format!(
@@ -719,6 +722,10 @@ mod tests {
         let [left, _] = at(250.0);
         assert_eq!((left.border_width, left.side_width), (0.0, 0.0));
         assert_eq!(left.surface_at(1.0), None);
+        // A barrier closes each side: past the road's 5 m half-width, the border and the side.
+        let barriers = |s: f64| t.frame(t.index_at(s)).barriers;
+        assert_eq!(barriers(50.0), [5.0 + 2.0, 5.0 + 5.0]);
+        assert_eq!(barriers(250.0), [5.0, 5.0 + 5.0]);
     }
 
     #[test]
