@@ -48,18 +48,12 @@ impl Body {
         if !nearest.is_finite() {
             return false;
         }
-        let (dx, dy) = (s.x - f.x, s.y - f.y);
-        let along = dx * f.cos_heading + dy * f.sin_heading;
-        let lateral = -dx * f.sin_heading + dy * f.cos_heading;
+        let (along, lateral) = f.local(s.x, s.y);
         let far = along.abs() + self.reach;
         if lateral.abs() + self.reach + 0.5 * f.curvature.abs() * far * far < nearest {
             return false;
         }
-        let (sy, cy) = s.yaw_sin_cos;
-        let (se, ce) = (
-            sy * f.cos_heading - cy * f.sin_heading,
-            cy * f.cos_heading + sy * f.sin_heading,
-        );
+        let (se, ce) = f.relative_heading(s.yaw_sin_cos);
         let (x, y) = (self.half_length, self.half_width);
         [(x, y), (x, -y), (-x, y), (-x, -y)]
             .into_iter()

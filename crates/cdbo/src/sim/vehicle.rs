@@ -374,18 +374,12 @@ impl Vehicle {
         if !f.has_verges {
             return None;
         }
-        let (dx, dy) = (s.x - f.x, s.y - f.y);
-        let along = dx * f.cos_heading + dy * f.sin_heading;
-        let lateral = -dx * f.sin_heading + dy * f.cos_heading;
+        let (along, lateral) = f.local(s.x, s.y);
         let far = along.abs() + self.reach;
         if lateral.abs() + self.reach + 0.5 * f.curvature.abs() * far * far < f.half_width {
             return None;
         }
-        let (sy, cy) = s.yaw_sin_cos;
-        let (se, ce) = (
-            sy * f.cos_heading - cy * f.sin_heading,
-            cy * f.cos_heading + sy * f.sin_heading,
-        );
+        let (se, ce) = f.relative_heading(s.yaw_sin_cos);
         let road = (f.friction, f.rolling_resistance.unwrap_or(self.rolling));
         let [yf, yr] = self.car.axles.half_track;
         let wheels = [(self.a, yf), (self.a, -yf), (-self.b, yr), (-self.b, -yr)];

@@ -189,6 +189,26 @@ pub struct Frame {
 pub const VERTICAL_WINDOW_M: f64 = 6.0;
 
 impl Frame {
+    /// The point (x, y) in the station's road coordinates: (along, left) of it, the heading's
+    /// unit vector and its left normal.
+    #[inline]
+    pub fn local(&self, x: f64, y: f64) -> (f64, f64) {
+        let (dx, dy) = (x - self.x, y - self.y);
+        (
+            dx * self.cos_heading + dy * self.sin_heading,
+            -dx * self.sin_heading + dy * self.cos_heading,
+        )
+    }
+
+    /// (sin(ψ − θ), cos(ψ − θ)) of a heading ψ given as (sin ψ, cos ψ), against the road's θ.
+    #[inline]
+    pub fn relative_heading(&self, (sin, cos): (f64, f64)) -> (f64, f64) {
+        (
+            sin * self.cos_heading - cos * self.sin_heading,
+            cos * self.cos_heading + sin * self.sin_heading,
+        )
+    }
+
     fn of(c: &Sample) -> Frame {
         let (sin_heading, cos_heading) = c.heading.sin_cos();
         let (sin_pitch, cos_pitch) = c.grade.atan().sin_cos();
