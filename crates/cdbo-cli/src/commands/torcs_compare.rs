@@ -388,6 +388,20 @@ fn markdown(reports: &[TrackReport], args: &CompareArgs) -> String {
     }
     let _ = writeln!(
         s,
+        "\n### Where they part\n\nThe drawn policies one simulator completes and the other does not, by where (to 10 m) and why the failing side failed; `compare.json` lists each (`policies.disagreements`).\n\n| track | cdbo fails, TORCS completes | TORCS fails, cdbo completes |\n| --- | --- | --- |"
+    );
+    for r in reports {
+        let d = &r.policies.disagreements;
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} |",
+            r.track,
+            failure_places(d.iter().map(|p| &p.cdbo)),
+            failure_places(d.iter().map(|p| &p.torcs))
+        );
+    }
+    let _ = writeln!(
+        s,
         "\n### cdbo's limit against the game's `{}` robot (same car)\n\n| track | QSS limit (standing start, centre line) | {} first lap (standing start) | {} best lap (flying) | limit vs first lap |\n| --- | --- | --- | --- | --- |",
         args.robot, args.robot, args.robot
     );
@@ -406,6 +420,29 @@ fn markdown(reports: &[TrackReport], args: &CompareArgs) -> String {
     s
 }
 
+/// The failed laps among `laps`, grouped by reason and place (to 10 m), most frequent first:
+/// "hit_wall at 5210 m (4), stalled at 2710 m (1)", or "–" when none failed.
+fn failure_places<'a>(laps: impl Iterator<Item = &'a Lap>) -> String {
+    let mut counts: std::collections::BTreeMap<(String, i64), usize> = Default::default();
+    for lap in laps {
+        if let (Some(reason), Some(at)) = (&lap.failure, lap.distance_fail_m) {
+            *counts
+                .entry((reason.clone(), (at / 10.0).round() as i64 * 10))
+                .or_default() += 1;
+        }
+    }
+    let mut places: Vec<_> = counts.into_iter().collect();
+    places.sort_by(|a, b| b.1.cmp(&a.1).then_with(|| a.0.cmp(&b.0)));
+    if places.is_empty() {
+        return "–".into();
+    }
+    places
+        .iter()
+        .map(|((reason, at), n)| format!("{reason} at {at} m ({n})"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 /// A fraction as a percentage with two decimals, or "–" where nothing could be computed (no
 /// policy completed in both simulators): never "NaN".
 fn percent(fraction: Option<f64>) -> String {
@@ -416,7 +453,30 @@ fn percent(fraction: Option<f64>) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::percent;
+    use super::{Lap, percent};
+
+    /// Failures grouped by reason and place to 10 m, the most frequent first; completed laps
+    /// are not counted.
+    #[test]
+    fn failures_are_grouped_by_reason_and_place() {
+        let lap = |failure: Option<(&str, f64)>| Lap {
+            lap_time_s: failure.is_none().then_some(100.0),
+            failure: failure.map(|(r, _)| r.to_owned()),
+            x_fail: failure.map(|(_, d)| d / 5000.0),
+            distance_fail_m: failure.map(|(_, d)| d),
+        };
+        let laps = [
+            lap(Some(("stalled", 2712.0))),
+            lap(Some(("hit_wall", 5212.0))),
+            lap(None),
+            lap(Some(("hit_wall", 5208.0))),
+        ];
+        assert_eq!(
+            super::failure_places(laps.iter()),
+            "hit_wall at 5210 m (2), stalled at 2710 m (1)"
+        );
+        assert_eq!(super::failure_places([lap(None)].iter()), "–");
+    }
 
     #[test]
     fn a_percentage_that_cannot_be_computed_is_a_dash_not_nan() {
