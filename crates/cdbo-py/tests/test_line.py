@@ -82,3 +82,21 @@ def test_steering_and_the_off_track_margin_are_the_clis(cli, tmp_path):
         cdbo.RaceEnv("ridgeway", kernels=10, steering="stanley")
     with pytest.raises(ValueError, match="off-track margin"):
         cdbo.race("ridgeway", kernels=10, laps=2, off_track_margin=9.0)
+
+
+def test_the_recommended_learner_in_the_readmes_loop_is_the_clis_race(cli, tmp_path):
+    """The learner the README recommends for a car, `safe-pattern-search` on the path tracker,
+    written as the README's loop (`env.optimizer(..., max_failed=B)`, ask, drive, tell the
+    whole lap), asks the laps `cdbo race --method safe-pattern-search --steering tracker
+    --max-failed-laps B` drives, bit for bit, and keeps to its budget."""
+    laps, budget = 60, 5
+    args = ("--method", "safe-pattern-search", "--kernels", 20, "--laps", laps)
+    flags = ("--steering", "tracker", "--max-failed-laps", budget, "--seed", 3)
+    summary = json.loads(cli("race", "--json", *args, *flags, "--out", tmp_path))
+    env = cdbo.RaceEnv("ridgeway", kernels=20, steering="tracker")
+    opt = env.optimizer("safe-pattern-search", seed=3, max_failed=budget)
+    rewards = asked_and_told(env, opt, laps)
+    assert max(rewards) == summary["best_reward_mps"] > float(env.lap(env.w0))
+    failed = sum(r == 0.0 for r in rewards)
+    assert failed == summary["failed_laps"]
+    assert 0 < failed <= budget, "some laps fail, none past the budget"

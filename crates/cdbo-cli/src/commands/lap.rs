@@ -36,10 +36,8 @@ pub struct LapArgs {
     /// How the car steers (default: as the policy file says it was raced, else the PI).
     #[arg(long, value_enum)]
     steering: Option<super::SteeringChoice>,
-    /// Where the lap leaves the road: once the car's centre is this far past the road's edge
-    /// (m; 1, the game's rule; negative: inside the road, as `race --off-track-margin`).
-    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true, value_parser = super::value::off_track_margin)]
-    off_track_margin: f64,
+    #[command(flatten)]
+    off_track: super::OffTrackArgs,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -129,7 +127,7 @@ pub fn run(args: &LapArgs, data: &DataPath, simulator: Simulator) -> CliResult {
     let line = base_line.line(&track, &car)?;
     let mut sim = cdbo::sim::Simulator::new(track, &car);
     sim.config.steering = args.steering.map_or(steering, |s| s.law()).steering();
-    sim.config.off_track_margin = args.off_track_margin;
+    sim.config.off_track_margin = args.off_track.off_track_margin;
     sim.config.line = line;
     sim.config.trace = args.trace.is_some() || args.plot.is_some();
     let lap = sim.lap(pedal.as_mut());
@@ -202,7 +200,7 @@ fn run_torcs(args: &LapArgs, data: &DataPath) -> CliResult {
         .or(policy.as_ref().map(|p| p.steering))
         .unwrap_or_default();
     req.config.steering = steering.steering();
-    req.config.off_track_margin = args.off_track_margin;
+    req.config.off_track_margin = args.off_track.off_track_margin;
     let track = super::game_track(&args.setup.track, &game, data)?;
     // The policy's line on the base line it was raced on (none: the centre line, no table).
     if let Some(raced) = policy {

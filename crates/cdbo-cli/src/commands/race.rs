@@ -65,14 +65,8 @@ pub struct RaceArgs {
     /// How the car steers.
     #[arg(long, value_enum, default_value_t)]
     steering: super::SteeringChoice,
-    /// Where a lap leaves the road: once the car's centre is this far past the road's edge
-    /// (m; 1, the game's rule). A negative margin keeps the car that far inside the road while
-    /// it learns, for a policy that must survive a world harsher than the simulator: learned
-    /// so with -1 (-2), the pattern search's best policy completes in the game on 17 (20) of
-    /// TORCS's 21 road tracks, against 5, for 4.4 % (8.0 %) of its pace (docs/results/torcs.md,
-    /// "Robust learning")
-    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true, value_parser = super::value::off_track_margin)]
-    off_track_margin: f64,
+    #[command(flatten)]
+    off_track: super::OffTrackArgs,
     #[command(flatten)]
     line: super::line::LineArgs,
     /// Output folder (default: runs/race-TRACK-METHOD-mM-sSEED).
@@ -171,7 +165,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     let (venue, track, car) = super::venue(&args.setup, data, simulator)?;
     let venue = venue
         .steered(args.steering.steering())
-        .off_track_at(args.off_track_margin);
+        .off_track_at(args.off_track.off_track_margin);
     let track_name = track.name.clone();
     let car_name = simulator.car(&args.setup.car).to_owned();
     let out = args.out.clone().unwrap_or_else(|| {
@@ -252,7 +246,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         car: car_name,
         simulator: simulator.name(),
         steering: args.steering.law(),
-        off_track_margin_m: args.off_track_margin,
+        off_track_margin_m: args.off_track.off_track_margin,
         max_failed_laps: args.max_failed_laps,
         kernels,
         line_kernels: config.line_kernels,
