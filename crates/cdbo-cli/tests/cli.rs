@@ -326,6 +326,58 @@ fn the_safe_search_keeps_its_budget_in_a_race() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// `--box-radius R` is the box every method searches: a pattern search in a box of 0.1 keeps
+/// each best weight within 0.1 of w₀, where the default box (1.5, written in the summary)
+/// lets the same race move some weight further; a box that is not a positive number is refused.
+#[test]
+fn the_box_radius_bounds_the_search() {
+    let dir =
+        Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("cdbo-cli-box-{}", std::process::id()));
+    let out = dir.to_str().unwrap();
+    let farthest = |box_radius: Option<&str>| {
+        let mut args = vec![
+            "race",
+            "--method",
+            "pattern-search",
+            "--laps",
+            "40",
+            "--json",
+        ];
+        args.extend(["--out", out]);
+        if let Some(r) = box_radius {
+            args.extend(["--box-radius", r]);
+        }
+        let raced = json(&args);
+        let weights = |file: &str| -> Vec<f64> {
+            let text = std::fs::read_to_string(dir.join(file)).unwrap();
+            let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+            serde_json::from_value(v["weights"].clone()).unwrap()
+        };
+        let (best, start) = (weights("best_policy.json"), weights("initial_policy.json"));
+        let moved = best.iter().zip(&start).map(|(b, s)| (b - s).abs());
+        (
+            raced["box_radius"].as_f64().unwrap(),
+            moved.fold(0.0, f64::max),
+        )
+    };
+    let (radius, moved) = farthest(Some("0.1"));
+    assert!(
+        radius == 0.1 && (moved - 0.1).abs() < 1e-12,
+        "{radius} {moved}: on the box"
+    );
+    let (radius, moved) = farthest(None);
+    assert!(radius == 1.5 && moved > 0.1, "{radius} {moved}");
+    for bad in ["0", "-1", "nan"] {
+        let out = cdbo(&["race", "--laps", "2", "--box-radius", bad]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            !out.status.success() && err.contains("--box-radius"),
+            "{err}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// `--max-failed-laps 10` caps a race's failed laps at 10 for every kind of method (a
 /// learner, the paper's GP method, a random search), where without it the same races fail
 /// more; the best lap is still a completed one.

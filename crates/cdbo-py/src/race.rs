@@ -144,12 +144,13 @@ impl PyRaceResult {
 /// the same settings): drive the demonstration, fit w0, then `laps` laps of `method`, on the
 /// line `line` (`centre`, `min-curvature` or `learn`, with `line_kernels` and `line_start` as
 /// `cdbo race --line-kernels` and `--line-start`), steered by `steering` (`pi` or `tracker`),
-/// its laps failing `off_track_margin` m past the road's edge (as `--off-track-margin`).
+/// its laps failing `off_track_margin` m past the road's edge (as `--off-track-margin`),
+/// searching w₀ ± `bounds` (as `--box-radius`; None: 1.5).
 /// `track` and `car` are objects or names; `knob` is the method's main knob (`cdbo race
 /// --knob`; None: its tuned value); `progress(record)` is called after every lap with the
 /// lap's record (a dict).
 #[pyfunction]
-#[pyo3(signature = (track = None, car = None, *, method = "cdbo", kernels = 30, laps = 300, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, demo_speed = 15.0, knob = None, max_failed = None, data_dir = None, progress = None, line = "centre", line_kernels = None, line_start = None, steering = "pi", off_track_margin = 1.0))]
+#[pyo3(signature = (track = None, car = None, *, method = "cdbo", kernels = 30, laps = 300, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, demo_speed = 15.0, knob = None, max_failed = None, data_dir = None, progress = None, line = "centre", line_kernels = None, line_start = None, steering = "pi", off_track_margin = 1.0, bounds = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn race(
     py: Python<'_>,
@@ -170,6 +171,7 @@ pub fn race(
     line_start: Option<&str>,
     steering: &str,
     off_track_margin: f64,
+    bounds: Option<f64>,
 ) -> PyResult<PyRaceResult> {
     let track = track_from(py, track, data_dir)?;
     let car = car_from(car, data_dir)?;
@@ -190,7 +192,9 @@ pub fn race(
         line_kernels,
         warm_start: None,
         base_line,
+        box_radius: bounds,
     };
+    config.spec().py()?;
     let mut callback_error: Option<PyErr> = None;
     let outcome = py
         .detach(|| {

@@ -29,6 +29,21 @@ def test_a_knob_is_the_clis_knob_and_changes_the_race(cli, tmp_path):
         cdbo.race("ridgeway", method="linebo", kernels=10, laps=2, knob=-1.0)
 
 
+def test_bounds_are_the_clis_box_radius_and_change_the_race(cli, tmp_path):
+    """`bounds=` is `cdbo race --box-radius`: the same laps, bit for bit; not the default box's
+    laps; a box that is not a positive number is refused before a lap is driven."""
+    args = ("race", "--json", "--laps", 40, "--kernels", 10, "--method", "pattern-search")
+    summary = json.loads(cli(*args, "--box-radius", 0.1, "--out", tmp_path))
+    how = dict(method="pattern-search", kernels=10, laps=40)
+    result = cdbo.race("ridgeway", bounds=0.1, **how)
+    assert result.best_reward == summary["best_reward_mps"]
+    default = cdbo.race("ridgeway", **how)
+    assert [lap["reward"] for lap in default.laps] != [lap["reward"] for lap in result.laps]
+    for bad in (0.0, -1.0, float("nan")):
+        with pytest.raises(ValueError, match="search-box radius"):
+            cdbo.race("ridgeway", bounds=bad, **how)
+
+
 @pytest.mark.parametrize(
     ("method", "knob"), [("cdbo", None), ("pattern-search", None), ("turbo", 0.1)]
 )

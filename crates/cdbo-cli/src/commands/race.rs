@@ -62,6 +62,10 @@ pub struct RaceArgs {
     /// search's own, 30).
     #[arg(long, value_name = "N")]
     max_failed_laps: Option<usize>,
+    /// Half-width r of the box [w₀ − r, w₀ + r] the method searches (default 1.5). A wider box
+    /// lets the pedal brake sharper where corners come close (README, "The line everywhere").
+    #[arg(long, value_name = "R", allow_negative_numbers = true, value_parser = super::value::positive)]
+    box_radius: Option<f64>,
     /// How the car steers.
     #[arg(long, value_enum, default_value_t)]
     steering: super::SteeringChoice,
@@ -92,6 +96,8 @@ struct Summary {
     /// The failed laps allowed (`--max-failed-laps`), if any.
     #[serde(skip_serializing_if = "Option::is_none")]
     max_failed_laps: Option<usize>,
+    /// The search box's half-width r around w₀.
+    box_radius: f64,
     kernels: usize,
     #[serde(skip_serializing_if = "Option::is_none")]
     line_kernels: Option<usize>,
@@ -156,6 +162,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         line_kernels,
         warm_start,
         base_line,
+        box_radius: args.box_radius,
     };
     // A knob the method cannot take is refused before any lap is driven.
     config.spec()?;
@@ -248,6 +255,9 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         steering: args.steering.law(),
         off_track_margin_m: args.off_track.off_track_margin,
         max_failed_laps: args.max_failed_laps,
+        box_radius: args
+            .box_radius
+            .unwrap_or(cdbo::optimizers::DEFAULT_BOX_RADIUS),
         kernels,
         line_kernels: config.line_kernels,
         base_line: config.base_line,

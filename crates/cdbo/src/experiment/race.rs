@@ -57,6 +57,10 @@ pub struct RaceConfig {
     /// which a learned line's offsets are measured (the car holds d₀(s) + d(s/L)).
     #[serde(default, skip_serializing_if = "BaseLine::is_centre")]
     pub base_line: BaseLine,
+    /// Half-width r of the search box [w₀ − r, w₀ + r] every method searches; `None`:
+    /// [`DEFAULT_BOX_RADIUS`](crate::optimizers::DEFAULT_BOX_RADIUS).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub box_radius: Option<f64>,
 }
 
 impl RaceConfig {
@@ -68,6 +72,9 @@ impl RaceConfig {
         }
         if self.warm_start.is_some() {
             spec = spec.warm_started();
+        }
+        if let Some(radius) = self.box_radius {
+            spec = spec.box_radius(radius)?;
         }
         Ok(match self.max_failed_laps {
             Some(max) => spec.max_failed_laps(max),
@@ -100,6 +107,7 @@ impl Default for RaceConfig {
             line_kernels: None,
             warm_start: None,
             base_line: BaseLine::Centre,
+            box_radius: None,
         }
     }
 }

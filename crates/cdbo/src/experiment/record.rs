@@ -211,6 +211,7 @@ pub fn run_at(
         line_kernels,
         warm_start: None,
         base_line,
+        box_radius: None,
     };
     let (track_name, length_m) = (track.name.clone(), track.length);
     let venue = match grounds {
