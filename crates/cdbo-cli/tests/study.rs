@@ -260,6 +260,53 @@ fn ask_tell_workflow_and_bad_input() {
     };
     fails(&dir, &budgeted("4"), "created with --max-failed-laps 3");
     ok(&dir, &budgeted("3"));
+    // The search box: stored at creation, every trial within it, a resume with another refused.
+    let boxed = [
+        "study",
+        "create",
+        "boxed",
+        "--kernels",
+        "5",
+        "--demo",
+        "demo.csv",
+        "--method",
+        "random",
+        "--knob",
+        "1",
+        "--box-radius",
+        "0.05",
+    ];
+    ok(&dir, &boxed);
+    let weights = |trial: usize| -> Vec<f64> {
+        let ask: serde_json::Value =
+            serde_json::from_str(&ok(&dir, &["study", "ask", "boxed"])).unwrap();
+        assert_eq!(ask["trial"], trial);
+        let t = trial.to_string();
+        ok(
+            &dir,
+            &["study", "tell", "boxed", "--trial", &t, "--reward", &t],
+        );
+        serde_json::from_value(ask["weights"].clone()).unwrap()
+    };
+    let w0 = weights(1);
+    let farthest = (2..6)
+        .flat_map(|t| {
+            weights(t)
+                .into_iter()
+                .zip(w0.clone())
+                .map(|(w, s)| (w - s).abs())
+        })
+        .fold(0.0, f64::max);
+    // Random search's σ of 1 sends most weights past the box: they sit on it.
+    assert!((farthest - 0.05).abs() < 1e-12, "{farthest}");
+    let mut resumed = boxed.to_vec();
+    resumed[1..3].copy_from_slice(&["create", "boxed-again"]);
+    resumed[12] = "0";
+    fails(&dir, &resumed, "--box-radius");
+    let mut other = budgeted("3").to_vec();
+    other[8] = "boxed.cdbo.db";
+    other[11..13].copy_from_slice(&["--box-radius", "0.1"]);
+    fails(&dir, &other, "created with --box-radius 0.05");
 }
 
 #[test]

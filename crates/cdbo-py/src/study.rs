@@ -68,12 +68,12 @@ impl PyTrial {
 ///
 /// `Study.create(path, w0, method="cdbo", lengthscale=None, seed=0, beta=1.0,
 /// track_length=None, knob=None, max_failed=None, line="centre", line_kernels=None,
-/// line_start=None, steering="pi")` (M = len(w0) kernels, length-scale 1/(M − 1) by default;
+/// line_start=None, steering="pi", bounds=None)` (M = len(w0) kernels, length-scale 1/(M − 1) by default;
 /// the lap's length in metres, if known, lets pattern search repair over road; `max_failed`
 /// is `cdbo study create --max-failed-laps`; `line`, `line_kernels`, `line_start` and
 /// `steering` as `cdbo.race`'s, stored with the study: with `line="learn"` w0 is [w_a, w_d]
 /// as `RaceEnv(line="learn").w0`, the line's M_d = `line_kernels` weights last, half of w0 by
-/// default), `Study.open(path)`;
+/// default; `bounds` the search box's half-width, as `--box-radius`), `Study.open(path)`;
 /// then `ask()` → `Trial`,
 /// `tell(trial, reward)`, `tell(trial, lap_time=T, length=L)` or `tell(trial, failed=True,
 /// at=x, reason=...)`; every told result is on disk when `tell` returns.
@@ -85,7 +85,7 @@ pub struct PyStudy {
 #[pymethods]
 impl PyStudy {
     #[classmethod]
-    #[pyo3(signature = (path, w0, *, method = "cdbo", lengthscale = None, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, track_length = None, knob = None, max_failed = None, line = "centre", line_kernels = None, line_start = None, steering = "pi"))]
+    #[pyo3(signature = (path, w0, *, method = "cdbo", lengthscale = None, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, track_length = None, knob = None, max_failed = None, line = "centre", line_kernels = None, line_start = None, steering = "pi", bounds = None))]
     #[allow(clippy::too_many_arguments)]
     fn create(
         _cls: &Bound<'_, PyType>,
@@ -103,6 +103,7 @@ impl PyStudy {
         line_kernels: Option<usize>,
         line_start: Option<&str>,
         steering: &str,
+        bounds: Option<f64>,
     ) -> PyResult<Self> {
         let w0 = vector(w0, "w0")?;
         let steering: SteeringLaw = steering.parse().py()?;
@@ -137,6 +138,7 @@ impl PyStudy {
             track_length,
             knob,
             max_failed_laps: max_failed,
+            box_radius: bounds,
             warm_start: None,
             line_kernels,
             base_line,
@@ -217,7 +219,8 @@ impl PyStudy {
     }
 
     /// The study's settings as a dict (method, kernels, lengthscale, seed, beta, w0, track,
-    /// track_length, knob, max_failed_laps, warm_start, line_kernels, base_line, steering;
+    /// track_length, knob, max_failed_laps, box_radius, warm_start, line_kernels, base_line,
+    /// steering;
     /// None where unset).
     #[getter]
     fn config<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
@@ -233,6 +236,7 @@ impl PyStudy {
         d.set_item("track_length", c.track_length)?;
         d.set_item("knob", c.knob)?;
         d.set_item("max_failed_laps", c.max_failed_laps)?;
+        d.set_item("box_radius", c.box_radius)?;
         d.set_item("warm_start", c.warm_start)?;
         d.set_item("line_kernels", c.line_kernels)?;
         d.set_item("base_line", c.base_line.name())?;

@@ -147,3 +147,23 @@ def test_a_study_keeps_the_race_settings_and_its_budget(tmp_path):
     with pytest.raises(ValueError, match="steering"):
         cdbo.Study.create(tmp_path / "steer.db", env.w0, steering="wheel")
     assert not any((tmp_path / f).exists() for f in ("short.db", "centre.db", "steer.db"))
+
+
+def test_bounds_are_stored_and_bound_every_trial(tmp_path):
+    """`bounds=` is `cdbo study create --box-radius`: stored with the study, named in its
+    config, and every trial of a random search whose σ reaches far past it stays on the box
+    w0 ± bounds; a box that is not a positive number is refused and writes nothing."""
+    w0 = np.linspace(-0.2, 0.2, 6)
+    study = cdbo.Study.create(tmp_path / "box.db", w0, method="random", knob=1.0, bounds=0.05)
+    assert study.config["box_radius"] == 0.05
+    farthest = 0.0
+    for i in range(5):
+        trial = study.ask()
+        farthest = max(farthest, float(np.max(np.abs(trial.weights - w0))))
+        study.tell(trial, float(i))
+    assert abs(farthest - 0.05) < 1e-12
+    assert cdbo.Study.open(tmp_path / "box.db").config["box_radius"] == 0.05
+    for bad in (0.0, -1.0, float("nan")):
+        with pytest.raises(ValueError, match="search-box radius"):
+            cdbo.Study.create(tmp_path / "bad.db", w0, bounds=bad)
+    assert not (tmp_path / "bad.db").exists()

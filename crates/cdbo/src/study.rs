@@ -83,6 +83,11 @@ pub struct StudyConfig {
     /// budget (the safe pattern search's own, [`crate::learner::safe_search::BUDGET`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_failed_laps: Option<usize>,
+    /// Half-width r of the box [w₀ − r, w₀ + r] the method searches ([`Spec::box_radius`]),
+    /// where the user set it; absent: [`DEFAULT_BOX_RADIUS`](crate::optimizers::DEFAULT_BOX_RADIUS)
+    /// (and in studies made before it could be set).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub box_radius: Option<f64>,
     /// The policy file w₀ was read from when the study is warm-started from a learned policy
     /// (the pattern search then does not push it: [`Spec::warm_started`]); absent: w₀ is a
     /// demonstration's fit or initial weights, and in studies made before it was recorded.
@@ -133,6 +138,9 @@ impl StudyConfig {
         }
         if let Some(max) = self.max_failed_laps {
             spec = spec.max_failed_laps(max);
+        }
+        if let Some(radius) = self.box_radius {
+            spec = spec.box_radius(radius)?;
         }
         if self.warm_start.is_some() {
             spec = spec.warm_started();
@@ -571,6 +579,7 @@ mod tests {
             track_length: None,
             knob: None,
             max_failed_laps: None,
+            box_radius: None,
             warm_start: None,
             line_kernels: None,
             base_line: Default::default(),

@@ -85,6 +85,10 @@ pub struct InitialPolicy {
     /// again (default: no budget; the safe pattern search's own budget, 30).
     #[arg(long, value_name = "N")]
     max_failed_laps: Option<usize>,
+    /// Half-width r of the box [w₀ − r, w₀ + r] the method searches, as `cdbo race
+    /// --box-radius` (default 1.5).
+    #[arg(long, value_name = "R", allow_negative_numbers = true, value_parser = super::value::positive)]
+    box_radius: Option<f64>,
     /// The line, as `cdbo race --line` (with `--line learn`, w₀'s line is the base line, d = 0,
     /// unless --weights gives one).
     #[command(flatten)]
@@ -198,6 +202,7 @@ impl InitialPolicy {
             track_length: self.track_length,
             knob: self.knob,
             max_failed_laps: self.max_failed_laps,
+            box_radius: self.box_radius,
             warm_start: self.warm_start.as_ref().map(|p| p.display().to_string()),
             line_kernels,
             base_line,
@@ -255,6 +260,11 @@ impl InitialPolicy {
             "--max-failed-laps",
             self.max_failed_laps.map(|n| n.to_string()),
             stored.max_failed_laps.map(|n| n.to_string()),
+        )?;
+        optional(
+            "--box-radius",
+            text(self.box_radius),
+            text(stored.box_radius),
         )?;
         optional(
             "--steering",
