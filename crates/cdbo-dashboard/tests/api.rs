@@ -65,6 +65,7 @@ fn study_config() -> StudyConfig {
         track_length: None,
         knob: None,
         max_failed_laps: None,
+        box_radius: None,
         warm_start: None,
         line_kernels: None,
         base_line: Default::default(),

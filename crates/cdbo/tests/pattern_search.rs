@@ -668,6 +668,7 @@ fn a_study_told_the_laps_length_drives_the_races_laps() {
                 track_length,
                 knob: None,
                 max_failed_laps: None,
+                box_radius: None,
                 warm_start: None,
                 line_kernels: None,
                 base_line: Default::default(),

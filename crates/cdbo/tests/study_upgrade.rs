@@ -28,6 +28,7 @@ fn config() -> StudyConfig {
         track_length: None,
         knob: None,
         max_failed_laps: None,
+        box_radius: None,
         warm_start: None,
         line_kernels: None,
         base_line: Default::default(),
