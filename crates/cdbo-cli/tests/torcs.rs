@@ -139,3 +139,42 @@ fn serve_sim_in_the_game_answers_with_game_laps() {
     nothing_left(&cache);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `cdbo torcs robots` times every shipped robot and reads its damage from the game's results:
+/// on Aalborg berniw2 drives its standing lap in about 78.15 s (docs/results/torcs.md) without
+/// striking a barrier, and a robot that leaves the road (sparkle, inferno2) is damaged.
+#[test]
+fn the_robots_table_gives_each_robots_laps_and_damage() {
+    let dir = fresh_dir("robots");
+    let Some(cache) = game_cache(&dir) else {
+        return;
+    };
+    let o = torcs_cmd(&cache)
+        .args(["torcs", "robots", "--track", "aalborg", "--json"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let table: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let robots = table["robots"].as_array().unwrap();
+    assert!(robots.len() >= 5, "{table}");
+    let robot = |name: &str| robots.iter().find(|r| r["robot"] == name).unwrap();
+    let berniw2 = robot("berniw2");
+    let first = berniw2["first_lap_s"].as_f64().unwrap();
+    assert!((77.5..79.0).contains(&first), "{berniw2}");
+    assert_eq!(berniw2["damage"], 0.0);
+    let damages: Vec<f64> = robots.iter().filter_map(|r| r["damage"].as_f64()).collect();
+    assert!(
+        damages.iter().all(|d| *d >= 0.0 && d.fract() == 0.0),
+        "{damages:?}"
+    );
+    assert!(damages.iter().any(|d| *d > 100.0), "{damages:?}");
+    // Fastest standing lap first.
+    let firsts: Vec<f64> = robots
+        .iter()
+        .filter_map(|r| r["first_lap_s"].as_f64())
+        .collect();
+    assert!(firsts.windows(2).all(|w| w[0] <= w[1]), "{firsts:?}");
+    assert_eq!(firsts[0], first);
+    nothing_left(&cache);
+    let _ = std::fs::remove_dir_all(&dir);
+}

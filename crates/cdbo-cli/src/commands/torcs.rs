@@ -154,6 +154,8 @@ struct RobotLaps {
     first_lap_s: Option<f64>,
     /// The best of its two laps, the second a flying one (s).
     best_lap_s: Option<f64>,
+    /// The car's damage after the two laps (0: no barrier struck harder than a graze).
+    damage: Option<f64>,
     /// Why it drove no lap.
     error: Option<String>,
 }
@@ -182,13 +184,17 @@ fn robots(track: &str, car: &str, json: bool) -> CliResult {
                     "{robot}: {}",
                     laps.as_ref().map_or_else(
                         |e| e.to_string(),
-                        |l| format!("first lap {:.2} s, best {:?} s", l.0, l.1)
+                        |l| format!(
+                            "first lap {:.2} s, best {:?} s, damage {}",
+                            l.first, l.best, l.damage
+                        )
                     )
                 );
             }
             RobotLaps {
-                first_lap_s: laps.as_ref().ok().map(|l| l.0),
-                best_lap_s: laps.as_ref().ok().and_then(|l| l.1),
+                first_lap_s: laps.as_ref().ok().map(|l| l.first),
+                best_lap_s: laps.as_ref().ok().and_then(|l| l.best),
+                damage: laps.as_ref().ok().map(|l| l.damage),
                 error: laps.err().map(|e| e.to_string()),
                 robot,
             }
@@ -218,12 +224,12 @@ fn robots(track: &str, car: &str, json: bool) -> CliResult {
         "{} on {}, each robot alone from a standing start; cdbo's QSS limit on the centre line {:.2} s",
         table.car, table.track, table.limit_lap_time_s
     );
-    println!("| robot | standing first lap | best (flying) lap | first lap / limit |");
-    println!("| --- | --- | --- | --- |");
+    println!("| robot | standing first lap | best (flying) lap | first lap / limit | damage |");
+    println!("| --- | --- | --- | --- | --- |");
     for r in &table.robots {
         let s = |v: Option<f64>| v.map_or("–".into(), |v| format!("{v:.2} s"));
         println!(
-            "| {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} |",
             r.robot,
             r.first_lap_s.map_or_else(
                 || format!("– ({})", r.error.as_deref().unwrap_or("no lap")),
@@ -234,6 +240,7 @@ fn robots(track: &str, car: &str, json: bool) -> CliResult {
                 "{:.1} %",
                 100.0 * table.limit_lap_time_s / v
             )),
+            r.damage.map_or("–".into(), |d| format!("{d:.0}")),
         );
     }
     Ok(())

@@ -312,8 +312,8 @@ fn compare_track(
         policies,
         limit_lap_time_s: learned.limit.lap_time_s,
         robot: args.robot.clone(),
-        robot_first_lap_s: robot.as_ref().ok().map(|r| r.0),
-        robot_best_lap_s: robot.as_ref().ok().and_then(|r| r.1),
+        robot_first_lap_s: robot.as_ref().ok().map(|r| r.first),
+        robot_best_lap_s: robot.as_ref().ok().and_then(|r| r.best),
     })
 }
 

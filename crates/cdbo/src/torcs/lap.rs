@@ -503,10 +503,8 @@ impl Game {
     }
 
     /// A built-in robot (`bt`, `berniw`, ...) driving `car` on `track` for two laps from the
-    /// same standing start, [`ROBOT_GRID_BEHIND`] behind the start line: (the first lap's
-    /// time, the best lap's time) in seconds; no best lap where the game records none (0: the
-    /// robot did not finish its second lap).
-    pub fn robot_laps(&self, robot: &str, track: &str, car: &str) -> Result<(f64, Option<f64>)> {
+    /// same standing start, [`ROBOT_GRID_BEHIND`] behind the start line.
+    pub fn robot_laps(&self, robot: &str, track: &str, car: &str) -> Result<RobotLaps> {
         let category = self.install.track_category(track)?;
         self.install.check_car(car)?;
         let xml = self
@@ -580,9 +578,15 @@ impl Game {
             .find(|l| l.contains("Leader Laps:    1") || l.contains("Leader Laps: 1,"))
             .and_then(|l| l.split_whitespace().nth(2))
             .and_then(|t| t.parse::<f64>().ok());
-        let best = find_number(&dir.0.join("results"), "best lap time")?;
-        match (first, best) {
-            (Some(first), Some(best)) => Ok((first, (best > 0.0).then_some(best))),
+        let results = dir.0.join("results");
+        let best = find_number(&results, "best lap time")?;
+        let damage = find_number(&results, "dammages")?;
+        match (first, best, damage) {
+            (Some(first), Some(best), Some(damage)) => Ok(RobotLaps {
+                first,
+                best: (best > 0.0).then_some(best),
+                damage,
+            }),
             _ => Err(Error::External {
                 program: format!("the TORCS robot {robot} on {track} in {car}"),
                 message: format!(
@@ -592,6 +596,22 @@ impl Game {
             }),
         }
     }
+}
+
+/// A shipped robot's two laps from a standing start ([`Game::robot_laps`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RobotLaps {
+    /// The first lap's time (s), from the standing start.
+    pub first: f64,
+    /// The best lap's time (s); none where the game records none (0: the robot did not
+    /// finish its second lap).
+    pub best: Option<f64>,
+    /// The car's damage after both laps, as the game's results give it. simuv2 (`collide.cpp`)
+    /// adds ⌊k·(½(v_n²/|v|)² + 0.005·|1 − v_n/|v||·|v|)⌋ at each step a corner of the body
+    /// presses into a barrier (v the car's velocity, v_n its part along the barrier's normal, k
+    /// the barrier surface's damage factor), and a little for wheels on rough surfaces: 0 means
+    /// no barrier struck harder than a graze.
+    pub damage: f64,
 }
 
 /// The value of the first `<attnum name="NAME" val="V"/>` in the XML files under `dir`

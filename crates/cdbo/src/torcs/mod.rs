@@ -27,7 +27,7 @@ pub mod traction;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
-pub use lap::{GamePedal, LapRequest};
+pub use lap::{GamePedal, LapRequest, RobotLaps};
 
 use crate::bounded;
 use crate::error::{Error, Result};
