@@ -183,3 +183,38 @@ fn the_ceiling_on_the_line_names_both_limits() {
     assert_eq!(centre["limit_mps"], limit["reward_mps"]);
     assert!(centre.get("centre_line_limit_mps").is_none(), "{centre}");
 }
+
+/// `cdbo ceiling --out FILE` writes the fitted policy with its line and steering, and `cdbo lap
+/// --policy FILE` drives the ceiling's lap again to the last bit; where no fitted policy
+/// completes (2 kernels) the command fails naming the file and writes nothing.
+#[test]
+fn the_ceilings_policy_is_written_and_drives_its_lap() {
+    let dir = fresh_dir("ceiling-out");
+    let ceiling = json(&ok(
+        &dir,
+        &[
+            "ceiling",
+            "--kernels",
+            "30",
+            "--steering",
+            "tracker",
+            "--line",
+            "min-curvature",
+            "--out",
+            "c.json",
+            "--json",
+        ],
+    ));
+    let file = json(&std::fs::read_to_string(dir.join("c.json")).unwrap());
+    assert_eq!(file["base_line"], "min-curvature");
+    assert_eq!(file["steering"], "tracker");
+    assert_eq!(file["weights"].as_array().unwrap().len(), 30);
+    let lap = json(&ok(&dir, &["lap", "--policy", "c.json", "--json"]));
+    assert_eq!(lap["reward_mps"], ceiling["policy_mps"]);
+    refused(
+        &dir,
+        &["ceiling", "--kernels", "2", "--out", "none.json"],
+        &["none.json", "no fitted policy"],
+    );
+    assert!(!dir.join("none.json").exists());
+}

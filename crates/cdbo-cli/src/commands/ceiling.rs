@@ -5,6 +5,7 @@ use clap::Args;
 use super::{CliResult, Setup, print_json};
 use cdbo::ceiling::ceiling_with;
 use cdbo::data_path::DataPath;
+use cdbo::experiment::line::RacedPolicy;
 
 #[derive(Debug, Args)]
 pub struct CeilingArgs {
@@ -21,6 +22,12 @@ pub struct CeilingArgs {
     /// that line's crest-blind limit, then of the centre line's.
     #[arg(long, value_enum, default_value_t)]
     line: super::line::FixedLine,
+    /// Write the fitted policy here, as `cdbo race` writes `best_policy.json` (its line and
+    /// steering named): `cdbo lap --policy FILE` drives it, `cdbo race --warm-start FILE`
+    /// learns on from it, in cdbo's simulator or the game. Nothing is written when no fitted
+    /// policy completes.
+    #[arg(long, value_name = "POLICY.json")]
+    out: Option<std::path::PathBuf>,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -61,6 +68,23 @@ pub fn run(args: &CeilingArgs, data: &DataPath) -> CliResult {
     sim.config.steering = args.steering.steering();
     sim.config.line = line;
     let c = ceiling_with(&sim, &limit, &profile, args.kernels)?;
+    if let Some(out) = &args.out {
+        let Some(policy) = &c.policy else {
+            return Err(format!(
+                "{}: no fitted policy completes within {} repairs, so none is written",
+                out.display(),
+                cdbo::ceiling::REPAIR_LAPS
+            )
+            .into());
+        };
+        let raced = RacedPolicy {
+            policy: policy.clone().into(),
+            base_line: args.line.base_line(),
+            steering: args.steering.law(),
+        };
+        std::fs::write(out, serde_json::to_string_pretty(&raced)?)
+            .map_err(|e| format!("{}: {e}", out.display()))?;
+    }
     if args.json {
         return print_json(&CeilingReport {
             ceiling: &c,
