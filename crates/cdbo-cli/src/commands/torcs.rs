@@ -146,9 +146,10 @@ pub fn run(cmd: &TorcsCommand, data: &cdbo::data_path::DataPath) -> CliResult {
     }
 }
 
-/// One shipped robot's laps, or why it drove none.
+/// One row of the robots table: a shipped robot's laps and damage
+/// ([`cdbo::torcs::RobotLaps`]), or why it drove none.
 #[derive(Debug, Serialize)]
-struct RobotLaps {
+struct RobotRow {
     robot: String,
     /// The first lap from the standing start (s).
     first_lap_s: Option<f64>,
@@ -175,7 +176,7 @@ fn robots(track: &str, car: &str, json: bool) -> CliResult {
         .filter(|n| drivers.join(n).join(format!("{n}.xml")).is_file())
         .collect();
     names.sort();
-    let mut laps: Vec<RobotLaps> = names
+    let mut laps: Vec<RobotRow> = names
         .into_iter()
         .map(|robot| {
             let laps = game.robot_laps(&robot, track, car);
@@ -191,7 +192,7 @@ fn robots(track: &str, car: &str, json: bool) -> CliResult {
                     )
                 );
             }
-            RobotLaps {
+            RobotRow {
                 first_lap_s: laps.as_ref().ok().map(|l| l.first),
                 best_lap_s: laps.as_ref().ok().and_then(|l| l.best),
                 damage: laps.as_ref().ok().map(|l| l.damage),
@@ -201,7 +202,7 @@ fn robots(track: &str, car: &str, json: bool) -> CliResult {
         })
         .collect();
     laps.sort_by(|a, b| {
-        let key = |r: &RobotLaps| r.first_lap_s.unwrap_or(f64::INFINITY);
+        let key = |r: &RobotRow| r.first_lap_s.unwrap_or(f64::INFINITY);
         key(a).total_cmp(&key(b))
     });
     #[derive(Serialize)]
@@ -209,7 +210,7 @@ fn robots(track: &str, car: &str, json: bool) -> CliResult {
         track: String,
         car: String,
         limit_lap_time_s: f64,
-        robots: Vec<RobotLaps>,
+        robots: Vec<RobotRow>,
     }
     let table = Table {
         track: track.to_owned(),
