@@ -5,6 +5,7 @@ use clap::Args;
 use super::{CliResult, Setup, print_json};
 use cdbo::ceiling::ceiling_with;
 use cdbo::data_path::DataPath;
+use cdbo::drive::steering::SteeringLaw;
 use cdbo::experiment::line::RacedPolicy;
 
 #[derive(Debug, Args)]
@@ -15,8 +16,8 @@ pub struct CeilingArgs {
     #[arg(long, default_value_t = 30)]
     kernels: usize,
     /// How the car steers.
-    #[arg(long, value_enum, default_value_t)]
-    steering: super::SteeringChoice,
+    #[arg(long, value_parser = super::steering_parser(), default_value_t)]
+    steering: SteeringLaw,
     /// The line the car holds: on the minimum-curvature line the profile tracked is that
     /// line's crest-aware limit (read at the centre line's stations) and the shares are of
     /// that line's crest-blind limit, then of the centre line's.
@@ -80,7 +81,7 @@ pub fn run(args: &CeilingArgs, data: &DataPath) -> CliResult {
         let raced = RacedPolicy {
             policy: policy.clone().into(),
             base_line: args.line.base_line(),
-            steering: args.steering.law(),
+            steering: args.steering,
         };
         std::fs::write(out, serde_json::to_string_pretty(&raced)?)
             .map_err(|e| format!("{}: {e}", out.display()))?;

@@ -34,8 +34,8 @@ pub struct LapArgs {
     #[arg(long, value_name = "FILE")]
     policy: Option<PathBuf>,
     /// How the car steers (default: as the policy file says it was raced, else the PI).
-    #[arg(long, value_enum)]
-    steering: Option<super::SteeringChoice>,
+    #[arg(long, value_parser = super::steering_parser())]
+    steering: Option<SteeringLaw>,
     #[command(flatten)]
     off_track: super::OffTrackArgs,
     /// Print JSON.
@@ -126,7 +126,7 @@ pub fn run(args: &LapArgs, data: &DataPath, simulator: Simulator) -> CliResult {
     let limit = limit_lap(&track, &car);
     let line = base_line.line(&track, &car)?;
     let mut sim = cdbo::sim::Simulator::new(track, &car);
-    sim.config.steering = args.steering.map_or(steering, |s| s.law()).steering();
+    sim.config.steering = args.steering.unwrap_or(steering).steering();
     sim.config.off_track_margin = args.off_track.off_track_margin;
     sim.config.line = line;
     sim.config.trace = args.trace.is_some() || args.plot.is_some();
@@ -196,7 +196,6 @@ fn run_torcs(args: &LapArgs, data: &DataPath) -> CliResult {
     let mut req = game.request(&args.setup.track, car_name, pedal)?;
     let steering = args
         .steering
-        .map(|s| s.law())
         .or(policy.as_ref().map(|p| p.steering))
         .unwrap_or_default();
     req.config.steering = steering.steering();

@@ -24,7 +24,7 @@ use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 
 use cdbo::car::{Car, catalog as cars};
 use cdbo::data_path::DataPath;
-use cdbo::drive::steering::{Steering, SteeringLaw};
+use cdbo::drive::steering::SteeringLaw;
 use cdbo::method::Method;
 use cdbo::track::{Ends, Track, builtin, catalog as tracks};
 use cdbo::venue::Venue;
@@ -33,6 +33,12 @@ use cdbo::venue::Venue;
 pub fn method_parser() -> impl clap::builder::TypedValueParser<Value = Method> {
     let names = Method::ALL.map(|m| PossibleValue::new(m.name()).help(m.description()));
     PossibleValuesParser::new(names).try_map(|name| name.parse::<Method>())
+}
+
+/// `--steering`: a [`SteeringLaw`] by name, each listed with its description in `--help`.
+pub fn steering_parser() -> impl clap::builder::TypedValueParser<Value = SteeringLaw> {
+    let names = SteeringLaw::ALL.map(|s| PossibleValue::new(s.name()).help(s.description()));
+    PossibleValuesParser::new(names).try_map(|name| name.parse::<SteeringLaw>())
 }
 
 /// The boxed error every command returns; printed as one line by `main`.
@@ -64,32 +70,6 @@ impl Simulator {
             Simulator::Cdbo => "cdbo",
             Simulator::Torcs => "torcs",
         }
-    }
-}
-
-/// How the car steers (`--steering`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
-pub enum SteeringChoice {
-    /// The paper's PI steering on a look-ahead point of the line (the default).
-    #[default]
-    Pi,
-    /// The path tracker: feed-forward from the path's curvature and the car's understeer
-    /// gradient, feedback on the previewed lateral error, yaw-rate damping.
-    Tracker,
-}
-
-impl SteeringChoice {
-    /// The steering law it names.
-    pub fn law(self) -> SteeringLaw {
-        match self {
-            SteeringChoice::Pi => SteeringLaw::Pi,
-            SteeringChoice::Tracker => SteeringLaw::Tracker,
-        }
-    }
-
-    /// The steering controller, with its documented gains.
-    pub fn steering(self) -> Steering {
-        self.law().steering()
     }
 }
 

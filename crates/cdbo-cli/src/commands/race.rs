@@ -67,8 +67,8 @@ pub struct RaceArgs {
     #[arg(long, value_name = "R", allow_negative_numbers = true, value_parser = super::value::positive)]
     box_radius: Option<f64>,
     /// How the car steers.
-    #[arg(long, value_enum, default_value_t)]
-    steering: super::SteeringChoice,
+    #[arg(long, value_parser = super::steering_parser(), default_value_t)]
+    steering: SteeringLaw,
     #[command(flatten)]
     off_track: super::OffTrackArgs,
     #[command(flatten)]
@@ -223,7 +223,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     ceiling_sim.config.steering = args.steering.steering();
     let profile = cdbo::ceiling::profile(&track, &car, None);
     let (_, ceiling_mps) = cdbo::ceiling::tracked_profile(&ceiling_sim, &profile)?;
-    write_outputs(&out, &outcome, config.base_line, args.steering.law())?;
+    write_outputs(&out, &outcome, config.base_line, args.steering)?;
     // The speed plots re-drive the initial and best policies where the race was driven, on
     // its base line.
     let venue = match &outcome.line {
@@ -236,7 +236,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         let raced = RacedPolicy {
             policy: outcome.best.clone(),
             base_line: config.base_line,
-            steering: args.steering.law(),
+            steering: args.steering,
         };
         super::plot::policy_line(&track, &car, outcome.line.clone(), &raced)
     });
@@ -252,7 +252,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         track: track_name,
         car: car_name,
         simulator: simulator.name(),
-        steering: args.steering.law(),
+        steering: args.steering,
         off_track_margin_m: args.off_track.off_track_margin,
         max_failed_laps: args.max_failed_laps,
         box_radius: args

@@ -7,6 +7,7 @@ use clap::{Args, Subcommand, ValueEnum};
 use super::line::LineArgs;
 use super::policy::{read_demo, read_raced_policy};
 use super::{CliResult, from_flag, print_json};
+use cdbo::drive::steering::SteeringLaw;
 use cdbo::experiment::line::{LineSetting, RacedPolicy};
 use cdbo::method::Method;
 use cdbo::policy::RkhsPolicy;
@@ -96,8 +97,8 @@ pub struct InitialPolicy {
     /// How the car steers: written into each lap's policy file (`cdbo lap --policy {policy}`
     /// drives with it) and used in the game (default: the --weights or --warm-start policy's,
     /// else the paper's PI).
-    #[arg(long, value_enum)]
-    steering: Option<super::SteeringChoice>,
+    #[arg(long, value_parser = super::steering_parser())]
+    steering: Option<SteeringLaw>,
 }
 
 impl InitialPolicy {
@@ -113,7 +114,7 @@ impl InitialPolicy {
             .unwrap_or_else(|| default_lengthscale(self.kernels));
         let (base_line, line_kernels) = self.line.resolve(self.kernels)?;
         let mut line_w0 = None;
-        let mut steering = self.steering.map(|s| s.law());
+        let mut steering = self.steering;
         let (policy, file) = match (
             &self.demo,
             self.weights.as_ref().or(self.warm_start.as_ref()),
@@ -268,7 +269,7 @@ impl InitialPolicy {
         )?;
         optional(
             "--steering",
-            self.steering.map(|s| s.law().name().to_owned()),
+            self.steering.map(|s| s.name().to_owned()),
             Some(stored.steering.name().to_owned()),
         )?;
         optional(

@@ -76,6 +76,9 @@ pub enum SteeringLaw {
 }
 
 impl SteeringLaw {
+    /// Every law, the default first.
+    pub const ALL: [SteeringLaw; 2] = [SteeringLaw::Pi, SteeringLaw::Tracker];
+
     /// The controller, fresh.
     pub fn steering(self) -> Steering {
         match self {
@@ -97,12 +100,31 @@ impl SteeringLaw {
             SteeringLaw::Tracker => "tracker",
         }
     }
+
+    /// One line on what it does, as `--steering`'s help lists it.
+    pub fn description(self) -> &'static str {
+        match self {
+            SteeringLaw::Pi => {
+                "The paper's PI steering on a look-ahead point of the line (the default)"
+            }
+            SteeringLaw::Tracker => {
+                "The path tracker: feed-forward from the path's curvature and the car's understeer \
+                 gradient, feedback on the previewed lateral error, yaw-rate damping"
+            }
+        }
+    }
+}
+
+impl std::fmt::Display for SteeringLaw {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
 }
 
 impl std::str::FromStr for SteeringLaw {
     type Err = crate::error::Error;
     fn from_str(s: &str) -> crate::error::Result<SteeringLaw> {
-        [SteeringLaw::Pi, SteeringLaw::Tracker]
+        SteeringLaw::ALL
             .into_iter()
             .find(|law| law.name() == s)
             .ok_or_else(|| {
