@@ -253,3 +253,50 @@ fn a_missing_shared_file_is_named_with_where_to_get_it() {
         );
     }
 }
+
+/// car1-trb1 pulling away at a constant pedal round a 60 m circle runs wide until it leaves
+/// the road; on a rough road (1 cm at λ = 1 m, as G-Track 1's) its wheels bounce and the tyres
+/// grip less, so it leaves sooner and slower. Its suspension is read from its file (dampers
+/// 400 / 300 lbs/in/s slow, 60 fast, 20 kg wheels); a road rough by less than
+/// [`cdbo::track::FELT_ROUGHNESS_M`] drives as a smooth one, to the last bit.
+#[test]
+fn a_rough_road_takes_car1_trb1s_grip() {
+    use cdbo::drive::ConstantPedal;
+    use cdbo::sim::Simulator;
+    use cdbo::track::{Piece, Roughness};
+    let data = cdbo::data_path::DataPath::with_env(&[shared("")], "");
+    let car = cdbo::car::catalog::find("car1-trb1", &data).unwrap();
+    let ride = car.ride.unwrap();
+    let lbs_in_s = 0.453_592_37 / 0.0254;
+    assert!((ride.dampers[0].bump.slow - 400.0 * lbs_in_s).abs() < 1e-9);
+    assert!((ride.dampers[1].rebound.slow - 400.0 * lbs_in_s).abs() < 1e-9);
+    assert!((ride.dampers[0].bump.fast - 60.0 * lbs_in_s).abs() < 1e-9);
+    assert_eq!(
+        (ride.dampers[0].bump.threshold, ride.wheel_mass),
+        (0.5, [20.0, 20.0])
+    );
+    assert_eq!(ride.bellcrank, [1.1, 1.1]);
+    let lap = |roughness: Roughness, car: &cdbo::car::Car| {
+        let circle = Piece {
+            roughness,
+            ..Piece::flat(2.0 * std::f64::consts::PI * 60.0, 1.0 / 60.0)
+        };
+        let track = Track::from_pieces("circle", "test", &[circle], vec![]);
+        let mut sim = Simulator::new(track, car);
+        sim.config.trace = true;
+        sim.lap(&mut ConstantPedal(1.0))
+    };
+    let smooth = lap(Roughness::NONE, &car);
+    let rough = lap(Roughness::from_file(0.01, 1.0), &car);
+    let (s, r) = (smooth.failure.unwrap(), rough.failure.unwrap());
+    let speed = |l: &cdbo::sim::LapResult| l.trace.last().unwrap().speed;
+    assert!(r.distance_m < s.distance_m, "{r:?} against {s:?}");
+    assert!(
+        speed(&rough) < 0.99 * speed(&smooth),
+        "{} against {}",
+        speed(&rough),
+        speed(&smooth)
+    );
+    let faint = lap(Roughness::from_file(0.0009, 1.0), &car);
+    assert_eq!((faint.failure, faint.trace), (smooth.failure, smooth.trace));
+}

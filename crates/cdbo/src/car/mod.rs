@@ -66,7 +66,65 @@ pub struct Ride {
     pub rate: [f64; 2],
     /// Travel of a front and of a rear wheel (m): the suspension course over the bellcrank.
     pub travel: [f64; 2],
+    /// The bellcrank's ratio b of a front and of a rear wheel: the spring and the damper
+    /// move b metres a metre of the wheel's.
+    pub bellcrank: [f64; 2],
+    /// The damper of a front and of a rear wheel.
+    pub dampers: [Damper; 2],
+    /// The mass of a front and of a rear wheel (kg; simuv2's default 20).
+    pub wheel_mass: [f64; 2],
 }
+
+/// A damper as simuv2's `susp.cpp` has it: at the damper's speed v (positive in bump,
+/// compressing) its force is C₁·|v| below the threshold v₁ and C₂·|v| + (C₁ − C₂)·v₁ above
+/// it, against the motion, each way with its own [`DamperCurve`]; |v| is capped at 10 m/s.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Damper {
+    /// Compressing (`slow bump`, `fast bump`, `fast bump threshold`).
+    pub bump: DamperCurve,
+    /// Extending (`slow rebound`, `fast rebound`, `fast rebound threshold`).
+    pub rebound: DamperCurve,
+}
+
+/// One way of a [`Damper`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct DamperCurve {
+    /// C₁ (N·s/m).
+    pub slow: f64,
+    /// C₂ (N·s/m).
+    pub fast: f64,
+    /// v₁ (m/s).
+    pub threshold: f64,
+}
+
+impl DamperCurve {
+    /// The force's size at the damper's speed |v| (N).
+    #[inline]
+    pub fn force(&self, speed: f64) -> f64 {
+        let v = speed.abs().min(DAMPER_SPEED_CAP);
+        if v < self.threshold {
+            self.slow * v
+        } else {
+            self.fast * v + (self.slow - self.fast) * self.threshold
+        }
+    }
+}
+
+impl Damper {
+    /// The damper's force at speed v (N, positive pushing the wheel out against a
+    /// compression).
+    #[inline]
+    pub fn force(&self, v: f64) -> f64 {
+        if v < 0.0 {
+            -self.rebound.force(v)
+        } else {
+            self.bump.force(v)
+        }
+    }
+}
+
+/// The damper's speed simuv2 caps (m/s).
+pub const DAMPER_SPEED_CAP: f64 = 10.0;
 
 impl Ride {
     /// h(Σ) = 2·exp(−3·(1.5·Σ)⁴) of simuv2's `aero.cpp`, Σ the ride heights' sum (m).
@@ -483,8 +541,11 @@ pub(crate) mod tests {
     use super::*;
 
     /// A car with simuv2's ride height: car1-trb1's figures (its file is not in the repository).
+    /// TORCS's `lbs/in` (and `lbs/in/s`) in SI: lbs is a mass to `GfParmGetNum`.
+    const LBS_PER_IN: f64 = 0.453_592_37 / 0.0254;
+
     pub(crate) fn on_springs() -> Car {
-        let rate = 5500.0 * 0.453_592_37 / 0.0254 * 1.1 * 1.1;
+        let rate = 5500.0 * LBS_PER_IN * 1.1 * 1.1;
         Car {
             mass: 1244.0,
             clift: [0.69, 0.7],
@@ -493,6 +554,20 @@ pub(crate) mod tests {
                 load: [2932.0, 2706.0],
                 rate: [rate, rate],
                 travel: [0.2 / 1.1, 0.2 / 1.1],
+                bellcrank: [1.1, 1.1],
+                dampers: [Damper {
+                    bump: DamperCurve {
+                        slow: 400.0 * LBS_PER_IN,
+                        fast: 60.0 * LBS_PER_IN,
+                        threshold: 0.5,
+                    },
+                    rebound: DamperCurve {
+                        slow: 300.0 * LBS_PER_IN,
+                        fast: 60.0 * LBS_PER_IN,
+                        threshold: 0.5,
+                    },
+                }; 2],
+                wheel_mass: [20.0, 20.0],
             }),
             ..Car::spirit_300()
         }

@@ -6,8 +6,8 @@
 use std::path::{Path, PathBuf};
 
 use super::{
-    Axles, Brake, Car, DEFAULT_ENGINE_BRAKE, DEFAULT_PAD_MU, DiffKind, Differential, Drive, Ride,
-    Tyre, Wing,
+    Axles, Brake, Car, DEFAULT_ENGINE_BRAKE, DEFAULT_PAD_MU, Damper, DamperCurve, DiffKind,
+    Differential, Drive, Ride, Tyre, Wing,
 };
 use crate::bounded;
 use crate::error::{Error, Result};
@@ -93,6 +93,13 @@ pub fn from_params(p: &Params) -> Result<Car> {
             Ok(v)
         } else {
             Err(s.value_error(name, format!("must be positive, got {v}")))
+        }
+    };
+    let non_negative = |s: &Section, name: &str, v: f64| -> Result<f64> {
+        if v >= 0.0 && v.is_finite() {
+            Ok(v)
+        } else {
+            Err(s.value_error(name, format!("must be non-negative, got {v}")))
         }
     };
     let fraction = |s: &Section, name: &str, v: f64| -> Result<f64> {
@@ -281,21 +288,59 @@ pub fn from_params(p: &Params) -> Result<Car> {
     // The suspension of the right-hand wheels (simuv2's `susp.cpp` and `wheel.cpp`): spring
     // rate K, bellcrank b, course c and the wheel's ride height x₀ under its static load.
     let ride = {
-        let axle = |susp: &str, wheel: &str| -> Result<(f64, f64, f64)> {
+        /// One wheel's suspension, as [`Ride`] keeps it per axle.
+        struct Wheel {
+            height: f64,
+            rate: f64,
+            travel: f64,
+            bellcrank: f64,
+            damper: Damper,
+            mass: f64,
+        }
+        let axle = |susp: &str, wheel: &str| -> Result<Wheel> {
             let (s, w) = (sec(susp), sec(wheel));
             let bellcrank = positive(s, "bellcrank", s.num_or("bellcrank", 1.0)?)?;
             let spring = positive(s, "spring", s.num_or("spring", 175_000.0)?)?;
             let course = positive(s, "suspension course", s.num_or("suspension course", 0.5)?)?;
             let height = positive(w, "ride height", w.num_or("ride height", 0.2)?)?;
-            Ok((height, spring * bellcrank * bellcrank, course / bellcrank))
+            // simuv2's `SimSuspConfig`: the slow rates default to 0, the fast ones to the
+            // slow, the thresholds to 0.5 m/s.
+            let curve = |way: &str| -> Result<DamperCurve> {
+                let slow_name = format!("slow {way}");
+                let slow = non_negative(s, &slow_name, s.num_or(&slow_name, 0.0)?)?;
+                let fast_name = format!("fast {way}");
+                let fast = non_negative(s, &fast_name, s.num_or(&fast_name, slow)?)?;
+                let threshold_name = format!("fast {way} threshold");
+                let threshold = positive(s, &threshold_name, s.num_or(&threshold_name, 0.5)?)?;
+                Ok(DamperCurve {
+                    slow,
+                    fast,
+                    threshold,
+                })
+            };
+            let damper = Damper {
+                bump: curve("bump")?,
+                rebound: curve("rebound")?,
+            };
+            Ok(Wheel {
+                height,
+                rate: spring * bellcrank * bellcrank,
+                travel: course / bellcrank,
+                bellcrank,
+                damper,
+                mass: positive(w, "mass", w.num_or("mass", 20.0)?)?,
+            })
         };
         let f = axle("Front Right Suspension", "Front Right Wheel")?;
         let r = axle("Rear Right Suspension", "Rear Right Wheel")?;
         Ride {
-            height: [f.0, r.0],
+            height: [f.height, r.height],
             load: static_wheel_load,
-            rate: [f.1, r.1],
-            travel: [f.2, r.2],
+            rate: [f.rate, r.rate],
+            travel: [f.travel, r.travel],
+            bellcrank: [f.bellcrank, r.bellcrank],
+            dampers: [f.damper, r.damper],
+            wheel_mass: [f.mass, r.mass],
         }
     };
     // The axles as simuv2 loads their wheels in a corner (`axle.cpp`, `susp.cpp`, `car.cpp`):

@@ -69,6 +69,7 @@ impl RacingLine {
                 width: c.width,
                 friction: c.friction,
                 rolling_resistance: c.rolling_resistance,
+                roughness: c.roughness,
                 verges: c.verges,
             });
         }

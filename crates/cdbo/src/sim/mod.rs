@@ -3,6 +3,7 @@
 //! 50 Hz.
 
 pub mod barrier;
+pub mod bounce;
 pub mod lap;
 pub mod powertrain;
 pub mod table;

@@ -59,10 +59,11 @@
 //!   robot's traction control in first gear, cdbo's car1-trb1 reaches 100 m of full throttle
 //!   within 0.02 s and 0.1 m/s of the game's on E-Track 2 and Ruudskogen (0.4 s behind before).
 
+use super::bounce::{self, Bounce, Corner};
 use super::powertrain::{EngineMap, Gearbox, ShiftMap};
 use super::tyre::TyreModel;
 use crate::car::{Car, DiffKind, Drive, G};
-use crate::track::Frame;
+use crate::track::{Bumps, Frame};
 
 /// Floor of the speed that normalises slip (m/s): keeps slip finite when standing.
 pub const SLIP_SPEED_FLOOR: f64 = 2.0;
@@ -148,6 +149,9 @@ pub struct State {
     pub clutch: f64,
     /// Time with the throttle open in first gear so far (s), the launch clutch's clock.
     pub launch_time: f64,
+    /// Each wheel's bounce over rough ground ([`super::bounce`]), front left, front right,
+    /// rear left, rear right.
+    pub bounce: [Bounce; 4],
 }
 
 impl State {
@@ -196,6 +200,18 @@ pub struct Vehicle {
     /// ([`Car::downforce`]: constant, 0.645·Clᵢ·A plus the wings', without a ride height; a
     /// function of the speed with one), linear in between, the last held beyond.
     downforce_per_v2: Vec<[f64; 2]>,
+    /// What moves a front and a rear wheel over rough ground ([`super::bounce`]); `None` for a
+    /// car without a suspension ([`Car::ride`]), which rides rough ground as smooth.
+    corners: Option<[Corner; 2]>,
+}
+
+/// What a wheel stands on: its surface's friction and rolling resistance coefficient, and the
+/// bumps it meets.
+#[derive(Debug, Clone, Copy)]
+struct Ground {
+    friction: f64,
+    rolling: f64,
+    bumps: Bumps,
 }
 
 impl Vehicle {
@@ -242,6 +258,15 @@ impl Vehicle {
                     })
                     .collect(),
             },
+            corners: car.ride.map(|ride| {
+                [0, 1].map(|k| Corner {
+                    rate: ride.rate[k],
+                    bellcrank: ride.bellcrank[k],
+                    damper: ride.dampers[k],
+                    inv_wheel_mass: 1.0 / ride.wheel_mass[k],
+                    inv_body_mass: G / ride.load[k],
+                })
+            }),
             tyres,
             radius: [car.front_tyre.radius, car.rear_tyre.radius],
             wheel_inertia: [2.0 * car.front_tyre.inertia, car.rear_tyre.inertia],
@@ -355,10 +380,12 @@ impl Vehicle {
         );
     }
 
-    /// Each wheel's surface, front left, front right, rear left, rear right: its friction and
-    /// rolling resistance coefficient (the tyres' where the surface gives none); `None` while
-    /// all four stand on the road, as they do whenever the road has no verges of its own
-    /// ([`Frame::has_verges`]) or the car is more than its reach inside both edges.
+    /// Each wheel's ground, front left, front right, rear left, rear right: its surface's
+    /// friction and rolling resistance coefficient (the tyres' where the surface gives none),
+    /// and the bumps of a rough road under it ([`crate::track::Roughness::plain`], t = l + w/2 from the
+    /// road's right edge, at the station s + a); `None` while all four stand on a smooth road,
+    /// as they do whenever the road has no verges of its own ([`Frame::has_verges`]) or the car
+    /// is more than its reach inside both edges.
     ///
     /// As simuv2's `wheel.cpp` (`SimWheelUpdateRide`: `RtTrackGlobal2Local` of the wheel's
     /// position, then the segment's `surface->kFriction` and `kRollRes`), a wheel takes the
@@ -368,39 +395,55 @@ impl Vehicle {
     /// a = d·t + x_w·cos e − y_w·sin e along the road and l = d·n + x_w·sin e + y_w·cos e − κa²/2
     /// to the left of the centre line (the projection's second-order arc correction,
     /// [`crate::track::Track::project`]); past an edge by l − w/2 > 0 (or −l − w/2 on the
-    /// right) it is on that side's [`crate::track::Verge`], border then side.
+    /// right) it is on that side's [`crate::track::Verge`], border then side. A verge's own
+    /// roughness is left out: smoothing the verges in the game changes none of 42 laps'
+    /// outcomes, while adding them to cdbo's changes 10, 6 of them away from the game's
+    /// (docs/results/torcs.md, "The road's roughness").
     #[inline]
-    fn wheel_surfaces(&self, s: &State, f: &Frame) -> Option<[(f64, f64); 4]> {
-        if !f.has_verges {
+    fn wheel_ground(&self, s: &State, f: &Frame) -> Option<[Ground; 4]> {
+        let rough_road = f.roughness.is_rough() && self.corners.is_some();
+        if !f.has_verges && !rough_road {
             return None;
         }
         let (along, lateral) = f.local(s.x, s.y);
         let far = along.abs() + self.reach;
-        if lateral.abs() + self.reach + 0.5 * f.curvature.abs() * far * far < f.half_width {
+        if lateral.abs() + self.reach + 0.5 * f.curvature.abs() * far * far < f.half_width
+            && !rough_road
+        {
             return None;
         }
         let (se, ce) = f.relative_heading(s.yaw_sin_cos);
-        let road = (f.friction, f.rolling_resistance.unwrap_or(self.rolling));
+        let road_rolling = f.rolling_resistance.unwrap_or(self.rolling);
         let [yf, yr] = self.car.axles.half_track;
         let wheels = [(self.a, yf), (self.a, -yf), (-self.b, yr), (-self.b, -yr)];
-        let mut out = [road; 4];
+        let mut out = [Ground {
+            friction: f.friction,
+            rolling: road_rolling,
+            bumps: Bumps::NONE,
+        }; 4];
         let mut off = false;
         for (i, (xw, yw)) in wheels.into_iter().enumerate() {
             let a = along + xw * ce - yw * se;
             let l = lateral + xw * se + yw * ce - 0.5 * f.curvature * a * a;
             let excess = l.abs() - f.half_width;
-            if excess > 0.0 {
-                let verge = &f.verges[if l > 0.0 { 0 } else { 1 }];
-                if let Some(surface) = verge.surface_at(excess) {
-                    out[i] = (
-                        surface.friction,
-                        surface.rolling_resistance.unwrap_or(self.rolling),
-                    );
+            let verge = &f.verges[if l > 0.0 { 0 } else { 1 }];
+            match verge.surface_at(excess).filter(|_| excess > 0.0) {
+                Some(surface) => {
+                    out[i] = Ground {
+                        friction: surface.friction,
+                        rolling: surface.rolling_resistance.unwrap_or(self.rolling),
+                        bumps: Bumps::NONE,
+                    };
                     off = true;
                 }
+                None if rough_road => {
+                    // simuv2's t: the distance from the road's right edge.
+                    out[i].bumps = f.roughness.plain(f.s + a, l + f.half_width);
+                }
+                None => {}
             }
         }
-        off.then_some(out)
+        (off || rough_road).then_some(out)
     }
 
     fn driven_omega(&self, s: &State) -> f64 {
@@ -435,11 +478,30 @@ impl Vehicle {
         };
         let (front_loads, rear_loads) = (wheel_loads(0), wheel_loads(1));
         // Each wheel's surface: the road's, or a verge's past the road's edge.
-        let surfaces = self.wheel_surfaces(s, frame);
-        let friction = match &surfaces {
+        let ground = self.wheel_ground(s, frame);
+        let mut friction = match &ground {
             None => [frame.friction; 4],
-            Some(w) => w.map(|(f, _)| f),
+            Some(w) => w.map(|g| g.friction),
         };
+        // The wheels' bounce over rough ground takes some of their grip.
+        if let Some(corners) = &self.corners {
+            let loads = [front_loads[0], front_loads[1], rear_loads[0], rear_loads[1]];
+            for (i, f) in friction.iter_mut().enumerate() {
+                let bumps = ground.map_or(Bumps::NONE, |w| w[i].bumps);
+                if bumps.amplitude != 0.0 || !s.bounce[i].settled() {
+                    let k = i / 2;
+                    *f *= bounce::step(
+                        &mut s.bounce[i],
+                        &corners[k],
+                        loads[i],
+                        &bumps,
+                        s.vx,
+                        dt,
+                        &self.tyres[k],
+                    );
+                }
+            }
+        }
 
         // Wheel-frame velocities of the front (steered) axle and the rear wheels, the left one
         // at y = +y_r (simuv2's `car.cpp`: vₓ − r·y).
@@ -614,10 +676,10 @@ impl Vehicle {
         // the road's c_rr·(F_zf + F_zr) plus Σᵢ (c_rr,i − c_rr)·F_z,i.
         let c_rr = frame.rolling_resistance.unwrap_or(self.rolling) * self.rolling_scale;
         let mut rolling_force = c_rr * (fz[0] + fz[1]);
-        if let Some(w) = &surfaces {
+        if let Some(w) = &ground {
             let loads = [front_loads[0], front_loads[1], rear_loads[0], rear_loads[1]];
-            for (i, (_, c)) in w.iter().enumerate() {
-                rolling_force += (c * self.rolling_scale - c_rr) * loads[i];
+            for (i, g) in w.iter().enumerate() {
+                rolling_force += (g.rolling * self.rolling_scale - c_rr) * loads[i];
             }
         }
         let roll = rolling_force * (s.vx / 0.5).clamp(-1.0, 1.0);
@@ -927,10 +989,11 @@ mod tests {
         let border = Surface {
             friction: 0.4,
             rolling_resistance: Some(0.05),
+            ..Surface::PLAIN
         };
         let sand = Surface {
             friction: 0.6,
-            rolling_resistance: None,
+            ..Surface::PLAIN
         };
         let piece = Piece {
             verges: [
@@ -953,7 +1016,8 @@ mod tests {
         let at = |y: f64, yaw: f64| {
             let mut s = v.at_rest(100.0, y, yaw);
             s.yaw_sin_cos = yaw.sin_cos();
-            v.wheel_surfaces(&s, &frame)
+            v.wheel_ground(&s, &frame)
+                .map(|w| w.map(|g| (g.friction, g.rolling)))
         };
         let (road, rr) = (1.0, v.rolling);
         assert_eq!(at(0.0, 0.0), None);
@@ -972,7 +1036,7 @@ mod tests {
         let plain = Track::from_pieces("plain", "test", &[Piece::flat(500.0, 0.0)], vec![]);
         let mut s = v.at_rest(100.0, 5.5, 0.0);
         s.yaw_sin_cos = (0.0, 1.0);
-        assert_eq!(v.wheel_surfaces(&s, plain.frame(100)), None);
+        assert!(v.wheel_ground(&s, plain.frame(100)).is_none());
     }
 
     /// The lateral load transfer takes the roll moment up: the axles' transfers ΔF_a at ±y_a

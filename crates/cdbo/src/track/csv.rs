@@ -238,6 +238,7 @@ fn build(rows: &[[f64; 4]], name: &str, file: &str) -> Result<Track> {
             width: sw.eval(ti).0,
             friction: 1.0,
             rolling_resistance: None,
+            roughness: super::Roughness::NONE,
             verges: [super::Verge::NONE; 2],
         });
     }

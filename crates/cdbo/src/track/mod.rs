@@ -39,19 +39,119 @@ pub struct Sample {
     /// simuv2 takes it from the road, F = c_rr·F_z), when the track names one; else the
     /// car's tyres give it.
     pub rolling_resistance: Option<f64>,
+    /// The road surface's roughness ([`Roughness`]; TORCS `roughness`).
+    #[serde(skip)]
+    pub roughness: Roughness,
     /// What lies past the road's left and right edges ([`Verge`]), `[left, right]`.
     #[serde(skip)]
     pub verges: [Verge; 2],
 }
 
-/// A surface a wheel can stand on: its TORCS `friction` and `rolling resistance` (`None`: the
-/// car's tyres give the rolling resistance).
+/// A surface a wheel can stand on: its TORCS `friction`, `rolling resistance` (`None`: the
+/// car's tyres give the rolling resistance) and roughness.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Surface {
     /// Friction coefficient, scales the tyre's grip.
     pub friction: f64,
     /// Rolling resistance coefficient, F = c_rr·F_z, if the track gives one.
     pub rolling_resistance: Option<f64>,
+    /// Its roughness.
+    pub roughness: Roughness,
+}
+
+impl Surface {
+    /// Friction 1, the tyres' rolling resistance, smooth.
+    pub const PLAIN: Surface = Surface {
+        friction: 1.0,
+        rolling_resistance: None,
+        roughness: Roughness::NONE,
+    };
+}
+
+/// A surface's roughness as TORCS's simuv2 lays it under the wheels (`RtTrackHeightL`): the
+/// ground under a wheel at distance l along its segment and t across it (from the segment's
+/// right edge) stands h = A·sin(k·t)·sin(k·l) above the smooth surface, A = R/2 and k = 2π/λ
+/// of the file's `roughness` R and `roughness wavelength` λ (`track4.cpp`: `kRoughness`,
+/// `kRoughWaveLen`). Most roads are smooth; Aalborg's is R = 0.7 to 1.5 cm at λ = 0.7 to
+/// 0.9 m in places, G-Track 1's 1 cm at 1 m; grass is 5 cm at 0.5 m. The wheels' bounce over
+/// a rough road ([`crate::sim::bounce`]) costs grip.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Roughness {
+    /// Amplitude A (m).
+    pub amplitude: f64,
+    /// Wavenumber k (rad/m).
+    pub wavenumber: f64,
+}
+
+impl Roughness {
+    /// A smooth surface.
+    pub const NONE: Roughness = Roughness {
+        amplitude: 0.0,
+        wavenumber: 0.0,
+    };
+
+    /// From a file's `roughness` R and `roughness wavelength` λ > 0 (m): A = R/2, k = 2π/λ.
+    pub fn from_file(roughness: f64, wavelength: f64) -> Roughness {
+        Roughness {
+            amplitude: 0.5 * roughness,
+            wavenumber: std::f64::consts::TAU / wavelength,
+        }
+    }
+
+    /// Whether it is rough enough to feel: an amplitude of [`FELT_ROUGHNESS_M`] or more.
+    #[inline]
+    pub fn is_rough(&self) -> bool {
+        self.amplitude >= FELT_ROUGHNESS_M
+    }
+
+    /// The bumps a wheel meets along its path on this surface, t metres across it from its
+    /// right edge (a plain surface: A·sin(k·t) is the amplitude along), l metres along.
+    #[inline]
+    pub fn plain(&self, along: f64, across: f64) -> Bumps {
+        Bumps {
+            amplitude: self.amplitude * (self.wavenumber * across).sin(),
+            wavenumber: self.wavenumber,
+            along,
+        }
+    }
+}
+
+/// The smallest amplitude A of a surface's roughness cdbo's car feels (m): half a millimetre.
+/// Below it the wheels' bounce takes less than 0.2 % of their grip up to 80 m/s (E-Track 2's
+/// and E-Track 3's roads, A = 0.25 mm at λ = 2 m) and would triple the cost of the physics
+/// step on those tracks; at A = 0.5 mm it takes 0.7 % at 80 m/s (car1-trb1 at λ of 1 to 2 m),
+/// at Aalborg's 7.5 mm (λ = 0.7 m) 6 % at 20 m/s and 12 % at 60 to 80 m/s.
+pub const FELT_ROUGHNESS_M: f64 = 0.0005;
+
+/// The ground's height along a wheel's path over a rough surface, h(δ) = a·sin(k·(l + δ)) at δ
+/// metres past where the wheel stands (l along the surface): [`Roughness::plain`] or
+/// [`Roughness::kerb`] at the wheel's place.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Bumps {
+    /// The amplitude a (m) across the wheel's path.
+    pub amplitude: f64,
+    /// The wavenumber k (rad/m).
+    pub wavenumber: f64,
+    /// Where the wheel stands along the surface, l (m).
+    pub along: f64,
+}
+
+impl Bumps {
+    /// None: a smooth surface.
+    pub const NONE: Bumps = Bumps {
+        amplitude: 0.0,
+        wavenumber: 0.0,
+        along: 0.0,
+    };
+
+    /// h(δ) (m).
+    #[inline]
+    pub fn height(&self, ahead: f64) -> f64 {
+        if self.amplitude == 0.0 {
+            return 0.0;
+        }
+        self.amplitude * (self.wavenumber * (self.along + ahead)).sin()
+    }
 }
 
 /// What lies past one edge of the road, as TORCS's `track4.cpp` builds it (`AddSides`): next
@@ -81,15 +181,9 @@ impl Verge {
     /// CSV tracks, TORCS version-3 files).
     pub const NONE: Verge = Verge {
         border_width: 0.0,
-        border: Surface {
-            friction: 1.0,
-            rolling_resistance: None,
-        },
+        border: Surface::PLAIN,
         side_width: 0.0,
-        side: Surface {
-            friction: 1.0,
-            rolling_resistance: None,
-        },
+        side: Surface::PLAIN,
         barrier: false,
     };
 
@@ -156,6 +250,8 @@ pub struct Frame {
     pub friction: f64,
     /// The surface's rolling resistance coefficient, if the track gives one.
     pub rolling_resistance: Option<f64>,
+    /// The road surface's roughness.
+    pub roughness: Roughness,
     /// What lies past the road's left and right edges, `[left, right]`.
     pub verges: [Verge; 2],
     /// Whether either verge differs from the road: a border or side of its own.
@@ -221,6 +317,7 @@ impl Frame {
             half_width: 0.5 * c.width,
             friction: c.friction,
             rolling_resistance: c.rolling_resistance,
+            roughness: c.roughness,
             verges: c.verges,
             has_verges: c
                 .verges
@@ -495,6 +592,7 @@ impl Track {
                     width: p.width,
                     friction: p.friction,
                     rolling_resistance: p.rolling_resistance,
+                    roughness: p.roughness,
                     verges: p.verges,
                 });
                 i += 1;
@@ -575,6 +673,8 @@ pub struct Piece {
     pub friction: f64,
     /// Surface rolling resistance, if the track gives one.
     pub rolling_resistance: Option<f64>,
+    /// The surface's roughness.
+    pub roughness: Roughness,
     /// What lies past the left and right edges, `[left, right]`.
     pub verges: [Verge; 2],
 }
@@ -593,6 +693,7 @@ impl Piece {
             width: 12.0,
             friction: 1.0,
             rolling_resistance: None,
+            roughness: Roughness::NONE,
             verges: [Verge::NONE; 2],
         }
     }

@@ -16,8 +16,9 @@
 //!   segment) gives z_end = z_start + length·grade; left and right edges follow cubic Hermite
 //!   profiles with `profil start/end tangent`; `banking start/end` override the edge heights.
 //!   Banking is atan((z_left − z_right) / width).
-//! - Road friction and rolling resistance are the `friction` and `rolling resistance` of the
-//!   segment's `surface` in the `Surfaces` section (simuv2 takes both from the road).
+//! - Road friction, rolling resistance and roughness are the `friction`, `rolling resistance`
+//!   and `roughness` / `roughness wavelength` of the segment's `surface` in the `Surfaces`
+//!   section (simuv2 takes all three from the road; [`super::Roughness`]).
 //! - Past each edge (version 4 and up; `track4.cpp`'s `InitSides` and `AddSides`), a border and
 //!   a side ([`super::Verge`]): `Main Track/Left Border` (`width`, default 0; `surface`,
 //!   default `grass`) and `Main Track/Left Side` (`width`, default 0; `surface`, default
@@ -32,7 +33,7 @@ use std::path::Path;
 
 use std::collections::HashMap;
 
-use super::{Ends, MAX_LENGTH_M, Piece, Surface, Track, Verge};
+use super::{Ends, MAX_LENGTH_M, Piece, Roughness, Surface, Track, Verge};
 use crate::bounded;
 use crate::error::Result;
 use crate::params::{Params, Section};
@@ -79,14 +80,14 @@ pub fn from_params(params: &Params, source: &str, ends: Ends) -> Result<Track> {
         if let Some(name) = seg.str("surface") {
             surface = name.to_owned();
         }
-        let friction = surface_friction(params, &surface, &mut warnings, false)?;
+        let road = surface_of(params, &surface, &mut warnings, false)?;
         let first = pieces.len();
         segment_pieces(
             params,
             seg,
             width,
             global_step,
-            friction,
+            road,
             &mut state,
             &mut pieces,
         )?;
@@ -175,54 +176,78 @@ impl Layout {
     }
 }
 
-/// Friction and rolling resistance of a named surface (in `Surfaces` or, for version 3,
-/// `Surfaces/List`); friction 1.0 and the tyres' rolling resistance, with a warning, when the
-/// surface is not defined. A road's friction must be positive; a verge's may be 0 (the
-/// `armco` and `barrier` of a wall that stands as a border: Brondehach, Corkscrew).
-fn surface_friction(
+/// A named surface (in `Surfaces` or, for version 3, `Surfaces/List`): its friction, rolling
+/// resistance and roughness; friction 1.0, the tyres' rolling resistance and a smooth surface,
+/// with a warning, when the surface is not defined. A road's friction must be positive; a
+/// verge's may be 0 (the `armco` and `barrier` of a wall that stands as a border: Brondehach,
+/// Corkscrew). The roughness must be ≥ 0 and its wavelength positive.
+fn surface_of(
     params: &Params,
     surface: &str,
     warnings: &mut Vec<String>,
     verge: bool,
-) -> Result<(f64, Option<f64>)> {
+) -> Result<Surface> {
     let surfaces = params.section("Surfaces");
     let found = surfaces
         .and_then(|s| s.section(surface))
         .or_else(|| surfaces.and_then(|s| s.section("List")?.section(surface)));
-    match found {
-        Some(sec) => {
-            let f = sec.num_or("friction", 1.0)?;
-            if f < 0.0 || (f == 0.0 && !verge) || !f.is_finite() {
-                return Err(params.error(
-                    &format!("{}/friction", sec.path),
-                    Some(sec.line_of("friction")),
-                    format!("friction must be positive, got {f}"),
-                ));
-            }
-            let rolling = match sec.num("rolling resistance")? {
-                Some(r) if !(0.0..1.0).contains(&r) => {
-                    return Err(params.error(
-                        &format!("{}/rolling resistance", sec.path),
-                        Some(sec.line_of("rolling resistance")),
-                        format!("rolling resistance must be in [0, 1), got {r}"),
-                    ));
-                }
-                r => r,
-            };
-            Ok((f, rolling))
+    let Some(sec) = found else {
+        let w = format!(
+            "{}: surface {surface:?} is not defined, friction 1.0 assumed",
+            params.file
+        );
+        if !warnings.contains(&w) {
+            warnings.push(w);
         }
-        None => {
-            let w = format!(
-                "{}: surface {surface:?} is not defined, friction 1.0 assumed",
-                params.file
-            );
-            if !warnings.contains(&w) {
-                warnings.push(w);
-            }
-            Ok((1.0, None))
-        }
+        return Ok(Surface::PLAIN);
+    };
+    let refuse = |field: &str, msg: String| {
+        params.error(
+            &format!("{}/{field}", sec.path),
+            Some(sec.line_of(field)),
+            msg,
+        )
+    };
+    let friction = sec.num_or("friction", 1.0)?;
+    if friction < 0.0 || (friction == 0.0 && !verge) || !friction.is_finite() {
+        return Err(refuse(
+            "friction",
+            format!("friction must be positive, got {friction}"),
+        ));
     }
+    let rolling_resistance = match sec.num("rolling resistance")? {
+        Some(r) if !(0.0..1.0).contains(&r) => {
+            return Err(refuse(
+                "rolling resistance",
+                format!("rolling resistance must be in [0, 1), got {r}"),
+            ));
+        }
+        r => r,
+    };
+    let roughness = sec.num_or("roughness", 0.0)?;
+    if !(0.0..=MAX_ROUGHNESS_M).contains(&roughness) {
+        return Err(refuse(
+            "roughness",
+            format!("roughness must be in [0, {MAX_ROUGHNESS_M}] m, got {roughness} m"),
+        ));
+    }
+    let wavelength = sec.num_or("roughness wavelength", 1.0)?;
+    if !(wavelength > 0.0 && wavelength.is_finite()) {
+        return Err(refuse(
+            "roughness wavelength",
+            format!("roughness wavelength must be positive, got {wavelength} m"),
+        ));
+    }
+    Ok(Surface {
+        friction,
+        rolling_resistance,
+        roughness: Roughness::from_file(roughness, wavelength),
+    })
 }
+
+/// The roughest surface a file may give (m): TORCS's roughest, gravel's, is 6 cm; a metre is a
+/// mistake in the file (a unit left out), not a surface.
+const MAX_ROUGHNESS_M: f64 = 1.0;
 
 /// A named surface, looked up once per track.
 fn resolve(
@@ -234,11 +259,7 @@ fn resolve(
     if let Some(s) = cache.get(name) {
         return Ok(*s);
     }
-    let (friction, rolling_resistance) = surface_friction(params, name, warnings, true)?;
-    let s = Surface {
-        friction,
-        rolling_resistance,
-    };
+    let s = surface_of(params, name, warnings, true)?;
     cache.insert(name.to_owned(), s);
     Ok(s)
 }
@@ -379,7 +400,7 @@ fn segment_pieces(
     seg: &Section,
     width: f64,
     global_step: f64,
-    (friction, rolling_resistance): (f64, Option<f64>),
+    road: Surface,
     st: &mut ProfileState,
     out: &mut Vec<Piece>,
 ) -> Result<()> {
@@ -542,8 +563,9 @@ fn segment_pieces(
             banking0: (zl0 - zr0).atan2(width),
             banking1: (zl1 - zr1).atan2(width),
             width,
-            friction,
-            rolling_resistance,
+            friction: road.friction,
+            rolling_resistance: road.rolling_resistance,
+            roughness: road.roughness,
             verges: [Verge::NONE; 2],
         });
         (zl0, zr0) = (zl1, zr1);
@@ -557,6 +579,7 @@ fn segment_pieces(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::TAU;
 
     #[test]
     fn hermite_meets_its_ends_and_slopes() {
@@ -673,7 +696,9 @@ mod tests {
         let xml = format!(
             r#"<params><section name="Surfaces">
                  <section name="kerb"><attnum name="friction" val="0.4"/>
-                   <attnum name="rolling resistance" val="0.05"/></section>
+                   <attnum name="rolling resistance" val="0.05"/>
+                   <attnum name="roughness" unit="cm" val="5"/>
+                   <attnum name="roughness wavelength" val="0.3"/></section>
                  <section name="sand"><attnum name="friction" val="0.6"/></section></section>
                <section name="Header"><attnum name="version" val="4"/></section>
                <section name="Main Track"><attnum name="width" val="10"/>
@@ -708,10 +733,15 @@ mod tests {
         assert_eq!(left.surface_at(1.0).unwrap().friction, 0.4);
         assert_eq!(left.surface_at(3.0).unwrap().friction, 0.4);
         assert_eq!(right.surface_at(0.5).unwrap().friction, 0.6);
+        // The kerb's 5 cm at 0.3 m: A = 2.5 cm, k = 2π/0.3; the sand is smooth.
+        let r = left.border.roughness;
+        assert!((r.amplitude - 0.025).abs() < 1e-15 && (r.wavenumber - TAU / 0.3).abs() < 1e-12);
+        assert!(!right.side.roughness.is_rough());
         // Segment b: no border; a side narrowing from 4 m to 0 over its 11 steps, step 0 at
         // 4·(1 − 0.5/11).
         let [left, right] = at(104.0);
         assert_eq!(left.border_width, 0.0);
+
         assert!(
             (left.side_width - 4.0 * (1.0 - 0.5 / 11.0)).abs() < 1e-9,
             "{left:?}"
@@ -726,6 +756,41 @@ mod tests {
         let barriers = |s: f64| t.frame(t.index_at(s)).barriers;
         assert_eq!(barriers(50.0), [5.0 + 2.0, 5.0 + 5.0]);
         assert_eq!(barriers(250.0), [5.0, 5.0 + 5.0]);
+    }
+
+    /// A roughness past its bound or a wavelength of 0 is refused, naming the surface's
+    /// element and the value.
+    #[test]
+    fn a_rough_surface_out_of_bounds_is_refused() {
+        for (field, val, says) in [
+            (
+                "roughness",
+                "-0.01",
+                "roughness must be in [0, 1] m, got -0.01 m",
+            ),
+            ("roughness", "2", "roughness must be in [0, 1] m, got 2 m"),
+            (
+                "roughness wavelength",
+                "0",
+                "roughness wavelength must be positive, got 0 m",
+            ),
+        ] {
+            let xml = format!(
+                r#"<params><section name="Surfaces"><section name="asphalt">
+                   <attnum name="{field}" val="{val}"/></section></section>
+                   <section name="Main Track"><section name="Track Segments">
+                   <section name="a">{STRAIGHT}</section></section></section></params>"#
+            );
+            let p = Params::parse(&xml, "rough.xml", None).unwrap();
+            let e = from_params(&p, "rough.xml", Ends::MayMiss)
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.starts_with(&format!("rough.xml:2: Surfaces/asphalt/{field}"))
+                    && e.contains(says),
+                "{e}"
+            );
+        }
     }
 
     #[test]
