@@ -211,10 +211,14 @@ fn the_ceilings_policy_is_written_and_drives_its_lap() {
     assert_eq!(file["weights"].as_array().unwrap().len(), 30);
     let lap = json(&ok(&dir, &["lap", "--policy", "c.json", "--json"]));
     assert_eq!(lap["reward_mps"], ceiling["policy_mps"]);
-    refused(
-        &dir,
-        &["ceiling", "--kernels", "2", "--out", "none.json"],
-        &["none.json", "no fitted policy"],
-    );
+    // A fit that completes no lap: refused in one line naming the file, nothing written, and
+    // the ceiling's figures still printed.
+    let args = ["ceiling", "--kernels", "2", "--out", "none.json"];
+    refused(&dir, &args, &["none.json", "no fitted policy"]);
     assert!(!dir.join("none.json").exists());
+    let printed = String::from_utf8_lossy(&common::cdbo(&dir, &args).stdout).into_owned();
+    assert!(
+        printed.contains("limit") && printed.contains("none completes within"),
+        "{printed}"
+    );
 }

@@ -69,6 +69,15 @@ pub fn run(args: &CeilingArgs, data: &DataPath) -> CliResult {
     sim.config.steering = args.steering.steering();
     sim.config.line = line;
     let c = ceiling_with(&sim, &limit, &profile, args.kernels)?;
+    if args.json {
+        print_json(&CeilingReport {
+            ceiling: &c,
+            centre_line_limit_mps: centre_mps,
+        })?;
+    } else {
+        print_summary(&c, &car.name, &name, which, centre_mps);
+    }
+    // The figures are printed first: a fit that completes no lap still reports its ceiling.
     if let Some(out) = &args.out {
         let Some(policy) = &c.policy else {
             return Err(format!(
@@ -86,12 +95,17 @@ pub fn run(args: &CeilingArgs, data: &DataPath) -> CliResult {
         std::fs::write(out, serde_json::to_string_pretty(&raced)?)
             .map_err(|e| format!("{}: {e}", out.display()))?;
     }
-    if args.json {
-        return print_json(&CeilingReport {
-            ceiling: &c,
-            centre_line_limit_mps: centre_mps,
-        });
-    }
+    Ok(())
+}
+
+/// The one-line report: the limit, the tracked profile's lap and the fitted policy's.
+fn print_summary(
+    c: &cdbo::ceiling::Ceiling,
+    car: &str,
+    track: &str,
+    which: &str,
+    centre_mps: Option<f64>,
+) {
     let of_centre = centre_mps.map_or(String::new(), |v| {
         format!(
             ", {:.1} % of the centre-line limit {v:.2} m/s",
@@ -110,9 +124,7 @@ pub fn run(args: &CeilingArgs, data: &DataPath) -> CliResult {
         format!("none completes within {} laps", cdbo::ceiling::REPAIR_LAPS)
     };
     println!(
-        "{} on {}: {which} limit {:.2} m/s; tracking {:.3} x the crest-aware limit's speed profile (its lap {:.2} m/s): {:.2} m/s ({:.1} % of the {which} limit{of_centre}); {}-kernel policy fitted to its pedal, repaired where it fails: {}",
-        car.name,
-        name,
+        "{car} on {track}: {which} limit {:.2} m/s; tracking {:.3} x the crest-aware limit's speed profile (its lap {:.2} m/s): {:.2} m/s ({:.1} % of the {which} limit{of_centre}); {}-kernel policy fitted to its pedal, repaired where it fails: {}",
         c.limit_mps,
         c.k,
         c.profile_mps,
@@ -121,5 +133,4 @@ pub fn run(args: &CeilingArgs, data: &DataPath) -> CliResult {
         c.kernels,
         policy
     );
-    Ok(())
 }
