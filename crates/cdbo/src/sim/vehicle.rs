@@ -382,10 +382,10 @@ impl Vehicle {
 
     /// Each wheel's ground, front left, front right, rear left, rear right: its surface's
     /// friction and rolling resistance coefficient (the tyres' where the surface gives none),
-    /// and the bumps of a rough road under it ([`crate::track::Roughness::plain`], t = l + w/2 from the
-    /// road's right edge, at the station s + a); `None` while all four stand on a smooth road,
-    /// as they do whenever the road has no verges of its own ([`Frame::has_verges`]) or the car
-    /// is more than its reach inside both edges.
+    /// and the bumps of a rough road under it ([`crate::track::Roughness::plain`] at
+    /// t = l + w/2 from the road's right edge and the station s + a); `None` while all four
+    /// stand on a smooth road, as they do whenever the road has no verges of its own
+    /// ([`Frame::has_verges`]) or the car is more than its reach inside both edges.
     ///
     /// As simuv2's `wheel.cpp` (`SimWheelUpdateRide`: `RtTrackGlobal2Local` of the wheel's
     /// position, then the segment's `surface->kFriction` and `kRollRes`), a wheel takes the
@@ -427,7 +427,12 @@ impl Vehicle {
             let l = lateral + xw * se + yw * ce - 0.5 * f.curvature * a * a;
             let excess = l.abs() - f.half_width;
             let verge = &f.verges[if l > 0.0 { 0 } else { 1 }];
-            match verge.surface_at(excess).filter(|_| excess > 0.0) {
+            let off_road = if excess > 0.0 {
+                verge.surface_at(excess)
+            } else {
+                None
+            };
+            match off_road {
                 Some(surface) => {
                     out[i] = Ground {
                         friction: surface.friction,
