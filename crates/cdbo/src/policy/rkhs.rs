@@ -223,18 +223,23 @@ pub fn features_into(x: f64, lengthscale: f64, out: &mut [f64]) {
     }
 }
 
+/// The narrowest policy kernel (a fraction of the lap): a millionth, millimetres on any track.
+/// Far narrower ones overflow: |x − xᵢ|/ℓ is infinite for a length-scale of 1e-308, and the
+/// kernel (1 + √3·r)·e^(−√3·r) then NaN.
+pub const MIN_LENGTHSCALE: f64 = 1e-6;
+
 /// Refuses fewer than 2 kernels (or more than the size bound) and a length-scale that is not
-/// finite and positive.
+/// finite or below [`MIN_LENGTHSCALE`].
 pub(crate) fn check_shape(kernels: usize, lengthscale: f64) -> Result<()> {
     if kernels < 2 {
         return Err(Error::too_small("policy kernels", kernels, 2));
     }
     crate::sizes::KERNELS.checked(kernels)?;
-    if !(lengthscale.is_finite() && lengthscale > 0.0) {
+    if !(lengthscale.is_finite() && lengthscale >= MIN_LENGTHSCALE) {
         return Err(Error::invalid_value(
             "the policy length-scale",
-            lengthscale,
-            "positive",
+            format!("{lengthscale:?}"),
+            format!("finite and at least {MIN_LENGTHSCALE:?} of the lap"),
         ));
     }
     Ok(())
@@ -328,5 +333,20 @@ mod tests {
         assert!(RkhsPolicy::fit(&[(f64::NAN, 0.1)], 10, 0.1, 1e-3).is_err());
         assert!(RkhsPolicy::fit(&[(0.5, 0.1)], 10, -1.0, 1e-3).is_err());
         assert!(RkhsPolicy::new(vec![0.0, f64::INFINITY], 0.5).is_err());
+        // A length-scale so small that |x − xᵢ|/ℓ overflows (the fuzzer's 9e-319) is refused,
+        // naming the bound; the narrowest allowed gives finite actions everywhere.
+        let e = RkhsPolicy::new(vec![0.1, 0.0], 9e-319)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("length-scale") && e.contains("at least 1e-6") && e.contains("9e-319"),
+            "{e}"
+        );
+        let narrow = RkhsPolicy::new(vec![0.1, 0.0], MIN_LENGTHSCALE).unwrap();
+        assert!(
+            [0.0, 0.37, 1.0]
+                .iter()
+                .all(|&x| narrow.action(x).is_finite())
+        );
     }
 }
