@@ -33,7 +33,7 @@
 //! is computed: a track without a rough road drives as before.
 
 use super::tyre::TyreModel;
-use crate::car::Damper;
+use crate::car::{Damper, G, Ride};
 use crate::track::Bumps;
 
 /// simuv2's step (s): `RCM_MAX_DT_SIMU`.
@@ -73,6 +73,19 @@ pub struct Corner {
     pub inv_wheel_mass: f64,
     /// 1 / the body's mass over the wheel, m_c = F₀/g (1/kg).
     pub inv_body_mass: f64,
+}
+
+impl Corner {
+    /// A front (`axle` 0) or rear (1) wheel of a car with this suspension.
+    pub fn of(ride: &Ride, axle: usize) -> Corner {
+        Corner {
+            rate: ride.rate[axle],
+            bellcrank: ride.bellcrank[axle],
+            damper: ride.dampers[axle],
+            inv_wheel_mass: 1.0 / ride.wheel_mass[axle],
+            inv_body_mass: G / ride.load[axle],
+        }
+    }
 }
 
 /// One of simuv2's steps `dt` with the ground `h` above the smooth surface under the wheel:
@@ -137,7 +150,6 @@ pub fn step(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::car::G;
     use crate::car::tests::on_springs;
     use crate::track::Roughness;
 
@@ -145,13 +157,7 @@ mod tests {
     fn front() -> (Corner, TyreModel, f64) {
         let car = on_springs();
         let ride = car.ride.unwrap();
-        let corner = Corner {
-            rate: ride.rate[0],
-            bellcrank: ride.bellcrank[0],
-            damper: ride.dampers[0],
-            inv_wheel_mass: 1.0 / ride.wheel_mass[0],
-            inv_body_mass: G / ride.load[0],
-        };
+        let corner = Corner::of(&ride, 0);
         (corner, TyreModel::new(&car.front_tyre), ride.load[0])
     }
 

@@ -258,15 +258,7 @@ impl Vehicle {
                     })
                     .collect(),
             },
-            corners: car.ride.map(|ride| {
-                [0, 1].map(|k| Corner {
-                    rate: ride.rate[k],
-                    bellcrank: ride.bellcrank[k],
-                    damper: ride.dampers[k],
-                    inv_wheel_mass: 1.0 / ride.wheel_mass[k],
-                    inv_body_mass: G / ride.load[k],
-                })
-            }),
+            corners: car.ride.map(|ride| [0, 1].map(|k| Corner::of(&ride, k))),
             tyres,
             radius: [car.front_tyre.radius, car.rear_tyre.radius],
             wheel_inertia: [2.0 * car.front_tyre.inertia, car.rear_tyre.inertia],
