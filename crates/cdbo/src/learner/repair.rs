@@ -82,6 +82,18 @@ impl PedalRepair {
     /// within one spacing and asked for the other direction, or restoring δ₀ if it lay more
     /// than one spacing before x_f.
     pub fn repair(&mut self, targets: &mut [(f64, f64)], x_fail: f64, too_slow: bool) {
+        self.repair_over(targets, x_fail, too_slow, self.window());
+    }
+
+    /// [`repair`](Self::repair) over the `stretch` (lap fraction) before x_f instead of the
+    /// window.
+    pub fn repair_over(
+        &mut self,
+        targets: &mut [(f64, f64)],
+        x_fail: f64,
+        too_slow: bool,
+        stretch: f64,
+    ) {
         let direction = if too_slow { 1.0 } else { -1.0 };
         match self.last {
             Some((x, d)) if (x_fail - x).abs() < self.spacing && d != direction => {
@@ -91,7 +103,7 @@ impl PedalRepair {
             _ => self.step = self.first,
         }
         self.last = Some((x_fail, direction));
-        let from = x_fail - self.window();
+        let from = x_fail - stretch;
         for (x, a) in targets.iter_mut() {
             if (from..=x_fail).contains(x) {
                 *a += direction * self.step;

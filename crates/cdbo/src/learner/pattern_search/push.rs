@@ -19,6 +19,18 @@
 //! 34.09 / 35.56 / 35.61 / 35.53 m/s against 34.86 for two spacings, and holding the lowered
 //! targets kept 35.62 m/s with 11 fewer failed laps a run.
 //!
+//! **Not through the corner before.** Where corners come close, 275 m before a failure reach
+//! back over the previous corner and the straight between, and lower a pedal the car needed
+//! there. The stretch before a failure at x_f is therefore
+//! min([`REPAIR_DISTANCE`], max(2/(M − 1), ½·(x_f − x_p))) with x_p the nearest place before
+//! x_f, by more than [`SAME_PLACE`], where the pushes failed (the start line if none): at most half
+//! the road back to the last corner the car was too fast for, but never less than the pedal's
+//! own resolution, two kernel spacings. Measured (car1-trb1, tracker on the minimum-curvature
+//! line, 50 kernels, seeds 0–2, cdbo's simulator): Aalborg 85.80 → 79.05 s, E-Track 2 128.06 →
+//! 126.96 s, Forza 96.48 → 96.26 s, Forza with 100 kernels 98.44 → 98.55 s; on the training
+//! panels (PI on the centre line, seeds 100–105) Ridgeway-30 37.37 → 37.16 m/s and Forza-50
+//! 40.25 → 39.50 m/s, the 30-kernel ones unchanged (their two spacings exceed 275 m).
+//!
 //! A push gives up when its repairs oscillate at one place (δ below [`GIVE_UP`]·δ₀: the car
 //! stalls there with less pedal and spins with more) or after [`LAPS`] laps. Its size is drawn
 //! around U₀ from the seed (±[`JITTER`]): where a failure lands moves from corner to corner
@@ -30,9 +42,9 @@ use serde::{Deserialize, Serialize};
 
 use super::PatternSearchConfig;
 use crate::error::Result;
-use crate::learner::repair::PedalRepair;
 #[cfg(test)]
 use crate::learner::repair::REPAIR_STEP;
+use crate::learner::repair::{PedalRepair, REPAIR_SPACINGS};
 use crate::optimizers::{FailedLap, SearchBox, rng_for};
 use crate::policy::RkhsPolicy;
 use crate::policy::rkhs::DEFAULT_RIDGE;
@@ -41,6 +53,9 @@ use crate::policy::rkhs::DEFAULT_RIDGE;
 /// checked again with repairs over road (0.25 / 0.3 / 0.35 / 0.4 / 0.45: 34.22 / 35.01 /
 /// 35.68 / 34.96 / 35.13 m/s; docs/results/beyond).
 pub const SIZE: f64 = 0.35;
+/// Failures closer than this (lap fraction) to a later one are at the same place: the
+/// stretch a repair moves stops half-way back to the nearest *other* place the pushes failed.
+pub const SAME_PLACE: f64 = 0.01;
 /// Pushes at most: U₀, then U₀/2, U₀/4, U₀/8, each after a kept one (chosen on the training
 /// panels: 2, 3, 4, 6 pushes gave 34.54, 34.81, 34.86, 34.86 m/s; with repairs over road, 1,
 /// 2, 3, 4 gave 34.41, 35.31, 35.51, 35.61).
@@ -79,6 +94,15 @@ pub struct Push {
     /// are these plus the offsets' fit, the start kept exactly where no repair moved it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub base: Option<Vec<f64>>,
+    /// The places (lap fractions) where this push's laps and the kept pushes' before it failed,
+    /// in the order they failed: a repair's stretch stops half-way back to the nearest other
+    /// one before the failure (empty in pushes saved before it existed).
+    #[serde(default)]
+    pub failures: Vec<f64>,
+    /// Whether a repair stops half-way back to the nearest other failure
+    /// ([`PatternSearchConfig::stop_half_way`]).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub stop_half_way: bool,
 }
 
 impl Push {
@@ -114,6 +138,7 @@ impl Push {
             .map(|p| p.repaired.clone())
             .filter(|r| r.len() == g)
             .unwrap_or_else(|| vec![0.0; g]);
+        let failures = previous.map(|p| p.failures.clone()).unwrap_or_default();
         let repair = PedalRepair::new(best.len()).starting_at(config.repair_step);
         Ok(Push {
             number,
@@ -127,6 +152,8 @@ impl Push {
             laps: 0,
             repaired,
             base: None,
+            failures,
+            stop_half_way: config.stop_half_way,
         })
     }
 
@@ -147,6 +174,8 @@ impl Push {
             laps: 0,
             repaired: vec![0.0; g],
             base: Some(start.to_vec()),
+            failures: Vec::new(),
+            stop_half_way: config.stop_half_way,
         }
     }
 
@@ -173,6 +202,7 @@ impl Push {
                 .last
                 .is_none_or(|(x, d)| x.is_finite() && d.is_finite())
             && self.laps <= LAPS
+            && self.failures.iter().all(|x| (0.0..=1.0).contains(x))
             && self
                 .base
                 .as_ref()
@@ -202,12 +232,35 @@ impl Push {
             return false;
         }
         let mut pairs = self.pairs();
-        self.repair.repair(&mut pairs, failure.at, failure.too_slow);
+        let stretch = self.stretch(failure.at);
+        self.failures.push(failure.at.clamp(0.0, 1.0));
+        self.repair
+            .repair_over(&mut pairs, failure.at, failure.too_slow, stretch);
         for ((target, net), (_, a)) in self.targets.iter_mut().zip(&mut self.repaired).zip(pairs) {
             *net += a - *target;
             *target = a;
         }
         true
+    }
+
+    /// The stretch (lap fraction) a repair moves before a failure at `at`: the repair's window;
+    /// when the push stops half-way, not further back than half-way to the nearest other place
+    /// before it where the pushes failed (the start line if none), nor less than two kernel
+    /// spacings (the module's "Not through the corner before").
+    fn stretch(&self, at: f64) -> f64 {
+        if !self.stop_half_way {
+            return self.repair.window();
+        }
+        let last_other = self
+            .failures
+            .iter()
+            .copied()
+            .filter(|&x| x < at - SAME_PLACE)
+            .fold(0.0, f64::max);
+        let half_way = 0.5 * (at - last_other);
+        self.repair
+            .window()
+            .min(half_way.max(REPAIR_SPACINGS * self.repair.spacing))
     }
 
     /// The targets as (xₖ, a(xₖ)) pairs.
@@ -354,5 +407,58 @@ mod tests {
         }
         assert_eq!(second.repaired, first.repaired);
         assert!(second.is_sound(best.len()));
+    }
+
+    /// A repair's stretch stops half-way back to the nearest other place the pushes failed
+    /// before it (the start line at first), never below two kernel spacings nor above the
+    /// window; failures within SAME_PLACE of each other are one place, and the next push
+    /// remembers them.
+    #[test]
+    fn a_repair_does_not_reach_through_the_corner_before() {
+        let (best, l) = best_and_lengthscale();
+        // 11 kernels: spacing 0.1, two spacings 0.2; the window 0.25 of the lap.
+        let config = PatternSearchConfig {
+            track_length: Some(4.0 * REPAIR_DISTANCE),
+            ..seeded(7)
+        };
+        let mut push = Push::begin(1, &best, l, &config, None).unwrap();
+        let g = push.targets.len();
+        let lowered_over = |push: &mut Push, at: f64| {
+            let before = push.targets.clone();
+            assert!(push.repair(FailedLap::too_fast(at)));
+            let moved: Vec<f64> = (0..g)
+                .filter(|&k| push.targets[k] < before[k] - 1e-12)
+                .map(|k| x_of(k, g))
+                .collect();
+            (moved[0], *moved.last().unwrap())
+        };
+        let close =
+            |(a, b): (f64, f64), (c, d): (f64, f64)| (a - c).abs() < 2e-3 && (b - d).abs() < 2e-3;
+        // Half-way to the start line is past the window: the window, 0.25.
+        let s = lowered_over(&mut push, 0.7);
+        assert!(close(s, (0.45, 0.7)), "{s:?}");
+        // 0.005 further on is the same place: the window again.
+        let s = lowered_over(&mut push, 0.705);
+        assert!(close(s, (0.455, 0.705)), "{s:?}");
+        // Half-way back to 0.705 is 0.1475, less than two spacings: 0.2.
+        let s = lowered_over(&mut push, 1.0);
+        assert!(close(s, (0.8, 1.0)), "{s:?}");
+        // The next push keeps the places. Before 0.45 there is none: half-way to the start
+        // line, 0.225, lies between two spacings and the window.
+        let mut next = Push::begin(2, &best, l, &config, Some(&push)).unwrap();
+        assert_eq!(next.failures, vec![0.7, 0.705, 1.0]);
+        let s = lowered_over(&mut next, 0.45);
+        assert!(close(s, (0.225, 0.45)), "{s:?}");
+        // Before 0.6 the nearest is 0.45, half-way 0.075: two spacings.
+        let s = lowered_over(&mut next, 0.6);
+        assert!(close(s, (0.4, 0.6)), "{s:?}");
+        assert!(next.is_sound(best.len()));
+        // A push that does not stop half-way moves the whole window.
+        next.stop_half_way = false;
+        let s = lowered_over(&mut next, 0.6);
+        assert!(close(s, (0.35, 0.6)), "{s:?}");
+        let mut unsound = next.clone();
+        unsound.failures.push(f64::NAN);
+        assert!(!unsound.is_sound(best.len()));
     }
 }

@@ -126,6 +126,7 @@ impl SafeSearchConfig {
                 push: PUSH,
                 repair_step: REPAIR_STEP,
                 repair_start: true,
+                stop_half_way: false,
                 ..search
             }
         };
