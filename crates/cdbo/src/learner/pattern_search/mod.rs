@@ -480,7 +480,7 @@ impl PatternSearchProposer {
         }
         let pedal = self.pedal_kernels();
         let mut push = Push::repairing(&self.state.start[..pedal], &self.state.config);
-        if push.repair(failure) {
+        if push.repair(failure, &self.state.config) {
             self.state.push = Some(push);
             self.state.next = Trial::Push;
             Ok(())
@@ -714,7 +714,7 @@ impl Proposer for PatternSearchProposer {
                     // blocks (measured: 109.40 against 109.51 s after 100 laps).
                     self.state.pushed |= push.base.is_none();
                     self.push_or_sweep(push.number + 1, Some(&push), told)?;
-                } else if failure.is_some_and(|f| push.repair(f)) {
+                } else if failure.is_some_and(|f| push.repair(f, &self.state.config)) {
                     self.state.push = Some(push);
                 } else {
                     self.push_or_sweep(push::PUSHES + 1, None, told)?;

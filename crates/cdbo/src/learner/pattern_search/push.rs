@@ -99,10 +99,6 @@ pub struct Push {
     /// one before the failure (empty in pushes saved before it existed).
     #[serde(default)]
     pub failures: Vec<f64>,
-    /// Whether a repair stops half-way back to the nearest other failure
-    /// ([`PatternSearchConfig::stop_half_way`]).
-    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-    pub stop_half_way: bool,
 }
 
 impl Push {
@@ -153,7 +149,6 @@ impl Push {
             repaired,
             base: None,
             failures,
-            stop_half_way: config.stop_half_way,
         })
     }
 
@@ -175,7 +170,6 @@ impl Push {
             repaired: vec![0.0; g],
             base: Some(start.to_vec()),
             failures: Vec::new(),
-            stop_half_way: config.stop_half_way,
         }
     }
 
@@ -227,12 +221,12 @@ impl Push {
 
     /// Repairs the targets for a lap that failed as `failure` says; false if the push gives up
     /// instead (its repairs oscillate or it has driven [`LAPS`] laps).
-    pub fn repair(&mut self, failure: FailedLap) -> bool {
+    pub fn repair(&mut self, failure: FailedLap, config: &PatternSearchConfig) -> bool {
         if self.laps >= LAPS || self.repair.step < GIVE_UP * self.repair.first {
             return false;
         }
         let mut pairs = self.pairs();
-        let stretch = self.stretch(failure.at);
+        let stretch = self.stretch(failure.at, config.stop_half_way);
         self.failures.push(failure.at.clamp(0.0, 1.0));
         self.repair
             .repair_over(&mut pairs, failure.at, failure.too_slow, stretch);
@@ -244,11 +238,11 @@ impl Push {
     }
 
     /// The stretch (lap fraction) a repair moves before a failure at `at`: the repair's window;
-    /// when the push stops half-way, not further back than half-way to the nearest other place
+    /// with `stop_half_way`, not further back than half-way to the nearest other place
     /// before it where the pushes failed (the start line if none), nor less than two kernel
     /// spacings (the module's "Not through the corner before").
-    fn stretch(&self, at: f64) -> f64 {
-        if !self.stop_half_way {
+    fn stretch(&self, at: f64, stop_half_way: bool) -> f64 {
+        if !stop_half_way {
             return self.repair.window();
         }
         let last_other = self
@@ -349,10 +343,11 @@ mod tests {
     #[test]
     fn a_push_repairs_before_the_failure_and_gives_up_when_it_oscillates() {
         let (best, l) = best_and_lengthscale();
-        let mut push = Push::begin(1, &best, l, &seeded(7), None).unwrap();
+        let config = seeded(7);
+        let mut push = Push::begin(1, &best, l, &config, None).unwrap();
         let before = push.targets.clone();
         let g = before.len();
-        assert!(push.repair(FailedLap::too_fast(0.5)));
+        assert!(push.repair(FailedLap::too_fast(0.5), &config));
         for (k, (a, b)) in push.targets.iter().zip(&before).enumerate() {
             let moved = (0.3 - 1e-9..=0.5).contains(&x_of(k, g));
             assert!(
@@ -364,13 +359,13 @@ mod tests {
             at: 0.51,
             too_slow: true,
         };
-        assert!(push.repair(stall)); // δ halves to 0.05
-        assert!(push.repair(FailedLap::too_fast(0.5))); // and to 0.025
+        assert!(push.repair(stall, &config)); // δ halves to 0.05
+        assert!(push.repair(FailedLap::too_fast(0.5), &config)); // and to 0.025
         assert!(push.repair.step < GIVE_UP * REPAIR_STEP);
-        assert!(!push.repair(stall));
-        let mut fresh = Push::begin(1, &best, l, &seeded(7), None).unwrap();
+        assert!(!push.repair(stall, &config));
+        let mut fresh = Push::begin(1, &best, l, &config, None).unwrap();
         fresh.laps = LAPS;
-        assert!(!fresh.repair(FailedLap::too_fast(0.5)));
+        assert!(!fresh.repair(FailedLap::too_fast(0.5), &config));
     }
 
     /// With the lap's length told, a repair moves the targets over REPAIR_DISTANCE metres of
@@ -387,7 +382,7 @@ mod tests {
         let mut first = Push::begin(1, &best, l, &config, None).unwrap();
         let before = first.targets.clone();
         let g = before.len();
-        assert!(first.repair(FailedLap::too_fast(0.5)));
+        assert!(first.repair(FailedLap::too_fast(0.5), &config));
         let lowered = |k: usize| (0.375..=0.5).contains(&x_of(k, g));
         let moves = first.targets.iter().zip(&before).zip(&first.repaired);
         for (k, ((a, b), net)) in moves.enumerate() {
@@ -423,9 +418,9 @@ mod tests {
         };
         let mut push = Push::begin(1, &best, l, &config, None).unwrap();
         let g = push.targets.len();
-        let lowered_over = |push: &mut Push, at: f64| {
+        let lowered_over = |push: &mut Push, at: f64, config: &PatternSearchConfig| {
             let before = push.targets.clone();
-            assert!(push.repair(FailedLap::too_fast(at)));
+            assert!(push.repair(FailedLap::too_fast(at), config));
             let moved: Vec<f64> = (0..g)
                 .filter(|&k| push.targets[k] < before[k] - 1e-12)
                 .map(|k| x_of(k, g))
@@ -435,27 +430,30 @@ mod tests {
         let close =
             |(a, b): (f64, f64), (c, d): (f64, f64)| (a - c).abs() < 2e-3 && (b - d).abs() < 2e-3;
         // Half-way to the start line is past the window: the window, 0.25.
-        let s = lowered_over(&mut push, 0.7);
+        let s = lowered_over(&mut push, 0.7, &config);
         assert!(close(s, (0.45, 0.7)), "{s:?}");
         // 0.005 further on is the same place: the window again.
-        let s = lowered_over(&mut push, 0.705);
+        let s = lowered_over(&mut push, 0.705, &config);
         assert!(close(s, (0.455, 0.705)), "{s:?}");
         // Half-way back to 0.705 is 0.1475, less than two spacings: 0.2.
-        let s = lowered_over(&mut push, 1.0);
+        let s = lowered_over(&mut push, 1.0, &config);
         assert!(close(s, (0.8, 1.0)), "{s:?}");
         // The next push keeps the places. Before 0.45 there is none: half-way to the start
         // line, 0.225, lies between two spacings and the window.
         let mut next = Push::begin(2, &best, l, &config, Some(&push)).unwrap();
         assert_eq!(next.failures, vec![0.7, 0.705, 1.0]);
-        let s = lowered_over(&mut next, 0.45);
+        let s = lowered_over(&mut next, 0.45, &config);
         assert!(close(s, (0.225, 0.45)), "{s:?}");
         // Before 0.6 the nearest is 0.45, half-way 0.075: two spacings.
-        let s = lowered_over(&mut next, 0.6);
+        let s = lowered_over(&mut next, 0.6, &config);
         assert!(close(s, (0.4, 0.6)), "{s:?}");
         assert!(next.is_sound(best.len()));
         // A push that does not stop half-way moves the whole window.
-        next.stop_half_way = false;
-        let s = lowered_over(&mut next, 0.6);
+        let whole = PatternSearchConfig {
+            stop_half_way: false,
+            ..config.clone()
+        };
+        let s = lowered_over(&mut next, 0.6, &whole);
         assert!(close(s, (0.35, 0.6)), "{s:?}");
         let mut unsound = next.clone();
         unsound.failures.push(f64::NAN);
