@@ -129,6 +129,10 @@ pub struct PatternSearchConfig {
     /// pays for the extra repairs (measured there: Forza-50 41.42 → 38.91 m/s).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub stop_half_way: bool,
+    /// A push gives up once this many of its laps in a row fail short of the furthest place
+    /// its laps reached ([`push`]; 0: never, as in searches saved before it existed).
+    #[serde(default)]
+    pub push_patience: usize,
 }
 
 /// The push's default repair step.
@@ -170,6 +174,7 @@ impl Default for PatternSearchConfig {
             repair_step: repair_step(),
             repair_start: false,
             stop_half_way: true,
+            push_patience: push::PATIENCE,
         }
     }
 }
