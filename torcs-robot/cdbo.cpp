@@ -37,11 +37,12 @@
  *                                lap's end (drive::periodic_linear); without it the centre line
  *   steering pi T_LA D_MIN K_I   the PI law: look-ahead time (s), shortest look-ahead (m),
  *                                integral gain
- *   steering tracker T_P X_MIN T_F C V_Y   the path tracker: preview time (s), shortest
- *                                preview (m), feed-forward time (s), yaw-rate gain and the
- *                                speed per unit of it below that gain (m/s)
- *   chassis M A B                (the tracker) mass (kg), distances of the front and rear
- *                                axle from the centre of gravity (m)
+ *   steering tracker T_P X_MIN T_F C V_Y G1   the path tracker: preview time (s), shortest
+ *                                preview (m), feed-forward time (s), yaw-rate gain, the
+ *                                speed per unit of it below that gain (m/s) and the yaw-rate
+ *                                loop's largest one-step gain
+ *   chassis M A B IZ             (the tracker) mass (kg), distances of the front and rear
+ *                                axle from the centre of gravity (m), yaw inertia (kg m^2)
  *   cornering_front V1 C1 ...    (the tracker) the axle's cornering stiffness (N/rad) on a
  *   cornering_rear V1 C1 ...     surface of friction 1 at speeds V increasing (m/s), linear
  *                                in between, held beyond the ends; scaled by the friction of
@@ -97,8 +98,8 @@ struct Settings {
     std::vector<double> line;  // the line's offsets; empty: the centre line
     bool tracker = false;  // the path tracker, else the PI law
     double lookahead_time = 0.8, lookahead_min = 12.0, ki = 0.1;
-    drive::TrackerGains gains = {0.4, 10.0, 0.15, 4.0};
-    double mass = 0.0, cg_to_front = 0.0, cg_to_rear = 0.0;
+    drive::TrackerGains gains = {0.4, 10.0, 0.15, 4.0, 6.0, 1.6};
+    double mass = 0.0, cg_to_front = 0.0, cg_to_rear = 0.0, yaw_inertia = 0.0;
     std::vector<double> cornering[2];  // (v, C) pairs per axle
     std::vector<double> ratios, upshift;
     size_t throttle_levels = 1;
@@ -189,15 +190,15 @@ bool read_settings(const std::string &path, Settings *s, std::string *error) {
             if ((ok = need(3))) { s->tracker = false; s->lookahead_time = nums[0]; s->lookahead_min = nums[1]; s->ki = nums[2]; }
         }
         else if (k == "steering" && word == "tracker") {
-            if ((ok = need(5))) { s->tracker = true; s->gains = {nums[0], nums[1], nums[2], nums[3], nums[4]}; }
+            if ((ok = need(6))) { s->tracker = true; s->gains = {nums[0], nums[1], nums[2], nums[3], nums[4], nums[5]}; }
         }
         else if (k == "steering") {
             *error = path + ":" + std::to_string(number) + ": steering must be 'pi T_LA D_MIN K_I' or "
-                     "'tracker T_P X_MIN T_F C V_Y', got '" + word + "'";
+                     "'tracker T_P X_MIN T_F C V_Y G1', got '" + word + "'";
             ok = false;
         }
         else if (k == "chassis") {
-            if ((ok = need(3))) { s->mass = nums[0]; s->cg_to_front = nums[1]; s->cg_to_rear = nums[2]; }
+            if ((ok = need(4))) { s->mass = nums[0]; s->cg_to_front = nums[1]; s->cg_to_rear = nums[2]; s->yaw_inertia = nums[3]; }
         }
         else if (k == "cornering_front") s->cornering[0] = nums;
         else if (k == "cornering_rear") s->cornering[1] = nums;
@@ -226,13 +227,13 @@ bool read_settings(const std::string &path, Settings *s, std::string *error) {
         return false;
     }
     if (s->tracker) {
-        bool chassis_ok = s->mass > 0.0 && s->cg_to_front > 0.0 && s->cg_to_rear > 0.0;
+        bool chassis_ok = s->mass > 0.0 && s->cg_to_front > 0.0 && s->cg_to_rear > 0.0 && s->yaw_inertia > 0.0;
         for (const std::vector<double> &c : s->cornering) {
             chassis_ok = chassis_ok && c.size() >= 2 && c.size() % 2 == 0;
             for (size_t i = 2; chassis_ok && i < c.size(); i += 2) chassis_ok = c[i] > c[i - 2];
         }
         if (!chassis_ok) {
-            *error = path + ": the path tracker needs 'chassis M A B' (positive) and "
+            *error = path + ": the path tracker needs 'chassis M A B IZ' (positive) and "
                             "'cornering_front' and 'cornering_rear' tables 'V1 C1 ...' with V increasing";
             return false;
         }
@@ -357,7 +358,7 @@ double tracker_steer(tCarElt *car, double speed) {
     for (int k = 0; k < 2; k++) {
         in.cornering[k] = friction * drive::table_action(c.cornering[k].data(), c.cornering[k].size() / 2, v);
     }
-    drive::TrackerCar tc = {c.mass, c.wheelbase, c.cg_to_front, c.cg_to_rear, car->_steerLock};
+    drive::TrackerCar tc = {c.mass, c.wheelbase, c.cg_to_front, c.cg_to_rear, car->_steerLock, c.yaw_inertia};
     return drive::tracker_law(c.gains, tc, in);
 }
 

@@ -201,8 +201,12 @@ struct TrackerGains {
     double preview_min;       ///< x_min (m)
     double feedforward_time;  ///< t_f (s)
     double yaw_rate_gain;     ///< c_max
-    double yaw_rate_speed;    ///< v_y (m/s): c = min(c_max, v / v_y)
+    double yaw_rate_speed;    ///< v_y (m/s): c = min(c_max, v / v_y, g* v I_z / (G a C_f T))
+    double yaw_step_gain;     ///< g*, the yaw-rate loop's largest one-step gain
 };
+
+/// The driver step T (s) the tracker's law acts at (drive/tracker.rs DRIVER_STEP).
+constexpr double kDriverStep = 0.02;
 
 /// The car as the tracker's law reads it (drive/tracker.rs TrackerCar).
 struct TrackerCar {
@@ -211,6 +215,7 @@ struct TrackerCar {
     double cg_to_front;  ///< a (m)
     double cg_to_rear;   ///< b (m)
     double steer_lock;   ///< delta_max (rad)
+    double yaw_inertia;  ///< I_z (kg m^2)
 };
 
 /// The car's state against the path (drive/tracker.rs TrackerInput).
@@ -225,7 +230,7 @@ struct TrackerInput {
 
 /// The road-wheel angle (rad) of the path tracker (drive/tracker.rs PathTracker::law):
 /// delta = clamp(G (kappa_d + c (kappa_d - r / v)), -delta_max, delta_max), with
-/// c = min(c_max, v / v_y),
+/// c = min(c_max, v / v_y, g* v I_z / (G a C_f T)),
 /// kappa_d = kappa_f - (2 / x_p^2) (e + x_p (dpsi - dpsi_ss)), x_p = max(t_p v, x_min),
 /// dpsi_ss = kappa_f (m a v^2 / (L C_r) - b), G = max(L + K v^2, L / 4) and the understeer
 /// gradient K = (m / L) (b / C_f - a / C_r).
@@ -239,7 +244,8 @@ inline double tracker_law(const TrackerGains &g, const TrackerCar &car, const Tr
     double x_p = std::fmax(g.preview_time * v, g.preview_min);
     double kappa_d = kappa - 2.0 / (x_p * x_p) * (e + x_p * (heading_error - steady_heading_error));
     double gain = std::fmax(l + understeer * v * v, 0.25 * l);
-    double c = std::fmin(g.yaw_rate_gain, v / g.yaw_rate_speed);
+    double one_step = g.yaw_step_gain * v * car.yaw_inertia / (gain * a * cf * kDriverStep);
+    double c = std::fmin(std::fmin(g.yaw_rate_gain, v / g.yaw_rate_speed), one_step);
     double delta = gain * (kappa_d + c * (kappa_d - in.yaw_rate / v));
     return clamp(delta, -car.steer_lock, car.steer_lock);
 }

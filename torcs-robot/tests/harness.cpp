@@ -137,8 +137,8 @@ const std::map<std::string, Case> kCases = {
          drive::offset_left(x, y, s, c, d, &px, &py);
          return std::vector<double>{px, py};
      }},
-    {"tracker_constants",  // -> kPathStep kTrackerMinSpeed
-     [](Args &) { return std::vector<double>{drive::kPathStep, drive::kTrackerMinSpeed}; }},
+    {"tracker_constants",  // -> kPathStep kTrackerMinSpeed kDriverStep
+     [](Args &) { return std::vector<double>{drive::kPathStep, drive::kTrackerMinSpeed, drive::kDriverStep}; }},
     {"tracker_speed",  // SPEED -> v
      [](Args &a) { return std::vector<double>{drive::tracker_speed(a.num())}; }},
     {"curvature",  // X0 Y0 X1 Y1 X2 Y2 -> kappa
@@ -146,7 +146,7 @@ const std::map<std::string, Case> kCases = {
          double x0 = a.num(), y0 = a.num(), x1 = a.num(), y1 = a.num(), x2 = a.num();
          return std::vector<double>{drive::curvature(x0, y0, x1, y1, x2, a.num())};
      }},
-    {"tracker_law",  // T_P X_MIN T_F C V_Y  M L A B LOCK  E DPSI KAPPA V R CF CR -> delta
+    {"tracker_law",  // T_P X_MIN T_F C V_Y G1  M L A B LOCK IZ  E DPSI KAPPA V R CF CR -> delta
      [](Args &a) {
          drive::TrackerGains g;
          g.preview_time = a.num();
@@ -154,12 +154,14 @@ const std::map<std::string, Case> kCases = {
          g.feedforward_time = a.num();
          g.yaw_rate_gain = a.num();
          g.yaw_rate_speed = a.num();
+         g.yaw_step_gain = a.num();
          drive::TrackerCar car;
          car.mass = a.num();
          car.wheelbase = a.num();
          car.cg_to_front = a.num();
          car.cg_to_rear = a.num();
          car.steer_lock = a.num();
+         car.yaw_inertia = a.num();
          drive::TrackerInput in;
          in.lateral_error = a.num();
          in.heading_error = a.num();

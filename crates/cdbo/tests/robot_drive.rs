@@ -410,7 +410,7 @@ fn the_robots_tracker_is_the_rust_one_on_a_recorded_lap() {
         "constants",
         "tracker_constants",
         &[],
-        &[tracker::PATH_STEP, tracker::MIN_SPEED],
+        &[tracker::PATH_STEP, tracker::MIN_SPEED, tracker::DRIVER_STEP],
         Agree::Exactly,
     );
     let tables = cornering_tables(&sim.vehicle);
@@ -425,6 +425,7 @@ fn the_robots_tracker_is_the_rust_one_on_a_recorded_lap() {
         tracker.feedforward_time,
         tracker.yaw_rate_gain,
         tracker.yaw_rate_speed,
+        tracker.yaw_step_gain,
     ];
     let tc = TrackerCar::of(&car);
     let chassis = [
@@ -433,6 +434,7 @@ fn the_robots_tracker_is_the_rust_one_on_a_recorded_lap() {
         tc.cg_to_front,
         tc.cg_to_rear,
         tc.steer_lock,
+        tc.yaw_inertia,
     ];
     let (mut saturated, mut cornering, mut fastest) = (0, 0, 0.0_f64);
     for (name, trace) in [("demonstration", &demo), ("learned policy", &fast)] {
@@ -529,6 +531,34 @@ fn the_robots_tracker_is_the_rust_one_on_a_recorded_lap() {
         );
         saturated += usize::from(delta == -e.signum() * car.steer_lock);
     }
+    // The yaw-rate loop's one-step bound, which the Spirit 300 never reaches: the same states
+    // on tyres three times as stiff (as car1-trb1's at speed) bind it from 10 m/s up.
+    let unbounded = PathTracker {
+        yaw_step_gain: f64::INFINITY,
+        ..tracker.clone()
+    };
+    let mut bound = 0;
+    for p in fast.iter().filter(|p| p.speed > 10.0).step_by(10) {
+        let input = TrackerInput {
+            lateral_error: 0.2,
+            heading_error: 0.01,
+            curvature: 0.005,
+            speed: p.speed,
+            yaw_rate: p.yaw_rate,
+            cornering_stiffness: sim
+                .vehicle
+                .cornering_stiffness(p.speed, 1.0)
+                .map(|c| 3.0 * c),
+        };
+        let delta = tracker.law(&tc, &input);
+        bound += usize::from(delta != unbounded.law(&tc, &input));
+        let mut args = [&gains[..], &chassis[..]].concat();
+        args.extend([0.2, 0.01, 0.005, p.speed, p.yaw_rate]);
+        args.extend(input.cornering_stiffness);
+        let at = format!("stiff tyres at {} m/s", p.speed);
+        calls.check(&at, "tracker_law", &args, &[delta], Agree::Exactly);
+    }
+    assert!(bound > 10, "{bound} states bound");
     // The states span the law: corners, a fast lap, the lock.
     assert!(cornering > 1000, "{cornering} steps in corners");
     assert!(fastest > 25.0, "{fastest} m/s");
@@ -760,8 +790,9 @@ fn the_robots_line_is_the_rust_one_on_recorded_laps() {
                         let delta = t.law(&tc, &input);
                         let mut args = vec![t.preview_time, t.preview_min];
                         args.extend([t.feedforward_time, t.yaw_rate_gain, t.yaw_rate_speed]);
-                        args.extend([tc.mass, tc.wheelbase, tc.cg_to_front, tc.cg_to_rear]);
-                        args.extend([tc.steer_lock, p.lateral - d, -bearing, kappa, v]);
+                        args.extend([t.yaw_step_gain, tc.mass, tc.wheelbase, tc.cg_to_front]);
+                        args.extend([tc.cg_to_rear, tc.steer_lock, tc.yaw_inertia]);
+                        args.extend([p.lateral - d, -bearing, kappa, v]);
                         args.extend([p.yaw_rate, stiffness[0], stiffness[1]]);
                         if from_table {
                             let mut calls = calls.borrow_mut();

@@ -300,3 +300,25 @@ fn a_rough_road_takes_car1_trb1s_grip() {
     let faint = lap(Roughness::from_file(0.0009, 1.0), &car);
     assert_eq!((faint.failure, faint.trace), (smooth.failure, smooth.trace));
 }
+
+/// The path tracker does not ring on car1-trb1 at speed: holding 25 m/s round Forza on the
+/// centre line, the steering's second difference averages less than 1 mrad a driver step
+/// (without the one-step bound on the yaw-rate gain, `drive::tracker::YAW_STEP_GAIN`, 170 mrad:
+/// the steering alternated step by step, in the game too).
+#[test]
+fn the_tracker_does_not_ring_on_car1_trb1_at_speed() {
+    let data = cdbo::data_path::DataPath::with_env(&[shared("")], "");
+    let car = cdbo::car::catalog::find("car1-trb1", &data).unwrap();
+    let track = common::shared_track("forza");
+    let steering = cdbo::drive::steering::Steering::Tracker(Default::default());
+    let venue = cdbo::venue::Venue::simulator(track, &car).steered(steering);
+    let (demo, _) = venue.demonstrate(25.0).unwrap();
+    assert!(demo.completed, "{:?}", demo.failure);
+    let steer: Vec<f64> = demo.trace.iter().map(|p| p.steer).collect();
+    let ring = steer
+        .windows(3)
+        .map(|w| (w[2] - 2.0 * w[1] + w[0]).abs())
+        .sum::<f64>()
+        / (steer.len() - 2) as f64;
+    assert!(ring < 1e-3, "{ring} rad a step");
+}

@@ -29,6 +29,15 @@
 //!   map r ← −c·r, which rings at half the driver's rate once c > 1 (discrete-time loop,
 //!   time constant τ of the yaw ∝ v: stable while c < (1 + e^(−T/τ))/(1 − e^(−T/τ))). So
 //!   c = min(c_max, v/v_y): 4 from 24 m/s, 2.5 at 15 m/s, 1.7 at 10 m/s.
+//! - At speed the yaw no longer settles within a step, and the loop's gain over one step is
+//!   the car's own: a steering change Δδ turns the front axle's force by C_f·Δδ and the yaw
+//!   rate, one step T later, by a·C_f·Δδ·T/I_z, which the law answers with
+//!   −(c·G/v)·a·C_f·T/I_z·Δδ. That one-step gain g₁ = c·G·a·C_f·T/(v·I_z) rings at half the
+//!   driver's rate once it passes 1 and grows once it passes 2: it falls with speed on an
+//!   oversteering, soft-tyred car (the Spirit 300's reaches 1.59 with c = min(c_max, v/v_y), at
+//!   20 m/s) and rises on an understeering, stiff one (car1-trb1's reached 1.9–2.8 from
+//!   20 m/s up, and its steering alternated step by step in cdbo's simulator and in the game
+//!   alike). So c = min(c_max, v/v_y, g*·v·I_z/(G·a·C_f·T)), g* = [`YAW_STEP_GAIN`].
 //!
 //! On a circle of curvature κ the linear single-track car settles with e = 0, Δψ = Δψ_ss and
 //! r = v·κ, steering δ = (L + K·v²)·κ: there κ_d = κ, the feed-forward is the whole steady
@@ -53,6 +62,16 @@ pub const PREVIEW_MIN: f64 = 10.0;
 pub const FEEDFORWARD_TIME: f64 = 0.15;
 /// Yaw-rate gain c_max (dimensionless: the steering per unit of curvature error in yaw).
 pub const YAW_RATE_GAIN: f64 = 4.0;
+/// The yaw-rate loop's largest one-step gain g* (see the module): c ≤ g*·v·I_z/(G·a·C_f·T).
+/// Chosen by measurement: the Spirit 300's laps reach at most 1.59 with c = min(c_max, v/v_y)
+/// and do not ring (0.003 rad a step), car1-trb1's reached 1.9–2.8 with c_max = 4 and rang at
+/// 0.09–0.17 rad a step from 20 m/s up, in cdbo's simulator and in the game alike
+/// (docs/results/torcs.md, "Transfer at −1.5 m"); at a flat c = 2.5 (one-step gains up to 1.75)
+/// they rang at 0.0003–0.002 rad.
+pub const YAW_STEP_GAIN: f64 = 1.6;
+/// The driver step T (s) the law acts at, in cdbo's simulator and in the game (TORCS's robots
+/// are called every 20 ms).
+pub const DRIVER_STEP: f64 = 0.02;
 /// The speed v_y (m/s) per unit of yaw-rate gain below c_max: c = min(c_max, v/v_y). With
 /// c_max at every speed the Spirit 300's steering rang at 25 Hz below some 17 m/s
 /// (Ridgeway's 15 m/s demonstration: 0.028 rad of steering change per driver step against
@@ -89,6 +108,8 @@ pub struct PathTracker {
     pub yaw_rate_gain: f64,
     /// Speed per unit of yaw-rate gain below c_max, v_y (m/s).
     pub yaw_rate_speed: f64,
+    /// The yaw-rate loop's largest one-step gain g*.
+    pub yaw_step_gain: f64,
 }
 
 impl Default for PathTracker {
@@ -99,6 +120,7 @@ impl Default for PathTracker {
             feedforward_time: FEEDFORWARD_TIME,
             yaw_rate_gain: YAW_RATE_GAIN,
             yaw_rate_speed: YAW_RATE_SPEED,
+            yaw_step_gain: YAW_STEP_GAIN,
         }
     }
 }
@@ -116,6 +138,8 @@ pub struct TrackerCar {
     pub cg_to_rear: f64,
     /// Largest road-wheel angle δ_max (rad).
     pub steer_lock: f64,
+    /// Yaw inertia I_z (kg·m²).
+    pub yaw_inertia: f64,
 }
 
 impl TrackerCar {
@@ -127,6 +151,7 @@ impl TrackerCar {
             cg_to_front: car.cg_to_front(),
             cg_to_rear: car.cg_to_rear(),
             steer_lock: car.steer_lock,
+            yaw_inertia: car.yaw_inertia(),
         }
     }
 }
@@ -185,8 +210,8 @@ impl PathTracker {
     }
 
     /// The road-wheel angle (rad) δ = clamp(G·(κ_d + c·(κ_d − r/v)), −δ_max, δ_max), with
-    /// c = min(c_max, v/v_y), κ_d = κ_f − (2/x_p²)·(e + x_p·(Δψ − Δψ_ss)), x_p = max(t_p·v, x_min),
-    /// Δψ_ss = κ_f·(m·a·v²/(L·C_r) − b), G = max(L + K·v², L/4), K = (m/L)·(b/C_f − a/C_r)
+    /// c = min(c_max, v/v_y, g*·v·I_z/(G·a·C_f·T)), κ_d = κ_f − (2/x_p²)·(e + x_p·(Δψ − Δψ_ss)),
+    /// x_p = max(t_p·v, x_min), Δψ_ss = κ_f·(m·a·v²/(L·C_r) − b), G = max(L + K·v², L/4), K = (m/L)·(b/C_f − a/C_r)
     /// (the [module](self)'s law, a pure function of numbers so that the TORCS robot's
     /// `torcs-robot/drive.hpp` can be checked against it, `tests/robot_drive.rs`).
     pub fn law(&self, car: &TrackerCar, input: &TrackerInput) -> f64 {
@@ -204,7 +229,11 @@ impl PathTracker {
         let kappa_d =
             kappa - 2.0 / (x_p * x_p) * (e + x_p * (heading_error - steady_heading_error));
         let gain = (l + understeer * v * v).max(0.25 * l);
-        let c = self.yaw_rate_gain.min(v / self.yaw_rate_speed);
+        let one_step = self.yaw_step_gain * v * car.yaw_inertia / (gain * a * cf * DRIVER_STEP);
+        let c = self
+            .yaw_rate_gain
+            .min(v / self.yaw_rate_speed)
+            .min(one_step);
         let delta = gain * (kappa_d + c * (kappa_d - input.yaw_rate / v));
         delta.clamp(-car.steer_lock, car.steer_lock)
     }
@@ -256,7 +285,8 @@ mod tests {
     /// The yaw-rate loop does not ring at low speed: the 15 m/s and 10 m/s demonstrations on
     /// Ridgeway change the steering by less than 1 mrad per driver step on average (with
     /// c = 4 at every speed, 28 and 150 mrad: the steering alternated step by step), and
-    /// with the full gain from v = c_max·v_y on, the law is the same there.
+    /// with the full gain from v = c_max·v_y on, the law is the same there (car1-trb1 at
+    /// speed: `tests/shared_tracks.rs`).
     #[test]
     fn the_steering_does_not_ring_at_low_speed() {
         let track = crate::track::builtin::load("ridgeway").unwrap().unwrap();

@@ -283,15 +283,16 @@ fn settings(
         Steering::Tracker(t) => {
             let _ = writeln!(
                 s,
-                "steering tracker {:e} {:e} {:e} {:e} {:e}",
+                "steering tracker {:e} {:e} {:e} {:e} {:e} {:e}",
                 t.preview_time,
                 t.preview_min,
                 t.feedforward_time,
                 t.yaw_rate_gain,
-                t.yaw_rate_speed
+                t.yaw_rate_speed,
+                t.yaw_step_gain
             );
-            let (a, b) = (car.cg_to_front(), car.cg_to_rear());
-            let _ = writeln!(s, "chassis {:e} {a:e} {b:e}", car.mass);
+            let (a, b, iz) = (car.cg_to_front(), car.cg_to_rear(), car.yaw_inertia());
+            let _ = writeln!(s, "chassis {:e} {a:e} {b:e} {iz:e}", car.mass);
             for (axle, table) in ["front", "rear"].iter().zip(cornering_tables(&vehicle)) {
                 let mut pairs = table.into_iter().flat_map(|(v, c)| [v, c]);
                 let _ = writeln!(s, "cornering_{axle} {}", list(&mut pairs));
