@@ -211,7 +211,8 @@ impl PathTracker {
 
     /// The road-wheel angle (rad) δ = clamp(G·(κ_d + c·(κ_d − r/v)), −δ_max, δ_max), with
     /// c = min(c_max, v/v_y, g*·v·I_z/(G·a·C_f·T)), κ_d = κ_f − (2/x_p²)·(e + x_p·(Δψ − Δψ_ss)),
-    /// x_p = max(t_p·v, x_min), Δψ_ss = κ_f·(m·a·v²/(L·C_r) − b), G = max(L + K·v², L/4), K = (m/L)·(b/C_f − a/C_r)
+    /// x_p = max(t_p·v, x_min), Δψ_ss = κ_f·(m·a·v²/(L·C_r) − b), G = max(L + K·v², L/4),
+    /// K = (m/L)·(b/C_f − a/C_r)
     /// (the [module](self)'s law, a pure function of numbers so that the TORCS robot's
     /// `torcs-robot/drive.hpp` can be checked against it, `tests/robot_drive.rs`).
     pub fn law(&self, car: &TrackerCar, input: &TrackerInput) -> f64 {
