@@ -542,6 +542,55 @@ fn after_a_kept_push_the_sweeps_move_single_weights() {
     );
 }
 
+/// A push whose lap completes slower than the best is not kept; the next lap is then the next
+/// push, the best lap's pedal raised by about U₀/4 everywhere (push 3 after kept push 1 and
+/// unkept push 2), not a step of one weight. A search saved before that rule (no
+/// `push_after_unkept`) ends its pushes there and steps one weight by σ₀.
+#[test]
+fn a_push_not_kept_is_followed_by_the_next() {
+    let l = default_lengthscale(12);
+    let config = PatternSearchConfig {
+        sigma0: 0.1,
+        lengthscale: Some(l),
+        ..PatternSearchConfig::default()
+    };
+    assert!(config.push_after_unkept);
+    let third_lap = |config: PatternSearchConfig| {
+        let mut ps = started(12, config);
+        let first = ps.ask().unwrap();
+        ps.tell_lap(&first, 2.0, None).unwrap();
+        let second = ps.ask().unwrap();
+        ps.tell_lap(&second, 1.5, None).unwrap();
+        (first, ps.ask().unwrap())
+    };
+    let (kept, next) = third_lap(config.clone());
+    let (kept, next) = (
+        RkhsPolicy::new(kept, l).unwrap(),
+        RkhsPolicy::new(next, l).unwrap(),
+    );
+    let quarter = push::SIZE / 4.0;
+    for k in 1..20 {
+        let x = k as f64 / 20.0;
+        let raised = next.action(x) - kept.action(x);
+        assert!(
+            (raised - quarter).abs() < push::JITTER * quarter + 0.01,
+            "at x = {x}: raised {raised}, U₀/4 = {quarter}"
+        );
+    }
+    let (kept, next) = third_lap(PatternSearchConfig {
+        push_after_unkept: false,
+        ..config
+    });
+    let moved: Vec<f64> = next
+        .iter()
+        .zip(&kept)
+        .map(|(a, b)| a - b)
+        .filter(|d| *d != 0.0)
+        .collect();
+    assert_eq!(moved.len(), 1, "{moved:?}");
+    assert!((moved[0].abs() - 0.1).abs() < 1e-12, "{moved:?}");
+}
+
 /// Saved in the middle of a push, the search resumes bit for bit.
 #[test]
 fn a_search_saved_mid_push_resumes_exactly() {

@@ -127,6 +127,7 @@ impl SafeSearchConfig {
                 repair_step: REPAIR_STEP,
                 repair_start: true,
                 stop_half_way: false,
+                push_after_unkept: false,
                 ..search
             }
         };
