@@ -35,6 +35,23 @@ fn the_15_mps_demonstration_completes_every_required_track() {
     }
 }
 
+/// A car held below 1 m/s has stopped racing: it stalls after 5 s, a few metres from the
+/// start. Held at 1.5 m/s it crawls on until the time limit.
+#[test]
+fn a_car_crawling_below_a_metre_a_second_stalls() {
+    let mut sim = Simulator::new(builtin("ridgeway"), &Car::spirit_300());
+    sim.config.time_limit = Some(60.0);
+    let crawl = sim.lap(&mut SpeedHold::new(0.8));
+    let failure = crawl.failure.expect("a crawl at 0.8 m/s completed");
+    assert_eq!(failure.reason, FailureReason::Stalled);
+    assert!((5.0..6.0).contains(&failure.time_s), "{failure:?}");
+    let slow = sim.lap(&mut SpeedHold::new(1.5));
+    assert_eq!(
+        slow.failure.map(|f| f.reason),
+        Some(FailureReason::TimeLimit)
+    );
+}
+
 #[test]
 fn full_throttle_fails_on_forza_and_says_where() {
     let sim = Simulator::new(shared_track("forza"), &Car::spirit_300());

@@ -14,7 +14,7 @@
 //! - **spun**: the car faces more than 90° away from the track, or slides with a body slip
 //!   angle above 60° at more than 3 m/s;
 //! - **backwards**: the car has moved 10 m back from the farthest point it reached;
-//! - **stalled**: slower than 0.5 m/s for 5 s;
+//! - **stalled**: slower than 1 m/s for 5 s ([`STALL_SPEED`]);
 //! - **time limit**: the lap takes longer than its limit.
 //!
 //! Nothing else ends a lap: whether these happen follows from speed, grip and steering.
@@ -208,8 +208,15 @@ impl Default for LapConfig {
 const INV_TAN_SPIN_SLIP_ANGLE: f64 = 0.577_350_269_189_625_8;
 const SPIN_MIN_SPEED: f64 = 3.0;
 const BACKWARDS_DISTANCE: f64 = 10.0;
-const STALL_SPEED: f64 = 0.5;
-const STALL_TIME: f64 = 5.0;
+/// Slower than this (m/s) for [`STALL_TIME`] the car has stopped racing. It was 0.5 m/s: in
+/// the game (car1-trb1, Aalborg, the line learned, seed 1) a push's pedal braked the car to
+/// 0.51–0.6 m/s in a slow corner for 10 s, a completed lap 12 s slower than the best that
+/// ended the pushes; at 1 m/s it stalls, and the repair raises the pedal there (six seeds in
+/// the game: 82.05 → 81.26 s, the fixed line 81.51 → 80.64 s with the push that follows an
+/// unkept one).
+pub const STALL_SPEED: f64 = 1.0;
+/// How long (s) below [`STALL_SPEED`] a car stalls.
+pub const STALL_TIME: f64 = 5.0;
 
 /// Whether the car faces more than 90° away from the road: cos(ψ − θ) < 0.
 #[inline]
