@@ -212,8 +212,7 @@ const BACKWARDS_DISTANCE: f64 = 10.0;
 /// the game (car1-trb1, Aalborg, the line learned, seed 1) a push's pedal braked the car to
 /// 0.51–0.6 m/s in a slow corner for 10 s, a completed lap 12 s slower than the best that
 /// ended the pushes; at 1 m/s it stalls, and the repair raises the pedal there (six seeds in
-/// the game: 82.05 → 81.26 s, the fixed line 81.51 → 80.64 s with the push that follows an
-/// unkept one).
+/// the game: 82.05 → 81.26 s with the line learned, 81.51 → 80.64 s fixed).
 pub const STALL_SPEED: f64 = 1.0;
 /// How long (s) below [`STALL_SPEED`] a car stalls.
 pub const STALL_TIME: f64 = 5.0;
