@@ -84,8 +84,8 @@ using drive::clamp;
 const double kSpinSlipTan = 0.5773502691896258;  // 1 / tan 60 deg (sim/lap.rs)
 const double kSpinMinSpeed = 3.0;
 const double kBackwardsDistance = 10.0;
-const double kStallSpeed = 1.0;
-const double kStallTime = 5.0;
+const double kStallSpeed = 1.0;  // sim/lap.rs STALL_SPEED
+const double kStallTime = 5.0;   // sim/lap.rs STALL_TIME
 const double kSlipSpeedFloor = 2.0;  // sim/vehicle.rs SLIP_SPEED_FLOOR
 
 struct Settings {

@@ -47,8 +47,8 @@
 //! search begins, after the start lap, by raising the whole pedal by U₀ ≈ 0.35 and repairing
 //! the pushed lap corner by corner where it fails, as the ceiling repairs its fit, then by
 //! U₀/2, U₀/4, U₀/8 (a push not kept is followed by the next, afresh from the best lap); after
-//! a kept push the sweeps begin at single
-//! weights (the pushed lap is near the limit everywhere, where blocks of 8 mostly fail).
+//! a kept push the sweeps begin at single weights (the pushed lap is near the limit
+//! everywhere, where blocks of 8 mostly fail).
 //! Measured on the training panels: 34.86 against 32.80 m/s (σ₀ 0.12); with the lap's length
 //! told, repairs over 275 m of road and later pushes holding what a kept one lowered, 35.62,
 //! and 35.68 with σ₀ re-swept to 0.05 (docs/results/beyond).
