@@ -62,7 +62,9 @@ pub struct CompareArgs {
     /// Games running at once.
     #[arg(long, default_value_t = 2)]
     jobs: usize,
-    /// Output folder: compare.json, compare.md, speed_TRACK.png/.svg.
+    /// Output folder: compare.json, compare.md, speed_TRACK.png/.svg, and each drawn policy
+    /// the two simulators disagree on as disagreements/TRACK/policy-I.json (`cdbo lap
+    /// --policy` and `cdbo --simulator torcs lap --policy` drive it again, `--trace` traces it).
     #[arg(long, default_value = "runs/torcs-compare")]
     out: PathBuf,
 }
@@ -279,6 +281,21 @@ fn compare_track(
             })
             .collect(),
     };
+
+    let folder = args.out.join("disagreements").join(name);
+    for (i, _) in ours
+        .iter()
+        .zip(&theirs)
+        .enumerate()
+        .filter(|(_, (o, t))| o.completed != t.completed)
+    {
+        std::fs::create_dir_all(&folder)?;
+        let policy = cdbo::policy::Policy::from(drawn[i].clone());
+        std::fs::write(
+            folder.join(format!("policy-{i}.json")),
+            serde_json::to_string_pretty(&policy)?,
+        )?;
+    }
 
     // Speed along the lap of the learned policy, in both.
     sim.config.trace = true;
