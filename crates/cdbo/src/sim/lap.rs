@@ -448,3 +448,38 @@ impl Simulator {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sim::vehicle::SLIP_SPEED_FLOOR;
+
+    /// The value of `const double NAME = VALUE;` in the robot's source.
+    fn robot_constant(name: &str) -> f64 {
+        let prefix = format!("const double {name} = ");
+        let line = crate::torcs::ROBOT_SOURCE
+            .lines()
+            .find_map(|l| l.trim().strip_prefix(prefix.as_str()))
+            .unwrap_or_else(|| panic!("no `{prefix}…;` in torcs-robot/cdbo.cpp"));
+        let value = line.split(';').next().unwrap_or_default().trim();
+        value
+            .parse()
+            .unwrap_or_else(|e| panic!("{name} = {value:?}: {e}"))
+    }
+
+    /// The robot ends a game's lap by the rules a lap of cdbo's simulator ends by: its copies
+    /// of the spin, backwards and stall thresholds and of the slip's speed floor are these.
+    #[test]
+    fn the_robot_fails_a_lap_by_the_simulators_rules() {
+        for (name, ours) in [
+            ("kSpinSlipTan", INV_TAN_SPIN_SLIP_ANGLE),
+            ("kSpinMinSpeed", SPIN_MIN_SPEED),
+            ("kBackwardsDistance", BACKWARDS_DISTANCE),
+            ("kStallSpeed", STALL_SPEED),
+            ("kStallTime", STALL_TIME),
+            ("kSlipSpeedFloor", SLIP_SPEED_FLOOR),
+        ] {
+            assert_eq!(robot_constant(name), ours, "{name}");
+        }
+    }
+}
