@@ -179,9 +179,10 @@ fn the_robots_table_gives_each_robots_laps_and_damage() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// `cdbo torcs compare` writes each drawn policy the two simulators disagree on, and nothing
-/// else, where `cdbo lap` drives it again to the lap compare.json recorded for cdbo's side
-/// (on G-Track 1 cdbo's car leaves the road at 630-640 m on a few of them, the game's holds).
+/// `cdbo torcs compare --seeds 2` learns a policy a seed, draws around each and pools them;
+/// it writes each drawn policy the two simulators disagree on, and nothing else, where `cdbo
+/// lap` drives it again to the lap compare.json recorded for cdbo's side (on G-Track 1 cdbo's
+/// car leaves the road at 620-660 m on a few of them, the game's at 1010-1080 m on others).
 #[test]
 fn compare_writes_each_disagreement_as_a_policy_that_drives_again() {
     let dir = fresh_dir("compare");
@@ -191,13 +192,25 @@ fn compare_writes_each_disagreement_as_a_policy_that_drives_again() {
     let out = dir.join("compare");
     let o = torcs_cmd(&cache)
         .args(["torcs", "compare", "--tracks", "g-track-1", "--demo", "15"])
-        .args(["--policies", "30", "--out", out.to_str().unwrap()])
+        .args([
+            "--seeds",
+            "2",
+            "--policies",
+            "15",
+            "--out",
+            out.to_str().unwrap(),
+        ])
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("compare.json")).unwrap()).unwrap();
-    let disagreements = report[0]["policies"]["disagreements"].as_array().unwrap();
+    let policies = &report[0]["policies"];
+    assert_eq!(policies["seeds"], serde_json::json!([0, 1]));
+    assert_eq!(policies["drawn"], 30);
+    let disagreements = policies["disagreements"].as_array().unwrap();
+    let agree = policies["agree"].as_u64().unwrap() as usize;
+    assert_eq!(agree + disagreements.len(), 30);
     let folder = out.join("disagreements").join("g-track-1");
     let mut written: Vec<String> = std::fs::read_dir(&folder)
         .map(|d| {

@@ -56,6 +56,12 @@ pub struct CompareArgs {
     /// Seed of the race and of the drawn policies.
     #[arg(long, default_value_t = 0)]
     seed: u64,
+    /// Learned policies to draw around, one a seed from --seed on (--seed, --seed + 1, …),
+    /// --policies around each: the agreement and the errors pool them. One learned policy
+    /// moves the agreement by several points (docs/results/torcs.md); three give a steadier
+    /// measure for three times the laps.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=100))]
+    seeds: u64,
     /// The game's built-in robot to compare the limit with.
     #[arg(long, default_value = "bt")]
     robot: String,
@@ -63,8 +69,9 @@ pub struct CompareArgs {
     #[arg(long, default_value_t = 2)]
     jobs: usize,
     /// Output folder: compare.json, compare.md, speed_TRACK.png/.svg, and each drawn policy
-    /// the two simulators disagree on as disagreements/TRACK/policy-I.json (`cdbo lap
-    /// --policy` and `cdbo --simulator torcs lap --policy` drive it again, `--trace` traces it).
+    /// the two simulators disagree on as disagreements/TRACK/policy-I.json (with several
+    /// seeds seed-S-policy-I.json; `cdbo lap --policy` and `cdbo --simulator torcs lap
+    /// --policy` drive it again, `--trace` traces it).
     #[arg(long, default_value = "runs/torcs-compare")]
     out: PathBuf,
 }
@@ -109,11 +116,14 @@ impl Lap {
     }
 }
 
-/// Policies drawn around the learned one, in both simulators.
+/// Policies drawn around the learned ones, in both simulators.
 #[derive(Debug, Serialize)]
 struct Policies {
+    /// The seeds of the learned policies, each of its race and of the policies drawn around it.
+    seeds: Vec<u64>,
     drawn: usize,
     sigma: f64,
+    /// The learned policies' mean best reward in cdbo's simulator.
     learned_reward_mps: f64,
     completed_cdbo: usize,
     completed_torcs: usize,
@@ -145,6 +155,15 @@ struct TrackReport {
 pub fn run(args: &CompareArgs, data: &DataPath) -> CliResult {
     if args.policies == 0 || args.jobs == 0 || !(args.sigma.is_finite() && args.sigma >= 0.0) {
         return Err("--policies and --jobs must be positive, --sigma non-negative".into());
+    }
+    if args.seed.checked_add(args.seeds - 1).is_none() {
+        return Err(format!(
+            "--seed {} with --seeds {}: the last seed would pass {}",
+            args.seed,
+            args.seeds,
+            u64::MAX
+        )
+        .into());
     }
     let game = Game::ready()?;
     std::fs::create_dir_all(&args.out).map_err(|e| format!("{}: {e}", args.out.display()))?;
@@ -212,38 +231,52 @@ fn compare_track(
         torcs: Lap::of(&in_game(GamePedal::Constant(1.0), false)?),
     };
 
-    // A policy learned in cdbo's simulator, then policies drawn around it.
-    let config = RaceConfig {
-        kernels: args.kernels,
-        laps: args.laps,
-        seed: args.seed,
-        ..RaceConfig::default()
-    };
-    let learned = race(
-        &Venue::simulator(track.clone(), &car),
-        &track,
-        &car,
-        &config,
-        |_| {},
-    )?;
-    let best = learned.best.pedal.clone();
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(args.seed);
-    let drawn: Vec<RkhsPolicy> = (0..args.policies)
-        .map(|_| {
+    // Policies learned in cdbo's simulator, one a seed, then policies drawn around each,
+    // named by their seed when there are several.
+    let seeds: Vec<u64> = (0..args.seeds).map(|k| args.seed + k).collect();
+    let mut learned_rewards = Vec::new();
+    let mut learned_best = None;
+    let mut drawn: Vec<(String, RkhsPolicy)> = Vec::new();
+    for &seed in &seeds {
+        let config = RaceConfig {
+            kernels: args.kernels,
+            laps: args.laps,
+            seed,
+            ..RaceConfig::default()
+        };
+        let learned = race(
+            &Venue::simulator(track.clone(), &car),
+            &track,
+            &car,
+            &config,
+            |_| {},
+        )?;
+        learned_rewards.push(learned.best_reward_mps);
+        let best = learned.best.pedal.clone();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        for i in 0..args.policies {
             let w = best
                 .weights
                 .iter()
                 .map(|w| w + args.sigma * Distribution::<f64>::sample(&StandardNormal, &mut rng))
                 .collect();
-            RkhsPolicy::new(w, best.lengthscale)
-        })
-        .collect::<Result<_, _>>()?;
-    let ours: Vec<LapResult> = drawn.iter().map(|p| sim.lap(&mut p.pedal())).collect();
+            let what = match seeds.len() {
+                1 => format!("policy {i}"),
+                _ => format!("seed {seed} policy {i}"),
+            };
+            drawn.push((what, RkhsPolicy::new(w, best.lengthscale)?));
+        }
+        learned_best.get_or_insert((learned, best));
+    }
+    let Some((learned, best)) = learned_best else {
+        return Err("no seed to learn a policy with".into());
+    };
+    let ours: Vec<LapResult> = drawn.iter().map(|(_, p)| sim.lap(&mut p.pedal())).collect();
     let start = std::time::Instant::now();
     let theirs: Vec<LapResult> = pool.install(|| {
         drawn
             .par_iter()
-            .map(|p| in_game(GamePedal::Rkhs(p.clone()), false))
+            .map(|(_, p)| in_game(GamePedal::Rkhs(p.clone()), false))
             .collect::<Result<_, _>>()
     })?;
     let torcs_wall_s = start.elapsed().as_secs_f64();
@@ -254,9 +287,10 @@ fn compare_track(
         .collect();
     let n = errors.len() as f64;
     let policies = Policies {
-        drawn: args.policies,
+        seeds: seeds.clone(),
+        drawn: drawn.len(),
         sigma: args.sigma,
-        learned_reward_mps: learned.best_reward_mps,
+        learned_reward_mps: learned_rewards.iter().sum::<f64>() / learned_rewards.len() as f64,
         completed_cdbo: ours.iter().filter(|l| l.completed).count(),
         completed_torcs: theirs.iter().filter(|l| l.completed).count(),
         agree: ours
@@ -275,7 +309,7 @@ fn compare_track(
             .enumerate()
             .filter(|(_, (o, t))| o.completed != t.completed)
             .map(|(i, (o, t))| Pair {
-                what: format!("policy {i}"),
+                what: drawn[i].0.clone(),
                 cdbo: Lap::of(o),
                 torcs: Lap::of(t),
             })
@@ -283,16 +317,15 @@ fn compare_track(
     };
 
     let folder = args.out.join("disagreements").join(name);
-    for (i, _) in ours
+    for ((what, p), _) in drawn
         .iter()
-        .zip(&theirs)
-        .enumerate()
+        .zip(ours.iter().zip(&theirs))
         .filter(|(_, (o, t))| o.completed != t.completed)
     {
         std::fs::create_dir_all(&folder)?;
-        let policy = cdbo::policy::Policy::from(drawn[i].clone());
+        let policy = cdbo::policy::Policy::from(p.clone());
         std::fs::write(
-            folder.join(format!("policy-{i}.json")),
+            folder.join(format!("{}.json", what.replace(' ', "-"))),
             serde_json::to_string_pretty(&policy)?,
         )?;
     }
@@ -377,8 +410,22 @@ fn markdown(reports: &[TrackReport], args: &CompareArgs) -> String {
     }
     let _ = writeln!(
         s,
-        "\n### Policies around a learned one\n\nLearned in cdbo's simulator ({} kernels, {} laps, seed {}); {} policies w = w* + {}·N(0, I).\n\n| track | learned: cdbo | learned: TORCS | completed cdbo / TORCS | completion agreement | both completed | lap-time error mean / max | bias (TORCS − cdbo) | TORCS wall |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- |",
-        args.kernels, args.laps, args.seed, args.policies, args.sigma
+        "\n### Policies around a learned one\n\nLearned in cdbo's simulator ({} kernels, {} laps, {}); {} policies w = w* + {}·N(0, I){}.\n\n| track | learned: cdbo | learned: TORCS | completed cdbo / TORCS | completion agreement | both completed | lap-time error mean / max | bias (TORCS − cdbo) | TORCS wall |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+        args.kernels,
+        args.laps,
+        match args.seeds {
+            1 => format!("seed {}", args.seed),
+            n => format!("seeds {}–{}", args.seed, args.seed + n - 1),
+        },
+        args.policies,
+        args.sigma,
+        match args.seeds {
+            1 => String::new(),
+            _ => format!(
+                " around each, pooled; the learned lap is seed {}'s",
+                args.seed
+            ),
+        }
     );
     for r in reports {
         let p = &r.policies;
