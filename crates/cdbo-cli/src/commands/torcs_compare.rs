@@ -234,8 +234,7 @@ fn compare_track(
     // Policies learned in cdbo's simulator, one a seed, then policies drawn around each,
     // named by their seed when there are several.
     let seeds: Vec<u64> = (0..args.seeds).map(|k| args.seed + k).collect();
-    let mut learned_rewards = Vec::new();
-    let mut learned_best = None;
+    let mut races = Vec::with_capacity(seeds.len());
     let mut drawn: Vec<(String, RkhsPolicy)> = Vec::new();
     for &seed in &seeds {
         let config = RaceConfig {
@@ -244,15 +243,14 @@ fn compare_track(
             seed,
             ..RaceConfig::default()
         };
-        let learned = race(
+        let outcome = race(
             &Venue::simulator(track.clone(), &car),
             &track,
             &car,
             &config,
             |_| {},
         )?;
-        learned_rewards.push(learned.best_reward_mps);
-        let best = learned.best.pedal.clone();
+        let best = outcome.best.pedal.clone();
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
         for i in 0..args.policies {
             let w = best
@@ -266,11 +264,12 @@ fn compare_track(
             };
             drawn.push((what, RkhsPolicy::new(w, best.lengthscale)?));
         }
-        learned_best.get_or_insert((learned, best));
+        races.push((outcome, best));
     }
-    let Some((learned, best)) = learned_best else {
-        return Err("no seed to learn a policy with".into());
-    };
+    let learned_reward_mps =
+        races.iter().map(|(o, _)| o.best_reward_mps).sum::<f64>() / races.len() as f64;
+    // The first seed's policy is the one traced and charted (--seeds is at least 1).
+    let (learned, best) = races.swap_remove(0);
     let ours: Vec<LapResult> = drawn.iter().map(|(_, p)| sim.lap(&mut p.pedal())).collect();
     let start = std::time::Instant::now();
     let theirs: Vec<LapResult> = pool.install(|| {
@@ -290,7 +289,7 @@ fn compare_track(
         seeds: seeds.clone(),
         drawn: drawn.len(),
         sigma: args.sigma,
-        learned_reward_mps: learned_rewards.iter().sum::<f64>() / learned_rewards.len() as f64,
+        learned_reward_mps,
         completed_cdbo: ours.iter().filter(|l| l.completed).count(),
         completed_torcs: theirs.iter().filter(|l| l.completed).count(),
         agree: ours
