@@ -285,6 +285,10 @@ fn compare_track(
         .filter_map(|(o, t)| Some((t.lap_time_s? - o.lap_time_s?) / o.lap_time_s?))
         .collect();
     let n = errors.len() as f64;
+    // The drawn policies one simulator completes and the other does not.
+    let parted: Vec<usize> = (0..drawn.len())
+        .filter(|&i| ours[i].completed != theirs[i].completed)
+        .collect();
     let policies = Policies {
         seeds: seeds.clone(),
         drawn: drawn.len(),
@@ -302,25 +306,19 @@ fn compare_track(
         lap_time_error_max: errors.iter().map(|e| e.abs()).reduce(f64::max),
         lap_time_bias: (n > 0.0).then(|| errors.iter().sum::<f64>() / n),
         torcs_wall_s,
-        disagreements: ours
+        disagreements: parted
             .iter()
-            .zip(&theirs)
-            .enumerate()
-            .filter(|(_, (o, t))| o.completed != t.completed)
-            .map(|(i, (o, t))| Pair {
+            .map(|&i| Pair {
                 what: drawn[i].0.clone(),
-                cdbo: Lap::of(o),
-                torcs: Lap::of(t),
+                cdbo: Lap::of(&ours[i]),
+                torcs: Lap::of(&theirs[i]),
             })
             .collect(),
     };
 
     let folder = args.out.join("disagreements").join(name);
-    for ((what, p), _) in drawn
-        .iter()
-        .zip(ours.iter().zip(&theirs))
-        .filter(|(_, (o, t))| o.completed != t.completed)
-    {
+    for &i in &parted {
+        let (what, p) = &drawn[i];
         std::fs::create_dir_all(&folder)?;
         let policy = cdbo::policy::Policy::from(p.clone());
         std::fs::write(
