@@ -42,6 +42,9 @@ enum Command {
     ServeSim(commands::serve_sim::ServeSimArgs),
     /// Drive one lap and report its time, reward and the physical limit.
     Lap(commands::lap::LapArgs),
+    /// Drive a logged lap's own steering and pedal through cdbo's car, window by window: where
+    /// the model and the car that drove it part.
+    Replay(commands::replay::ReplayArgs),
     /// The quasi-steady-state minimum lap time of a car on a track.
     Limit(commands::limit::LimitArgs),
     /// The ceiling: the fastest completed lap tracking k x the limit's speed profile, and the
@@ -103,6 +106,7 @@ fn main() -> ExitCode {
         Command::Optimize(args) => commands::optimize::run(&args, cli.simulator, &data),
         Command::ServeSim(args) => commands::serve_sim::run(&args, &data, cli.simulator),
         Command::Lap(args) => commands::lap::run(&args, &data, cli.simulator),
+        Command::Replay(args) => commands::replay::run(&args, &data),
         Command::Limit(args) => commands::limit::run(&args, &data),
         Command::Ceiling(args) => commands::ceiling::run(&args, &data),
         Command::Dashboard(args) => commands::dashboard::run(&args, &data),

@@ -163,6 +163,51 @@ fn limit_and_bench_print_their_keys() {
 }
 
 #[test]
+fn a_traced_lap_replays_through_the_model_window_by_window() {
+    let trace = scratch("replayed.csv", "");
+    succeed(&["lap", "--trace", trace.to_str().unwrap()]);
+    let v = json(&["replay", "--log", trace.to_str().unwrap(), "--json"]);
+    let lap = &v[0];
+    // Ridgeway's 15 m/s lap, a window every 0.5 s: its own commands give it back.
+    let windows = lap["windows"].as_array().unwrap();
+    assert!(windows.len() > 300, "{}", windows.len());
+    assert!(lap["yaw_rate_rms"].as_f64().unwrap() < 0.003, "{lap}");
+    assert!(lap["mean_abs_lateral_m"].as_f64().unwrap() < 0.01, "{lap}");
+    let text = String::from_utf8(
+        succeed(&["replay", "--log", trace.to_str().unwrap(), "--worst", "3"]).stdout,
+    )
+    .unwrap();
+    assert!(
+        text.contains("where they part most") && text.lines().count() == 8,
+        "{text}"
+    );
+    // A log without the steering it applied cannot be replayed: one line says so.
+    let pedal_only = scratch(
+        "pedal-only.csv",
+        "t_s,distance_m,speed_mps,lateral_m,yaw_rate_rms,pedal\n0,0,0,0,0,1\n",
+    );
+    fails_with(
+        &["replay", "--log", pedal_only.to_str().unwrap()],
+        &["pedal-only.csv", "yaw_rate_rad_s", "missing"],
+    );
+    let text = std::fs::read_to_string(&trace).unwrap();
+    let no_steer: String = text
+        .lines()
+        .map(|l| l.replace("steer_rad", "wheel_rad"))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let no_steer_file = scratch("no-steer.csv", &no_steer);
+    fails_with(
+        &["replay", "--log", no_steer_file.to_str().unwrap()],
+        &["no-steer.csv", "lap 0", "t_s and steer_rad"],
+    );
+    fails_with(
+        &["replay", "--log", trace.to_str().unwrap(), "--window", "0"],
+        &["--window"],
+    );
+}
+
+#[test]
 fn traces_and_plots_are_written() {
     let trace = scratch("lap.csv", "");
     let png = scratch("lap.png", "");

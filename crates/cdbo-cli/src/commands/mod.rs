@@ -11,6 +11,7 @@ pub mod optimize;
 pub mod plot;
 pub mod policy;
 pub mod race;
+pub mod replay;
 pub mod report;
 pub mod serve_sim;
 pub mod study;

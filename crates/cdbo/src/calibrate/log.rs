@@ -11,8 +11,10 @@
 //! | `lateral_m` | offset from the centre line, m, positive left | yes |
 //! | `yaw_rate_rad_s` | yaw rate, rad/s, positive turning left | yes |
 //! | `pedal` | the pedal command applied, −1 (full brake) … 1 (full throttle) | yes |
-//! | `steer_rad` | the road-wheel steering angle applied, rad | no (not fitted) |
-//! | `t_s` | time since the start, s (gives the lap time of a completed lap) | no |
+//! | `steer_rad` | the road-wheel steering angle applied, rad | no (not fitted; [`crate::sim::replay`] needs it) |
+//! | `slip_angle_rad` | the body's slip angle atan(v_y/v_x), rad | no (replay: 0 without it) |
+//! | `gear` | the gear engaged, 1 = first (0 = neutral) | no (replay: cdbo's gearbox without it) |
+//! | `t_s` | time since the start, s (gives the lap time of a completed lap) | no (replay needs it) |
 //! | `lap` | a lap number: rows of one lap are consecutive | no (one lap) |
 //!
 //! Each lap starts standing on the start line, as cdbo's laps do. A lap is complete when it
@@ -38,6 +40,12 @@ pub struct Sample {
     pub pedal: f64,
     /// Time since the start (s), when logged.
     pub t: Option<f64>,
+    /// Road-wheel steering angle applied (rad), when logged.
+    pub steer: Option<f64>,
+    /// Body slip angle (rad), when logged.
+    pub slip_angle: Option<f64>,
+    /// Gear engaged (1 = first, 0 = neutral), when logged.
+    pub gear: Option<u8>,
 }
 
 /// One logged lap.
@@ -107,6 +115,11 @@ const YAW_RATE: &str = "yaw_rate_rad_s";
 const PEDAL: &str = "pedal";
 const TIME: &str = "t_s";
 const LAP: &str = "lap";
+const STEER: &str = "steer_rad";
+const SLIP_ANGLE: &str = "slip_angle_rad";
+const GEAR: &str = "gear";
+/// The highest gear a log may name.
+pub const MAX_GEAR: u8 = 12;
 
 /// Parses a log of laps on a track of `length` metres; `file` names it in errors.
 pub fn parse(text: &str, file: &str, length: f64) -> Result<Vec<LoggedLap>> {
@@ -152,6 +165,7 @@ pub fn parse(text: &str, file: &str, length: f64) -> Result<Vec<LoggedLap>> {
     let yaw_rate = required(YAW_RATE)?;
     let pedal = required(PEDAL)?;
     let (time, lap_col) = (find(TIME), find(LAP));
+    let (steer, slip_angle, gear) = (find(STEER), find(SLIP_ANGLE), find(GEAR));
 
     let mut laps: Vec<LoggedLap> = Vec::new();
     for (line, row) in lines {
@@ -203,6 +217,22 @@ pub fn parse(text: &str, file: &str, length: f64) -> Result<Vec<LoggedLap>> {
             yaw_rate: num(yaw_rate)?,
             pedal: a,
             t: time.map(num).transpose()?,
+            steer: steer.map(num).transpose()?,
+            slip_angle: slip_angle.map(num).transpose()?,
+            gear: match gear {
+                Some(i) => {
+                    let g = num(i)?;
+                    if g.fract() != 0.0 || !(0.0..=f64::from(MAX_GEAR)).contains(&g) {
+                        return Err(err(
+                            line,
+                            GEAR,
+                            format!("{g} is not a gear (a whole number 0 … {MAX_GEAR})"),
+                        ));
+                    }
+                    Some(g as u8)
+                }
+                None => None,
+            },
         };
         let lap = match lap_col {
             Some(i) => {
@@ -252,13 +282,27 @@ pub fn parse(text: &str, file: &str, length: f64) -> Result<Vec<LoggedLap>> {
     Ok(laps)
 }
 
-/// Writes laps in the log format [`parse`] reads (all columns, the lap numbered).
+/// Writes laps in the log format [`parse`] reads: every column, the lap numbered; the steering,
+/// slip angle and gear where every sample has them.
 pub fn write(laps: &[LoggedLap]) -> String {
-    let mut s = format!("{LAP},{DISTANCE},{SPEED},{LATERAL},{YAW_RATE},{PEDAL},{TIME}\n");
+    let all = |f: fn(&Sample) -> bool| laps.iter().flat_map(|l| &l.samples).all(f);
+    let (steer, slip, gear) = (
+        all(|p| p.steer.is_some()),
+        all(|p| p.slip_angle.is_some()),
+        all(|p| p.gear.is_some()),
+    );
+    let mut s = format!("{LAP},{DISTANCE},{SPEED},{LATERAL},{YAW_RATE},{PEDAL},{TIME}");
+    for (on, name) in [(steer, STEER), (slip, SLIP_ANGLE), (gear, GEAR)] {
+        if on {
+            s.push(',');
+            s.push_str(name);
+        }
+    }
+    s.push('\n');
     for lap in laps {
         for p in &lap.samples {
             s.push_str(&format!(
-                "{},{:.3},{:.4},{:.4},{:.5},{:.4},{}\n",
+                "{},{:.3},{:.4},{:.4},{:.5},{:.4},{}",
                 lap.lap,
                 p.distance_m,
                 p.speed,
@@ -267,6 +311,16 @@ pub fn write(laps: &[LoggedLap]) -> String {
                 p.pedal,
                 p.t.map_or("0".into(), |t| format!("{t:.3}"))
             ));
+            if let (true, Some(v)) = (steer, p.steer) {
+                s.push_str(&format!(",{v:.5}"));
+            }
+            if let (true, Some(v)) = (slip, p.slip_angle) {
+                s.push_str(&format!(",{v:.5}"));
+            }
+            if let (true, Some(g)) = (gear, p.gear) {
+                s.push_str(&format!(",{g}"));
+            }
+            s.push('\n');
         }
     }
     s
@@ -289,6 +343,17 @@ mod tests {
         assert_eq!(laps[0].lap_time_s(100.0), Some(8.0));
         assert_eq!(laps[1].line, 5);
         assert_eq!(parse(&write(&laps), "l.csv", 100.0).unwrap(), laps);
+        // The commands and the gear, where every sample has them, round-trip too.
+        let steered = parse(
+            "t_s,distance_m,speed_mps,lateral_m,yaw_rate_rad_s,pedal,steer_rad,gear\n0,0,0,0,0,1,0.01,1\n1,5,10,0,0,1,-0.02,2\n",
+            "l.csv",
+            100.0,
+        )
+        .unwrap();
+        assert_eq!(steered[0].samples[1].steer, Some(-0.02));
+        assert_eq!(steered[0].samples[1].gear, Some(2));
+        assert_eq!(steered[0].samples[1].slip_angle, None);
+        assert_eq!(parse(&write(&steered), "l.csv", 100.0).unwrap(), steered);
         assert_eq!(
             laps[0].pedal_table(100.0),
             vec![(0.0, 1.0), (0.5, 1.0), (0.995, 0.5)]
@@ -321,6 +386,10 @@ mod tests {
                 .starts_with("l.csv:3: column distance_m: the lap runs back")
         );
         assert!(bad(&format!("{HEAD}0,0,0,0,0,1,0\n")).contains("single row"));
+        assert_eq!(
+            bad("distance_m,speed_mps,lateral_m,yaw_rate_rad_s,pedal,gear\n0,0,0,0,1,2.5\n"),
+            "l.csv:2: column gear: 2.5 is not a gear (a whole number 0 … 12)"
+        );
         assert_eq!(bad(""), "l.csv: header: the log is empty");
         assert_eq!(bad(HEAD), "l.csv: rows: the log has a header but no rows");
         // A lap fraction instead of metres.

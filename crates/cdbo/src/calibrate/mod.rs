@@ -293,6 +293,9 @@ fn sample(p: &TracePoint) -> Sample {
         yaw_rate: p.yaw_rate,
         pedal: p.pedal,
         t: Some(p.t),
+        steer: Some(p.steer),
+        slip_angle: Some(p.slip_angle),
+        gear: u8::try_from(p.gear).ok(),
     }
 }
 

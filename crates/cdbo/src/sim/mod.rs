@@ -6,6 +6,7 @@ pub mod barrier;
 pub mod bounce;
 pub mod lap;
 pub mod powertrain;
+pub mod replay;
 pub mod table;
 pub mod tyre;
 pub mod vehicle;

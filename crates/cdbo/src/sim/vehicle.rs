@@ -337,6 +337,42 @@ impl Vehicle {
         }
     }
 
+    /// Under way at (x, y) facing `yaw`, with body velocities (vₓ, v_y), yaw rate r and the
+    /// tyres' longitudinal force per unit mass `accel` (m/s²), in `gear` (0-based), as in a
+    /// steady state: the wheels rolling at vₓ/R, the lagged load transfer settled (the
+    /// longitudinal at `accel`, the lateral at the roll moment m·vₓ·r·(h_f·b + h_r·a)/L of
+    /// the tyres' lateral forces shared by the lever rule), the clutch closed. Where a logged
+    /// lap is picked up ([`super::replay`]).
+    pub fn under_way(
+        &self,
+        (x, y, yaw): (f64, f64, f64),
+        (vx, vy, yaw_rate): (f64, f64, f64),
+        accel: f64,
+        gear: usize,
+    ) -> State {
+        let [h_f, h_r] = self.car.axles.roll_centre;
+        let l = self.a + self.b;
+        let mut s = State {
+            x,
+            y,
+            yaw,
+            vx,
+            vy,
+            yaw_rate,
+            omega: [
+                vx / self.radius[0],
+                vx / self.radius[1],
+                vx / self.radius[1],
+            ],
+            ax: accel,
+            roll: self.car.mass * vx * yaw_rate * (h_f * self.b + h_r * self.a) / l,
+            yaw_sin_cos: yaw.sin_cos(),
+            ..self.at_rest(x, y, yaw)
+        };
+        s.gearbox.gear = gear.min(self.car.gears.len().saturating_sub(1));
+        s
+    }
+
     /// The automatic gearbox's decision for the driver's throttle in [0, 1], taken at the
     /// driver's rate; also re-synchronises the incrementally rotated (sin ψ, cos ψ) with ψ.
     pub fn shift(&self, s: &mut State, throttle: f64) {
