@@ -182,7 +182,9 @@ fn the_robots_table_gives_each_robots_laps_and_damage() {
 /// `cdbo torcs compare --seeds 2` learns a policy a seed, draws around each and pools them;
 /// it writes each drawn policy the two simulators disagree on, and nothing else, where `cdbo
 /// lap` drives it again to the lap compare.json recorded for cdbo's side (on G-Track 1 cdbo's
-/// car leaves the road at 620-660 m on a few of them, the game's at 1010-1080 m on others).
+/// car leaves the road at 620-660 m on a few of them, the game's at 1010-1080 m on others);
+/// and it keeps every drawn policy with the game's lap, which `cdbo torcs panel` scores again
+/// to compare's count.
 #[test]
 fn compare_writes_each_disagreement_as_a_policy_that_drives_again() {
     let dir = fresh_dir("compare");
@@ -254,6 +256,20 @@ fn compare_writes_each_disagreement_as_a_policy_that_drives_again() {
             "{file:?}"
         );
     }
+    // The panel keeps every drawn policy with the game's lap; scored again without the game,
+    // cdbo's simulator agrees with it on exactly the policies compare counted.
+    let panel = out.join("panel_g-track-1.jsonl");
+    let text = std::fs::read_to_string(&panel).unwrap();
+    assert_eq!(text.lines().count(), 30);
+    let o = torcs_cmd(&cache)
+        .args(["torcs", "panel", "--json"])
+        .arg(&panel)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let scores: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(scores[0]["agree"].as_u64(), Some(agree as u64), "{scores}");
+    assert_eq!(scores[0]["lap_time_bias"], policies["lap_time_bias"]);
     nothing_left(&cache);
     let _ = std::fs::remove_dir_all(&dir);
 }

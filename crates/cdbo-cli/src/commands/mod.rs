@@ -18,6 +18,7 @@ pub mod study;
 pub mod torcs;
 pub mod torcs_calibrate;
 pub mod torcs_compare;
+pub mod torcs_panel;
 pub mod track;
 
 use clap::Args;

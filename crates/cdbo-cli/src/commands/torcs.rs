@@ -34,6 +34,10 @@ pub enum TorcsCommand {
     /// cdbo's simulator against the game: demonstrations, full throttle, policies drawn
     /// around a learned one, speed along the lap, the limit against a built-in robot.
     Compare(super::torcs_compare::CompareArgs),
+    /// cdbo's simulator scored again against the game's laps a compare kept
+    /// (OUT/panel_TRACK.jsonl), without the game: completion agreement and lap-time error per
+    /// track, in seconds, for a change to the model or a calibrated car (--car car.toml).
+    Panel(super::torcs_panel::PanelArgs),
     /// Fit the simulator's uncertain car parameters (grip, peak slip, drag, downforce,
     /// rolling resistance, launch) to traced laps of chosen policies in the game, or to a real
     /// car's logged laps (--log); write the calibrated car (car.toml, for --car) and the
@@ -77,6 +81,7 @@ fn report(game: &Game) -> SetupReport {
 pub fn run(cmd: &TorcsCommand, data: &cdbo::data_path::DataPath) -> CliResult {
     match cmd {
         TorcsCommand::Compare(args) => super::torcs_compare::run(args, data),
+        TorcsCommand::Panel(args) => super::torcs_panel::run(args, data),
         TorcsCommand::Calibrate(args) => super::torcs_calibrate::run(args, data),
         TorcsCommand::Robots { track, car, json } => robots(track, car, *json),
         TorcsCommand::Setup { json } => {

@@ -19,6 +19,7 @@ use cdbo::drive::demo::SpeedHold;
 use cdbo::experiment::race::{RaceConfig, race};
 use cdbo::policy::RkhsPolicy;
 use cdbo::sim::{LapResult, Simulator};
+use cdbo::torcs::panel::{Outcome, PanelLap};
 use cdbo::torcs::{Game, GamePedal, LapRequest};
 use cdbo::venue::Venue;
 
@@ -68,10 +69,12 @@ pub struct CompareArgs {
     /// Games running at once.
     #[arg(long, default_value_t = 2)]
     jobs: usize,
-    /// Output folder: compare.json, compare.md, speed_TRACK.png/.svg, and each drawn policy
-    /// the two simulators disagree on as disagreements/TRACK/policy-I.json (with several
-    /// seeds seed-S-policy-I.json; `cdbo lap --policy` and `cdbo --simulator torcs lap
-    /// --policy` drive it again, `--trace` traces it).
+    /// Output folder: compare.json, compare.md, speed_TRACK.png/.svg, every drawn policy
+    /// with the game's lap as panel_TRACK.jsonl (`cdbo torcs panel` scores cdbo's simulator
+    /// against it again, without the game), and each drawn policy the two simulators
+    /// disagree on as disagreements/TRACK/policy-I.json (with several seeds
+    /// seed-S-policy-I.json; `cdbo lap --policy` and `cdbo --simulator torcs lap --policy`
+    /// drive it again, `--trace` traces it).
     #[arg(long, default_value = "runs/torcs-compare")]
     out: PathBuf,
 }
@@ -315,6 +318,21 @@ fn compare_track(
             })
             .collect(),
     };
+
+    // Every drawn policy with the game's lap: `cdbo torcs panel` scores the simulator against
+    // them again without the game.
+    std::fs::create_dir_all(&args.out)?;
+    let mut panel = String::new();
+    for ((what, p), lap) in drawn.iter().zip(&theirs) {
+        panel += &cdbo::torcs::panel::line(&PanelLap {
+            track: name.to_owned(),
+            what: what.clone(),
+            policy: cdbo::policy::Policy::from(p.clone()),
+            torcs: Outcome::of(lap),
+        })?;
+        panel.push('\n');
+    }
+    std::fs::write(args.out.join(format!("panel_{name}.jsonl")), panel)?;
 
     let folder = args.out.join("disagreements").join(name);
     for &i in &parted {

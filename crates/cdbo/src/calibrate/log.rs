@@ -48,6 +48,23 @@ pub struct Sample {
     pub gear: Option<u8>,
 }
 
+impl Sample {
+    /// A step of a traced lap ([`crate::sim::lap`]), as a log's row.
+    pub fn of(p: &crate::sim::TracePoint) -> Sample {
+        Sample {
+            distance_m: p.distance_m,
+            speed: p.speed,
+            lateral: p.lateral,
+            yaw_rate: p.yaw_rate,
+            pedal: p.pedal,
+            t: Some(p.t),
+            steer: Some(p.steer),
+            slip_angle: Some(p.slip_angle),
+            gear: u8::try_from(p.gear).ok(),
+        }
+    }
+}
+
 /// One logged lap.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LoggedLap {

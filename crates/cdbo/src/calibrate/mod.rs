@@ -54,7 +54,7 @@ use crate::drive::demo::SpeedHold;
 use crate::error::{Error, Result};
 use crate::policy::PolicyTable;
 use crate::sim::Simulator;
-use crate::sim::lap::{LapResult, TracePoint};
+use crate::sim::lap::LapResult;
 use crate::track::Track;
 pub use log::{LoggedLap, Sample};
 
@@ -253,7 +253,7 @@ impl Observed {
     pub fn of_lap(probe: Probe, lap: &LapResult) -> Observed {
         Observed {
             probe,
-            samples: lap.trace.iter().map(sample).collect(),
+            samples: lap.trace.iter().map(Sample::of).collect(),
             completed: lap.completed,
             lap_time_s: lap.lap_time_s,
         }
@@ -282,20 +282,6 @@ impl Observed {
             line: 0,
             samples: self.samples.clone(),
         }
-    }
-}
-
-fn sample(p: &TracePoint) -> Sample {
-    Sample {
-        distance_m: p.distance_m,
-        speed: p.speed,
-        lateral: p.lateral,
-        yaw_rate: p.yaw_rate,
-        pedal: p.pedal,
-        t: Some(p.t),
-        steer: Some(p.steer),
-        slip_angle: Some(p.slip_angle),
-        gear: u8::try_from(p.gear).ok(),
     }
 }
 
@@ -408,7 +394,7 @@ impl<'a> Reader<'a> {
 /// Compares cdbo's lap `sim` of a probe with the observed lap `obs` on a track of `length`
 /// metres (module documentation, step 2).
 pub fn compare(obs: &Observed, sim: &LapResult, length: f64) -> LapComparison {
-    let ours: Vec<Sample> = sim.trace.iter().map(sample).collect();
+    let ours: Vec<Sample> = sim.trace.iter().map(Sample::of).collect();
     let (mut a, mut b) = (Reader::new(&obs.samples), Reader::new(&ours));
     let window = obs.probe.window * length;
     // A completed lap reached every station up to the finish, its last sample or not.

@@ -223,25 +223,14 @@ fn pose(track: &Track, before: &Sample, p: &Sample, after: &Sample) -> (f64, f64
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sim::{Simulator, TracePoint};
+    use crate::sim::Simulator;
 
     /// cdbo's own lap of Ridgeway at a 20 m/s speed hold, as a log.
     fn own_lap(car: &Car) -> (Track, LoggedLap) {
         let track = crate::track::builtin::load("ridgeway").unwrap().unwrap();
         let (lap, _) = Simulator::new(track.clone(), car).demonstrate(20.0);
         assert!(lap.completed);
-        let sample = |p: &TracePoint| Sample {
-            distance_m: p.distance_m,
-            speed: p.speed,
-            lateral: p.lateral,
-            yaw_rate: p.yaw_rate,
-            pedal: p.pedal,
-            t: Some(p.t),
-            steer: Some(p.steer),
-            slip_angle: Some(p.slip_angle),
-            gear: u8::try_from(p.gear).ok(),
-        };
-        let samples = lap.trace.iter().map(sample).collect();
+        let samples = lap.trace.iter().map(Sample::of).collect();
         (
             track,
             LoggedLap {

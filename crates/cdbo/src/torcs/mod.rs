@@ -22,6 +22,7 @@ pub mod evaluator;
 pub mod lap;
 pub mod launch;
 pub mod line;
+pub mod panel;
 pub mod traction;
 
 use std::path::{Path, PathBuf};
