@@ -207,23 +207,31 @@ fn a_traced_lap_replays_through_the_model_window_by_window() {
     );
 }
 
-/// A panel of laps (here written by hand, as `torcs compare` writes the game's) scores cdbo's
-/// simulator policy by policy, without the game.
-#[test]
-fn a_panel_of_the_games_laps_scores_the_simulator_without_the_game() {
-    let trace = scratch("panel-demo.csv", "");
+/// Ridgeway's 15 m/s demonstration traced (`cdbo lap --trace`, `TAG-demo.csv`) and w0 of 20
+/// kernels fitted to it (`cdbo policy fit`, `TAG-w0.json`).
+fn fitted_to_the_demonstration(tag: &str) -> (PathBuf, PathBuf) {
+    let trace = scratch(&format!("{tag}-demo.csv"), "");
     succeed(&["lap", "--trace", trace.to_str().unwrap()]);
-    let w0 = scratch("panel-w0.json", "");
+    let w0 = scratch(&format!("{tag}-w0.json"), "");
+    let (demo, out) = (trace.to_str().unwrap(), w0.to_str().unwrap());
     succeed(&[
         "policy",
         "fit",
         "--demo",
-        trace.to_str().unwrap(),
+        demo,
         "--kernels",
         "20",
         "-o",
-        w0.to_str().unwrap(),
+        out,
     ]);
+    (trace, w0)
+}
+
+/// A panel of laps (here written by hand, as `torcs compare` writes the game's) scores cdbo's
+/// simulator policy by policy, without the game.
+#[test]
+fn a_panel_of_the_games_laps_scores_the_simulator_without_the_game() {
+    let (_, w0) = fitted_to_the_demonstration("panel");
     let ours = json(&["lap", "--policy", w0.to_str().unwrap(), "--json"]);
     let t0 = ours["lap_time_s"].as_f64().expect("w0 completes Ridgeway");
     let policy: serde_json::Value =
@@ -768,19 +776,7 @@ fn a_cdbo_race_points_to_the_learner_beyond_the_paper() {
 
 #[test]
 fn policies_fit_to_a_trace_and_print_tables() {
-    let trace = scratch("demo-trace.csv", "");
-    succeed(&["lap", "--trace", trace.to_str().unwrap()]);
-    let weights = scratch("w0.json", "");
-    succeed(&[
-        "policy",
-        "fit",
-        "--demo",
-        trace.to_str().unwrap(),
-        "--kernels",
-        "20",
-        "-o",
-        weights.to_str().unwrap(),
-    ]);
+    let (trace, weights) = fitted_to_the_demonstration("table");
     let out = succeed(&[
         "policy",
         "table",
