@@ -47,10 +47,9 @@
 //!   scales drag, downforce and c_rr, and the drive torque in first gear (its launch).
 //! - Brakes: T = p·share·A_piston·μ_pad·r_disc per wheel, with ABS easing the pressure while an
 //!   axle's slip exceeds half the tyre's peak slip; traction control eases the throttle
-//!   likewise (the Spirit 300 has both; TORCS robots implement them in the driver). For a
-//!   car the TORCS robot drives, both are the robot's, set once a driver step
-//!   ([`Vehicle::robot_aids`]): traction control on the driven wheels' slip speed in every
-//!   gear, ABS scaling the one brake command by each sliding axle.
+//!   likewise (the Spirit 300 has both; TORCS robots implement them in the driver), and for a
+//!   car the TORCS robot drives as the robot does, on the driven wheels' slip speed in every
+//!   gear.
 //! - Launch of a car the TORCS robot drives ([`Car::torcs_robot`]): as simuv2 does, a
 //!   slipping clutch (transfer τ = 1 − c, c the robot's launch clutch, [`Vehicle::clutch`])
 //!   leaves the engine unloaded, ω̇_e = T_e(ω_e)/I_e, blended with the wheels' speed by τ⁴,
@@ -386,10 +385,8 @@ impl Vehicle {
     /// control on the driven axle's slip speed ωR − vₓ ([`crate::torcs::traction`]), and ABS
     /// scaling the one brake command by (2 − σ_a/σ*_a) clamped to [0, 1] for each axle a whose
     /// sliding slip σ_a = −(ω_aR − vₓ)/max(|vₓ|, v₀) passes its threshold σ*_a. The game holds
-    /// both until the next step, as cdbo's lap does ([`super::lap`]). With the gears' inertia
-    /// ([`Car::gear_inertia`]) cdbo's car1-trb1 is 0.17–0.25 m/s above the game's at 50 m
-    /// of full throttle from the start (E-Track 2, G-Track 1), against 0.20–0.28 with both aids
-    /// at every physics step.
+    /// both until the next step, as cdbo's lap does ([`super::lap`]): acting at every physics
+    /// step instead, cdbo's car pulled away 0.2–0.3 m/s faster than the game's.
     pub fn robot_aids(&self, s: &State, throttle: f64, brake: f64) -> (f64, f64) {
         let inv_axle = 1.0 / s.vx.abs().max(SLIP_SPEED_FLOOR);
         let omega = [s.omega[0], rear_omega(s)];
