@@ -282,14 +282,6 @@ pub struct Car {
     pub engine_inertia: f64,
     /// Forward gear ratios, first gear first.
     pub gears: Vec<f64>,
-    /// Each forward gear's own rotational inertia I_g (kg·m², at the gearbox), first gear
-    /// first: simuv2 spins it with the driven wheels, I_g·(g·g_f)² shared among them
-    /// (`transmission.cpp`: `freeI`); 0 where a car gives none.
-    pub gear_inertia: Vec<f64>,
-    /// Each forward gear's efficiency η_g in (0, 1], first gear first: simuv2 divides the
-    /// driven wheels' own inertia by it (`transmission.cpp`: `outAxis->I = curI/2 +
-    /// inAxis->I/gearEff`) and takes nothing from the drive torque.
-    pub gear_efficiency: Vec<f64>,
     /// Final drive (differential) ratio.
     pub final_drive: f64,
     /// Time without drive during a gear change (s).
@@ -390,8 +382,6 @@ impl Car {
             engine_brake: DEFAULT_ENGINE_BRAKE,
             engine_inertia: 0.15,
             gears: vec![3.66, 2.18, 1.4, 1.02, 0.85, 0.76],
-            gear_inertia: vec![0.0; 6],
-            gear_efficiency: vec![1.0; 6],
             final_drive: 4.5,
             shift_time: 0.4,
             drive: Drive::Rear,

@@ -221,16 +221,10 @@ pub fn from_params(p: &Params) -> Result<Car> {
 
     let gearbox = p.require_section("Gearbox")?;
     let shift_time = gearbox.num_or("shift time", 0.2)?;
-    let (mut gears, mut gear_inertia, mut gear_efficiency) = (Vec::new(), Vec::new(), Vec::new());
+    let mut gears = Vec::new();
     for i in 1..=10 {
         match gearbox.section(&format!("gears/{i}")) {
-            Some(g) => {
-                gears.push(positive(g, "ratio", g.require_num("ratio")?)?);
-                gear_inertia.push(non_negative(g, "inertia", g.num_or("inertia", 0.0)?)?);
-                // simuv2 caps an efficiency above 1 at 1; it divides by it, so 0 is refused.
-                gear_efficiency
-                    .push(positive(g, "efficiency", g.num_or("efficiency", 1.0)?)?.min(1.0));
-            }
+            Some(g) => gears.push(positive(g, "ratio", g.require_num("ratio")?)?),
             None => break,
         }
     }
@@ -434,8 +428,6 @@ pub fn from_params(p: &Params) -> Result<Car> {
         engine_brake,
         engine_inertia,
         gears,
-        gear_inertia,
-        gear_efficiency,
         final_drive: positive(sec(diff_section), "ratio", final_drive)?,
         shift_time,
         drive,

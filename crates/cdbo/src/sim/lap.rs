@@ -368,17 +368,10 @@ impl Simulator {
                     )
                 };
                 let steer = steering.update(track, &self.vehicle, &state, &proj, &line, driver_dt);
-                let (throttle, brake) = (a.max(0.0), (-a).max(0.0));
-                // The robot picks the gear on the pedal, then eases it (its aids) and slips
-                // the launch clutch on what is left.
-                self.vehicle.shift(&mut state, throttle);
-                let (throttle, brake) = if self.vehicle.car.torcs_robot {
-                    self.vehicle.robot_aids(&state, throttle, brake)
-                } else {
-                    (throttle, brake)
-                };
-                controls = Controls::new(steer, throttle, brake);
-                self.vehicle.clutch(&mut state, throttle, driver_dt);
+                controls = Controls::new(steer, a.max(0.0), (-a).max(0.0));
+                self.vehicle.shift(&mut state, controls.throttle());
+                self.vehicle
+                    .clutch(&mut state, controls.throttle(), driver_dt);
                 if cfg.trace {
                     trace.push(TracePoint {
                         t,

@@ -147,13 +147,7 @@ pub fn replay(
         let mut squared = 0.0;
         for k in i..end {
             let q = &samples[k];
-            let (throttle, brake) = (q.pedal.max(0.0), (-q.pedal).max(0.0));
-            let (throttle, brake) = if car.torcs_robot {
-                vehicle.robot_aids(&state, throttle, brake)
-            } else {
-                (throttle, brake)
-            };
-            let controls = Controls::new(steers[k], throttle, brake);
+            let controls = Controls::new(steers[k], q.pedal.max(0.0), (-q.pedal).max(0.0));
             match gear_index(q) {
                 // A logged change of gear starts a shift, as cdbo's gearbox does.
                 Some(g) => {

@@ -168,13 +168,7 @@ pub struct Vehicle {
     pub car: Car,
     tyres: [TyreModel; 2],
     radius: [f64; 2],
-    /// The front axle's (both wheels, one spin) and each rear wheel's rotational inertia in
-    /// each forward gear (kg·m²), as simuv2's differential spins them (`transmission.cpp`,
-    /// `differential.cpp`): a driven wheel I_w/η_g + I_g·(g·g_f)²/n, with η_g and I_g the
-    /// gear's efficiency and own inertia ([`Car::gear_inertia`]) and n the driven wheels (2,
-    /// or 4 with four-wheel drive); an undriven one I_w. car1-trb1's rear wheel: 1.35 kg·m²
-    /// undriven, 1.69 in first gear and 1.53 in sixth.
-    wheel_inertia: Vec<[f64; 2]>,
+    wheel_inertia: [f64; 2],
     max_brake: [f64; 2],
     driven: [f64; 2],
     shift_map: ShiftMap,
@@ -267,7 +261,7 @@ impl Vehicle {
             corners: car.ride.map(|ride| [0, 1].map(|k| Corner::of(&ride, k))),
             tyres,
             radius: [car.front_tyre.radius, car.rear_tyre.radius],
-            wheel_inertia: driven_inertia(car, driven),
+            wheel_inertia: [2.0 * car.front_tyre.inertia, car.rear_tyre.inertia],
             max_brake: [2.0 * car.brake_torque(true), car.brake_torque(false)],
             driven,
             shift_map: ShiftMap::new(car),
@@ -377,31 +371,6 @@ impl Vehicle {
         };
         s.gearbox.gear = gear.min(self.car.gears.len().saturating_sub(1));
         s
-    }
-
-    /// The throttle and brake pedal the TORCS robot sends for the driver's `throttle` and
-    /// `brake`, in [0, 1], at one of its steps (`torcs-robot/cdbo.cpp`), for a car it drives
-    /// ([`Car::torcs_robot`]; another car's aids act inside [`Vehicle::step`]): traction
-    /// control on the driven axle's slip speed ωR − vₓ ([`crate::torcs::traction`]), and ABS
-    /// scaling the one brake command by (2 − σ_a/σ*_a) clamped to [0, 1] for each axle a whose
-    /// sliding slip σ_a = −(ω_aR − vₓ)/max(|vₓ|, v₀) passes its threshold σ*_a. The game holds
-    /// both until the next step, as cdbo's lap does ([`super::lap`]): acting at every physics
-    /// step instead, cdbo's car pulled away 0.2–0.3 m/s faster than the game's.
-    pub fn robot_aids(&self, s: &State, throttle: f64, brake: f64) -> (f64, f64) {
-        let inv_axle = 1.0 / s.vx.abs().max(SLIP_SPEED_FLOOR);
-        let omega = [s.omega[0], rear_omega(s)];
-        let slip_speed = |k: usize| omega[k] * self.radius[k] - s.vx;
-        let k = if self.driven[1] > 0.0 { 1 } else { 0 };
-        let throttle = crate::torcs::traction::traction_throttle(throttle, slip_speed(k));
-        let mut brake = brake;
-        for axle in 0..2 {
-            let slide = -slip_speed(axle) * inv_axle;
-            let threshold = self.aid_threshold[axle];
-            if brake > 0.0 && threshold > 0.0 && slide > threshold {
-                brake *= (2.0 - slide / threshold).clamp(0.0, 1.0);
-            }
-        }
-        (throttle, brake)
     }
 
     /// The automatic gearbox's decision for the driver's throttle in [0, 1], taken at the
@@ -598,7 +567,7 @@ impl Vehicle {
         let combined2 = spin * spin + lateral * lateral;
         let threshold = self.aid_threshold[k];
         if self.car.torcs_robot {
-            // The robot's traction control acts at its driver steps ([`Vehicle::robot_aids`]).
+            throttle = crate::torcs::traction::traction_throttle(throttle, spin_speed);
         } else if spin > 0.0 && combined2 > threshold * threshold {
             throttle *= (2.0 - combined2.sqrt() / threshold).clamp(0.0, 1.0);
         }
@@ -663,7 +632,7 @@ impl Vehicle {
             let mut brake = c.brake() * self.max_brake[0];
             let threshold = self.aid_threshold[0];
             let slide = -(s.omega[0] * r - s.vx) * inv_axle;
-            if slide > threshold && !self.car.torcs_robot {
+            if slide > threshold {
                 brake *= (2.0 - slide / threshold).clamp(0.0, 1.0);
             }
             // Implicit step of I·dω/dt = T − T_b·sgn ω − R·ΣFₓ(ω), with Fₓ linear in ω.
@@ -671,7 +640,7 @@ impl Vehicle {
                 .iter()
                 .map(|(f, _, inv)| (f.dfx_dsx * r * inv).max(0.0))
                 .sum();
-            let inertia = self.wheel_inertia[s.gearbox.gear][0];
+            let inertia = self.wheel_inertia[0];
             let torque = self.driven[0] * drive_torque - r * (wheels[0].0.fx + wheels[1].0.fx);
             let free = torque - brake * s.omega[0].signum() * f64::from(s.omega[0] != 0.0);
             let mut new_omega = s.omega[0] + dt * free / (inertia + dt * r * dfx_domega);
@@ -796,34 +765,6 @@ impl Vehicle {
     }
 }
 
-/// [`Vehicle`]'s wheel inertias in each forward gear: the front axle's two wheels together and
-/// one rear wheel, for a car whose axles take the shares `driven` of the drive.
-pub(crate) fn driven_inertia(car: &Car, driven: [f64; 2]) -> Vec<[f64; 2]> {
-    let wheels = if driven.iter().all(|&d| d > 0.0) {
-        4.0
-    } else {
-        2.0
-    };
-    (0..car.gears.len())
-        .map(|g| {
-            let ratio = car.gears[g] * car.final_drive;
-            let gear = car.gear_inertia.get(g).copied().unwrap_or(0.0) * ratio * ratio / wheels;
-            let efficiency = car.gear_efficiency.get(g).copied().unwrap_or(1.0);
-            let wheel = |inertia: f64, k: usize| {
-                if driven[k] > 0.0 {
-                    inertia / efficiency + gear
-                } else {
-                    inertia
-                }
-            };
-            [
-                2.0 * wheel(car.front_tyre.inertia, 0),
-                wheel(car.rear_tyre.inertia, 1),
-            ]
-        })
-        .collect()
-}
-
 /// The rear wheels' loads and wheel-frame velocities at a step.
 struct RearWheels {
     /// Normal loads of the left and right wheels (N).
@@ -868,7 +809,7 @@ impl Vehicle {
     ) -> ([f64; 2], [f64; 2]) {
         let tyre = &self.tyres[1];
         let r = self.radius[1];
-        let inertia = self.wheel_inertia[s.gearbox.gear][1];
+        let inertia = self.wheel_inertia[1];
         let diff = &self.car.differential;
         let mut omega = [s.omega[1], s.omega[2]];
         // The differential's mode, its torque split and its speed constraint.
@@ -915,7 +856,7 @@ impl Vehicle {
         let mut brake = brake_pedal * self.max_brake[1];
         let threshold = self.aid_threshold[1];
         let slide = -(0.5 * (omega[0] + omega[1]) * r - s.vx) * w.inv_axle;
-        if slide > threshold && !self.car.torcs_robot {
+        if slide > threshold {
             brake *= (2.0 - slide / threshold).clamp(0.0, 1.0);
         }
 
@@ -1016,70 +957,6 @@ mod tests {
             vec![],
         );
         *t.frame(0)
-    }
-
-    /// simuv2's driven wheel spins with its gear: I_w/η_g + I_g·(g·g_f)²/n, n = 2 driven
-    /// wheels (4 with four-wheel drive); an undriven wheel with its own inertia alone.
-    #[test]
-    fn a_driven_wheel_spins_with_its_gear() {
-        let mut car = Car::spirit_300();
-        car.gear_inertia = vec![0.003, 0.0037, 0.0048, 0.0064, 0.0107, 0.015];
-        car.gear_efficiency = vec![0.955, 0.957, 0.95, 0.983, 0.948, 0.94];
-        let (i_f, i_r) = (car.front_tyre.inertia, car.rear_tyre.inertia);
-        let rear = driven_inertia(&car, [0.0, 1.0]);
-        let all = driven_inertia(&car, [0.5, 0.5]);
-        for g in 0..car.gears.len() {
-            let reflected = car.gear_inertia[g] * (car.gears[g] * car.final_drive).powi(2);
-            let eta = car.gear_efficiency[g];
-            assert_eq!(rear[g], [2.0 * i_f, i_r / eta + reflected / 2.0]);
-            assert_eq!(
-                all[g],
-                [
-                    2.0 * (i_f / eta + reflected / 4.0),
-                    i_r / eta + reflected / 4.0
-                ]
-            );
-        }
-        // First gear: 0.003·(3.66·4.5)²/2 = 0.41 kg·m² more than the wheel's own 1.67/0.955.
-        assert!(
-            (rear[0][1] - i_r / 0.955 - 0.4070).abs() < 1e-3,
-            "{:?}",
-            rear[0]
-        );
-        // The Spirit 300 as the paper drives it: no gear inertia, no loss.
-        let stock = Car::spirit_300();
-        assert!(
-            driven_inertia(&stock, [0.0, 1.0])
-                .iter()
-                .all(|i| *i == [2.0 * i_f, i_r])
-        );
-    }
-
-    /// The robot's aids, once a step: the throttle loses 1/10 per m/s of the driven axle's
-    /// slip speed past 2 m/s, and the one brake command the factor (2 − σ/σ*) of each axle
-    /// sliding past its threshold σ*.
-    #[test]
-    fn the_robots_aids_ease_throttle_and_brake_from_the_state() {
-        let mut car = Car::spirit_300();
-        car.torcs_robot = true;
-        let v = Vehicle::new(&car);
-        let mut s = v.at_rest(0.0, 0.0, 0.0);
-        s.vx = 20.0;
-        let [r_f, r_r] = v.radius;
-        // Rear wheels spinning 5 m/s faster than the road: 3 m/s past the slip.
-        s.omega = [20.0 / r_f, 25.0 / r_r, 25.0 / r_r];
-        let (throttle, brake) = v.robot_aids(&s, 1.0, 0.0);
-        assert!((throttle - 0.7).abs() < 1e-12 && brake == 0.0, "{throttle}");
-        // Braking: the front axle slides at 1.5 times its threshold, the rear at 1.25 times.
-        let [t_f, t_r] = v.aid_threshold;
-        s.omega = [
-            20.0 * (1.0 - 1.5 * t_f) / r_f,
-            20.0 * (1.0 - 1.25 * t_r) / r_r,
-            20.0 * (1.0 - 1.25 * t_r) / r_r,
-        ];
-        let (throttle, brake) = v.robot_aids(&s, 0.0, 0.8);
-        assert_eq!(throttle, 0.0);
-        assert!((brake - 0.8 * 0.5 * 0.75).abs() < 1e-9, "{brake}");
     }
 
     /// The car mirrored: steering, lateral velocity, yaw rate, roll moment and the rear wheels
