@@ -282,12 +282,25 @@ fn compare_track(
             .collect::<Result<_, _>>()
     })?;
     let torcs_wall_s = start.elapsed().as_secs_f64();
+    // Every drawn policy with the game's lap, kept as the panel (`cdbo torcs panel` scores
+    // the simulator against it again without the game), and scored as it would score it.
+    let panel: Vec<PanelLap> = drawn
+        .iter()
+        .zip(&theirs)
+        .map(|((what, p), lap)| PanelLap {
+            track: name.to_owned(),
+            what: what.clone(),
+            policy: cdbo::policy::Policy::from(p.clone()),
+            torcs: Outcome::of(lap),
+        })
+        .collect();
+    let outcomes: Vec<Outcome> = ours.iter().map(Outcome::of).collect();
+    let score = cdbo::torcs::panel::score(name, &panel.iter().collect::<Vec<_>>(), &outcomes);
     let errors: Vec<f64> = ours
         .iter()
         .zip(&theirs)
         .filter_map(|(o, t)| Some((t.lap_time_s? - o.lap_time_s?) / o.lap_time_s?))
         .collect();
-    let n = errors.len() as f64;
     // The drawn policies one simulator completes and the other does not.
     let parted: Vec<usize> = (0..drawn.len())
         .filter(|&i| ours[i].completed != theirs[i].completed)
@@ -299,15 +312,11 @@ fn compare_track(
         learned_reward_mps,
         completed_cdbo: ours.iter().filter(|l| l.completed).count(),
         completed_torcs: theirs.iter().filter(|l| l.completed).count(),
-        agree: ours
-            .iter()
-            .zip(&theirs)
-            .filter(|(o, t)| o.completed == t.completed)
-            .count(),
+        agree: score.agree,
         both_completed: errors.len(),
-        lap_time_error_mean: (n > 0.0).then(|| errors.iter().map(|e| e.abs()).sum::<f64>() / n),
+        lap_time_error_mean: score.lap_time_error_mean,
         lap_time_error_max: errors.iter().map(|e| e.abs()).reduce(f64::max),
-        lap_time_bias: (n > 0.0).then(|| errors.iter().sum::<f64>() / n),
+        lap_time_bias: score.lap_time_bias,
         torcs_wall_s,
         disagreements: parted
             .iter()
@@ -319,20 +328,13 @@ fn compare_track(
             .collect(),
     };
 
-    // Every drawn policy with the game's lap: `cdbo torcs panel` scores the simulator against
-    // them again without the game.
     std::fs::create_dir_all(&args.out)?;
-    let mut panel = String::new();
-    for ((what, p), lap) in drawn.iter().zip(&theirs) {
-        panel += &cdbo::torcs::panel::line(&PanelLap {
-            track: name.to_owned(),
-            what: what.clone(),
-            policy: cdbo::policy::Policy::from(p.clone()),
-            torcs: Outcome::of(lap),
-        })?;
-        panel.push('\n');
+    let mut lines = String::new();
+    for lap in &panel {
+        lines += &cdbo::torcs::panel::line(lap)?;
+        lines.push('\n');
     }
-    std::fs::write(args.out.join(format!("panel_{name}.jsonl")), panel)?;
+    std::fs::write(args.out.join(format!("panel_{name}.jsonl")), lines)?;
 
     let folder = args.out.join("disagreements").join(name);
     for &i in &parted {

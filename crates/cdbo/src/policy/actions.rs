@@ -129,13 +129,20 @@ impl Policy {
     pub fn from_json(text: &str, file: &str) -> Result<Policy> {
         let p: Policy = serde_json::from_str(text)
             .map_err(|e| Error::parse(file, "policy", format!("not policy weights: {e}")))?;
+        p.checked(file)
+    }
+
+    /// The policy with every block checked as [`RkhsPolicy::new`] checks it (finite weights,
+    /// a positive length-scale), for one deserialised without those checks; `file` names it
+    /// in errors.
+    pub fn checked(self, file: &str) -> Result<Policy> {
         let checked = |b: RkhsPolicy, what: &str| {
             RkhsPolicy::new(b.weights, b.lengthscale)
                 .map_err(|e| Error::parse(file, what, e.to_string()))
         };
         Ok(Policy {
-            pedal: checked(p.pedal, "policy")?,
-            line: p.line.map(|l| checked(l, "line")).transpose()?,
+            pedal: checked(self.pedal, "policy")?,
+            line: self.line.map(|l| checked(l, "line")).transpose()?,
         })
     }
 

@@ -70,11 +70,11 @@ pub fn parse(text: &str, file: &str) -> Result<Vec<PanelLap>> {
         };
         let lap: PanelLap = serde_json::from_str(line).map_err(|e| at(e.to_string()))?;
         // Every block checked as a policy file's, and a lap either completed or failed.
-        let policy = Policy::from_json(
-            &serde_json::to_string(&lap.policy).map_err(|e| at(e.to_string()))?,
-            file,
-        )
-        .map_err(|e| at(e.to_string()))?;
+        let policy = lap
+            .policy
+            .clone()
+            .checked(file)
+            .map_err(|e| at(e.to_string()))?;
         let t = &lap.torcs;
         let sound = match (t.lap_time_s, &t.failure) {
             (Some(s), None) => s.is_finite() && s > 0.0,
