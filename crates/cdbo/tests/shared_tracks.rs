@@ -231,6 +231,18 @@ fn spirit_300_from_its_files_equals_the_builtin_car() {
     );
     assert!((h - 1.45).abs() < 0.01, "{h}");
     assert!(rear > front, "the rear wing loads the rear axle");
+    // Each wing's drag at its height (front 0.04 m, rear 0.99 m) pitches the body as simuv2's
+    // car.cpp does, M_y −= Fₓ·z: it loads the front axle by Σ 1.23·A·sin α·z / L, L = 2.64 m
+    // between the axles (196 N at 50 m/s).
+    let pitch = 1.23
+        * (0.25 * 6f64.to_radians().sin() * 0.04 + 0.7 * 14f64.to_radians().sin() * 0.99)
+        / (1.22 + 1.42);
+    assert!(
+        (trb1.wing_pitch_per_v2() - pitch).abs() < 1e-12,
+        "{}",
+        trb1.wing_pitch_per_v2()
+    );
+    assert!((pitch * 2500.0 - 196.5).abs() < 0.1, "{}", pitch * 2500.0);
     assert_eq!(trb1.engine_brake, 0.33);
     assert!((trb1.revs_max - 10_000.0 * std::f64::consts::PI / 30.0).abs() < 1e-9);
 }

@@ -220,6 +220,9 @@ pub struct Wing {
     pub angle: f64,
     /// Share of its downforce on the front axle, by the lever rule: (x_wing − x_rear) / L.
     pub front_share: f64,
+    /// Height z of the wing (m, TORCS `zpos`), the arm of its drag's pitching moment
+    /// ([`Car::wing_pitch_per_v2`]).
+    pub height: f64,
 }
 
 impl Wing {
@@ -487,6 +490,17 @@ impl Car {
     pub fn drag(&self, v: f64) -> f64 {
         let wings: f64 = self.wings.iter().map(Wing::drag_per_v2).sum();
         (AIR_HALF_RHO * self.cx * self.front_area + wings) * v * v * self.scales.drag
+    }
+
+    /// The load the wings' drag moves from the rear axle onto the front per v² (kg/m):
+    /// Σ 1.23·A·sin α·z / L over the wings, times the calibration's drag scale. simuv2's
+    /// `car.cpp` pitches the body by M_y −= Fₓ·z for each wing's drag Fₓ < 0 at its height z,
+    /// where a force's moment about the centre of gravity is z·Fₓ: in the game a wing's drag
+    /// loads the front. At 50 m/s car1-trb1's wings put 196 N on the front axle and take as
+    /// much from the rear, 195 N of it the rear wing's (0.7 m² at 14°, z = 0.99 m).
+    pub fn wing_pitch_per_v2(&self) -> f64 {
+        let moment: f64 = self.wings.iter().map(|w| w.drag_per_v2() * w.height).sum();
+        moment / self.wheelbase * self.scales.drag
     }
 
     /// Downforce on the front and rear axles at speed v, level road and no acceleration: the

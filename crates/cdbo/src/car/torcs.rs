@@ -175,6 +175,7 @@ pub fn from_params(p: &Params) -> Result<Car> {
             area,
             angle: w.num_or("angle", 0.0)?,
             front_share: (w.num_or("xpos", rear_x)? - rear_x) / wheelbase,
+            height: w.num_or("zpos", 0.0)?,
         })
     };
     let wings = [wing("Front Wing")?, wing("Rear Wing")?];

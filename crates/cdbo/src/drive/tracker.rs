@@ -259,7 +259,7 @@ pub fn curvature(p0: (f64, f64), p1: (f64, f64), p2: (f64, f64)) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::car::Car;
+    use crate::car::{Car, G};
     use crate::drive::demo::SpeedHold;
     use crate::drive::steering::{Steering, wrap_angle};
     use crate::drive::{Observation, Pedal};
@@ -328,9 +328,11 @@ mod tests {
     /// 3 m inside it (and outside it) at 15 m/s (0.23 g), the car settles on the line (e = 0
     /// within 5 mm) with the steering δ = (L + K·v²)·κ of the linear single-track car (within
     /// 0.5 %, as the front wheels' mean angle: the outer wheel steers by its Ackermann angle)
-    /// and its heading error Δψ_ss = κ·(m·a·v²/(L·C_r) − b) (within 2.5 % of κ·b, the
-    /// two terms nearly cancelling at this speed; the drive force on the rear tyres' budget
-    /// moves the rear slip a little), κ = 1/(R − d) the line's curvature.
+    /// and its heading error Δψ_ss = κ·(m·a·v²/(L·C_r) − b) − M_R/(L·C_r) (within 2.5 % of
+    /// κ·b, the terms nearly cancelling at this speed; the drive force on the rear tyres'
+    /// budget moves the rear slip a little), κ = 1/(R − d) the line's curvature; the rolling
+    /// resistance's moment M_R = R·L/2 against the yaw (simuv2's) asks the front tyres for
+    /// M_R/L more and the rear ones for M_R/L less, δ gaining M_R/L·(1/C_f + 1/C_r).
     #[test]
     fn the_tracker_holds_an_offset_on_a_circle() {
         let r = 100.0;
@@ -366,8 +368,11 @@ mod tests {
             let kappa = 1.0 / (r - offset);
             let [cf, cr] = sim.vehicle.cornering_stiffness(v, 1.0);
             let understeer = m / l * (b / cf - a / cr);
-            let steer = (l + understeer * v * v) * kappa;
-            let heading = kappa * (m * a * v * v / (l * cr) - b);
+            let c_rr = 0.5 * (car.front_tyre.rolling_resistance + car.rear_tyre.rolling_resistance);
+            let [df, dr] = car.downforce(v);
+            let turning = 0.5 * c_rr * (m * G + df + dr) * l;
+            let steer = (l + understeer * v * v) * kappa + turning / l * (1.0 / cf + 1.0 / cr);
+            let heading = kappa * (m * a * v * v / (l * cr) - b) - turning / (l * cr);
             let lateral = mean(&|p| p.lateral);
             let heading_error = mean(&|p| {
                 let proj = sim.track.project_global(p.pos_x, p.pos_y);

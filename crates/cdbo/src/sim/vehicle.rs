@@ -5,10 +5,11 @@
 //! State: position (X, Y), yaw ψ, body velocities (vₓ, v_y), yaw rate r, the spin ω of the
 //! front wheels and of each rear wheel. With a = CG→front axle, b = CG→rear axle, L = a + b:
 //!
-//! - Axle loads: F_zf = m·n·b/L − m·Āₓ·h_p/L + D_f, F_zr = m·n·a/L + m·Āₓ·h_p/L + D_r, with
-//!   m·Āₓ the tyres' longitudinal force (lagged 50 ms), h_p the pitch height
+//! - Axle loads: F_zf = m·n·b/L − m·Āₓ·h_p/L + D_f + W·v², F_zr = m·n·a/L + m·Āₓ·h_p/L + D_r
+//!   − W·v², with m·Āₓ the tyres' longitudinal force (lagged 50 ms), h_p the pitch height
 //!   ([`crate::car::Axles::pitch_height`]: simuv2's `car.cpp` pitches the body by Fₓ·(h +
-//!   ride height)), D the downforce and n = g·cos φ·cos β + vₓ²·κ_v
+//!   ride height)), W·v² what the wings' drag moves onto the front axle as the game's body
+//!   pitches ([`Car::wing_pitch_per_v2`]), D the downforce and n = g·cos φ·cos β + vₓ²·κ_v
 //!   the road's push per unit mass: gravity on the grade φ and the banking β, and the road's
 //!   vertical curvature κ_v = dφ/ds (negative over a crest, which unloads the car: at 31 m/s
 //!   over Ruudskogen's crest at 320 m, κ_v ≈ −0.004 /m takes 40 % of the weight off, and the
@@ -38,8 +39,9 @@
 //!   the engine's inertia does not load the wheels: the engine speed follows them.
 //! - Body: m(v̇ₓ − v_y r) = F_xf cos δ − F_yf sin δ + F_xr − F_drag − F_roll − m g sin φ,
 //!   m(v̇_y + vₓ r) = F_xf sin δ + F_yf cos δ + F_yr − m g sin β,
-//!   I_z ṙ = a(F_xf sin δ + F_yf cos δ) − b F_yr + y_r(F_x,rr − F_x,rl), with β the banking
-//!   and F_xr, F_yr the rear wheels' sums.
+//!   I_z ṙ = a(F_xf sin δ + F_yf cos δ) − b F_yr + y_r(F_x,rr − F_x,rl) − M_R, with β the
+//!   banking, F_xr, F_yr the rear wheels' sums and M_R the rolling resistance's moment against
+//!   the yaw, simuv2's R·L/2 (`car.cpp`; [`Vehicle::rolling_yaw_moment`]).
 //! - Drag F = 0.645·Cx·A·v², downforce Dᵢ = 0.645·Clᵢ·A·v², rolling resistance
 //!   F = Σᵢ c_rr,i·F_z,i·sgn vₓ, c_rr,i the surface's under wheel i where the track gives one
 //!   (as TORCS's simuv2 does, `wheel.cpp`: F_z·`kRollRes` of the wheel's segment), else the
@@ -196,6 +198,9 @@ pub struct Vehicle {
     aid_threshold: [f64; 2],
     /// 0.645·Cx·A (kg/m).
     drag_per_v2: f64,
+    /// The load the wings' drag moves onto the front axle per v² (kg/m,
+    /// [`Car::wing_pitch_per_v2`]).
+    wing_pitch_per_v2: f64,
     /// Downforce per v² per axle (kg/m) at speeds 0, [`DOWNFORCE_SPEED_STEP`], 2·… m/s
     /// ([`Car::downforce`]: constant, 0.645·Clᵢ·A plus the wings', without a ride height; a
     /// function of the speed with one), linear in between, the last held beyond.
@@ -248,6 +253,7 @@ impl Vehicle {
                 .max(car.cg_to_rear())
                 .hypot(car.axles.half_track[0].max(car.axles.half_track[1])),
             drag_per_v2: car.drag(1.0),
+            wing_pitch_per_v2: car.wing_pitch_per_v2(),
             downforce_per_v2: match car.ride {
                 None => vec![car.downforce(1.0)],
                 Some(_) => (0..=DOWNFORCE_SPEEDS)
@@ -297,6 +303,20 @@ impl Vehicle {
     /// The tyre models of the front and rear axles.
     pub fn tyres(&self) -> &[TyreModel; 2] {
         &self.tyres
+    }
+
+    /// The rolling resistance's moment against the yaw (N·m), as simuv2's `car.cpp` turns the
+    /// body: M = R·L/2 against the yaw rate r, R the rolling resistance Σᵢ c_rr,i·F_z,i, or
+    /// r·I_z where R·L/(2·I_z) > |r| (the yaw then dies away over a second instead of turning
+    /// back). On a road of c_rr = 0.02 (E-Track 2 and 3, G-Track 1) car1-trb1 meets some
+    /// 420 N·m at 50 m/s; on Forza's 0.001, 20 N·m.
+    fn rolling_yaw_moment(&self, rolling: f64, yaw_rate: f64) -> f64 {
+        let half = 0.5 * rolling * self.car.wheelbase;
+        if half * self.inv_yaw_inertia > yaw_rate.abs() {
+            yaw_rate / self.inv_yaw_inertia
+        } else {
+            half.copysign(yaw_rate)
+        }
     }
 
     /// The cornering stiffness C_α (N/rad) of the front and rear axles at speed v on level road
@@ -494,7 +514,7 @@ impl Vehicle {
         // banking, and the vertical curvature's vₓ²κ_v (a crest unloads the car).
         let normal =
             frame.cos_pitch * frame.cos_banking + s.vx * s.vx * frame.vertical_curvature / G;
-        let transfer = self.transfer_per_accel * s.ax;
+        let transfer = self.transfer_per_accel * s.ax - self.wing_pitch_per_v2 * v2;
         let fz = [
             (self.static_load[0] * normal - transfer + down[0]).max(0.0),
             (self.static_load[1] * normal + transfer + down[1]).max(0.0),
@@ -730,6 +750,8 @@ impl Vehicle {
         let moment = self.a * front_y - self.b * rear_y
             + front_moment
             + self.car.axles.half_track[1] * (fx_rear[1] - fx_rear[0]);
+
+        let moment = moment - self.rolling_yaw_moment(rolling_force, s.yaw_rate);
 
         let inv_m = self.inv_mass;
         let ax = force_x * inv_m;
@@ -1070,6 +1092,47 @@ mod tests {
         let mut s = v.at_rest(100.0, 5.5, 0.0);
         s.yaw_sin_cos = (0.0, 1.0);
         assert!(v.wheel_ground(&s, plain.frame(100)).is_none());
+    }
+
+    /// The rolling resistance turns against the yaw as simuv2's `car.cpp` has it. One 4 ms
+    /// step of a car yawing at 0.6 rad/s on a road of c_rr = 0.01 loses R·L/2·dt/I_z more yaw
+    /// rate than on a road without rolling resistance, R = c_rr·(F_zf + F_zr) its rolling
+    /// resistance; a yaw slower than R·L/(2·I_z) loses r·dt, dying away over a second.
+    #[test]
+    fn the_rolling_resistance_turns_against_the_yaw() {
+        let v = Vehicle::new(&Car::spirit_300());
+        let (speed, c_rr, dt) = (30.0, 0.01, 0.004);
+        let yaw_rate_after = |rolling: f64, yaw_rate: f64| {
+            let mut frame = level();
+            frame.rolling_resistance = Some(rolling);
+            let mut s = v.at_rest(0.0, 0.0, 0.0);
+            s.vx = speed;
+            s.yaw_rate = yaw_rate;
+            s.omega = [
+                speed / v.radius[0],
+                speed / v.radius[1],
+                speed / v.radius[1],
+            ];
+            v.step(&mut s, &Controls::default(), &frame, dt);
+            s.yaw_rate
+        };
+        let down = v.downforce_per_v2(speed);
+        let loads = v.static_load[0] + v.static_load[1] + (down[0] + down[1]) * speed * speed;
+        let turning = 0.5 * c_rr * loads * v.car.wheelbase * v.inv_yaw_inertia;
+        let (fast, slow) = (0.6, 0.5 * turning);
+        assert!(turning < fast, "{turning}");
+        let lost = yaw_rate_after(0.0, fast) - yaw_rate_after(c_rr, fast);
+        assert!(
+            (lost - turning * dt).abs() < 1e-12,
+            "{lost} against {}",
+            turning * dt
+        );
+        let lost = yaw_rate_after(0.0, slow) - yaw_rate_after(c_rr, slow);
+        assert!(
+            (lost - slow * dt).abs() < 1e-12,
+            "{lost} against {}",
+            slow * dt
+        );
     }
 
     /// The lateral load transfer takes the roll moment up: the axles' transfers ΔF_a at ±y_a
