@@ -43,7 +43,7 @@ pub struct CalibrateArgs {
     )]
     fit: Vec<String>,
     /// Cost evaluations at most (each drives every calibration lap once in cdbo's simulator).
-    #[arg(long, default_value_t = 150, value_parser = super::value::evals)]
+    #[arg(long, default_value_t = cdbo::calibrate::DEFAULT_EVALUATIONS, value_parser = super::value::evals)]
     evaluations: usize,
     /// Games running at once.
     #[arg(long, default_value_t = 2, value_parser = super::value::jobs)]

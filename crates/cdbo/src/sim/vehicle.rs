@@ -710,12 +710,14 @@ impl Vehicle {
         );
 
         if slipping {
-            // ω_e ← ω_axle·g·τ⁴ + (ω_e + T_e·dt/I_e)·(1 − τ⁴), within idle and the revs
-            // maximum; free (τ ≤ 0.01), ω_e + T_e·dt/I_e.
+            // ω_e ← ω_axle·g·(1 − k) + (ω_e + T_e·dt/I_e)·k, k = (1 − τ⁴)^(dt/T_g), within idle
+            // and the revs maximum; free (τ ≤ 0.01), ω_e + T_e·dt/I_e. simuv2's `engine.cpp`
+            // blends by τ⁴ at each of its own steps T_g ([`GAME_STEP`]): k is that blend over
+            // this step's dt/T_g of them.
             let free = s.engine_speed + engine_torque * dt / car.engine_inertia;
             s.engine_speed = if transfer > 0.01 {
-                let t4 = transfer.powi(4);
-                let w = self.driven_omega(s) * s.gearbox.ratio(car) * t4 + free * (1.0 - t4);
+                let keep = (1.0 - transfer.powi(4)).powf(dt / GAME_STEP);
+                let w = self.driven_omega(s) * s.gearbox.ratio(car) * (1.0 - keep) + free * keep;
                 w.clamp(car.tickover, car.revs_max)
             } else {
                 free
@@ -952,6 +954,10 @@ fn scale_to_budget(x: f64, y: f64, fmax: f64) -> (f64, f64) {
     let scale = fmax / (x * x + y * y).sqrt();
     (x * scale, y * scale)
 }
+
+/// The step of TORCS's simuv2 (s; `RCM_MAX_DT_SIMU`), at which its slipping clutch blends the
+/// engine's speed with the wheels'.
+const GAME_STEP: f64 = 0.002;
 
 /// Speed step (m/s) of the table of downforce per v².
 const DOWNFORCE_SPEED_STEP: f64 = 0.5;
