@@ -300,10 +300,10 @@ fn a_panel_of_the_games_laps_scores_the_simulator_without_the_game() {
 /// The game's laps kept beside the fidelity report (docs/results/torcs/panel_TRACK.jsonl, 300
 /// policies a track drawn around three learned ones, driven in TORCS 1.3.7): cdbo's simulator
 /// keeps agreeing with them. A change to the model that loses fidelity fails here, without the
-/// game: on Forza, E-Track 2 and Aalborg it completed where the game did on 289–292 of 300
-/// when they were kept (session 33), and its laps were 0.3–0.4 % faster; the model before
-/// session 33 (no rolling resistance against the yaw, no pitch from the wings' drag) agrees
-/// on 278–283 of them.
+/// game: on Forza, E-Track 2 and Aalborg it completed where the game did on 291, 295 and 291
+/// of 300 when they were kept (session 33), and its laps were 0.2–0.4 % faster; the model
+/// before session 33 (no rolling resistance against the yaw, no pitch from the wings' drag, the
+/// launch clutch blended at cdbo's own step) agrees on 282, 290 and 285 of them.
 #[test]
 fn the_simulator_still_agrees_with_the_games_kept_laps() {
     let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/results/torcs");
@@ -317,7 +317,7 @@ fn the_simulator_still_agrees_with_the_games_kept_laps() {
     for s in v.as_array().unwrap() {
         let (agree, laps) = (s["agree"].as_u64().unwrap(), s["laps"].as_u64().unwrap());
         assert_eq!(laps, 300, "{s}");
-        assert!(agree >= 285, "{}: {agree} of {laps}", s["track"]);
+        assert!(agree >= 287, "{}: {agree} of {laps}", s["track"]);
         let bias = s["lap_time_bias"].as_f64().unwrap();
         assert!(
             (-0.005..0.015).contains(&bias),
