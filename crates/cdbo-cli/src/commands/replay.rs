@@ -8,7 +8,7 @@ use clap::Args;
 use super::{CliResult, Setup, print_json};
 use cdbo::calibrate::log;
 use cdbo::data_path::DataPath;
-use cdbo::sim::replay::{Replay, ReplayConfig, replay};
+use cdbo::sim::replay::{RegimeSummary, Replay, ReplayConfig, SLIDE_ANGLE, replay};
 
 #[derive(Debug, Args)]
 pub struct ReplayArgs {
@@ -28,7 +28,8 @@ pub struct ReplayArgs {
     /// How many of the windows where the two part most to list.
     #[arg(long, default_value_t = 10)]
     worst: usize,
-    /// Print JSON: every window of every lap.
+    /// Print JSON: every window of every lap, and the means over all and by what the logged
+    /// car did (`by_regime`).
     #[arg(long)]
     json: bool,
 }
@@ -72,8 +73,25 @@ pub fn run(args: &ReplayArgs, data: &DataPath) -> CliResult {
         );
         println!(
             "  yaw rate {:.4} rad/s rms; at a window's end the lateral offset {:.3} m apart (mean |cdbo - log|), the speed {:+.3} m/s (mean cdbo - log)",
-            r.yaw_rate_rms, r.mean_abs_lateral_m, r.mean_speed_error_mps
+            r.all.yaw_rate_rms, r.all.mean_abs_lateral_m, r.all.mean_speed_error_mps
         );
+        println!(
+            "  by what the logged car did (past the edge, sliding past {SLIDE_ANGLE} rad, braking, driving):"
+        );
+        println!(
+            "  | the car | windows | yaw rate rms (rad/s) | lateral, mean of abs(cdbo - log) (m) | speed, mean of cdbo - log (m/s) |"
+        );
+        println!("  | --- | ---: | ---: | ---: | ---: |");
+        for RegimeSummary { regime, summary: s } in &r.by_regime {
+            println!(
+                "  | {} | {} | {:.4} | {:.3} | {:+.3} |",
+                regime.name(),
+                s.count,
+                s.yaw_rate_rms,
+                s.mean_abs_lateral_m,
+                s.mean_speed_error_mps
+            );
+        }
         let mut worst: Vec<_> = r.windows.iter().collect();
         worst.sort_by(|a, b| b.lateral_error_m.abs().total_cmp(&a.lateral_error_m.abs()));
         worst.truncate(args.worst);

@@ -11,6 +11,11 @@
 //! - the yaw-rate error e_r = √(mean_k (r_k − r̂_k)²) over the window's samples,
 //! - the lateral and speed errors at its end, d − d̂ and v − v̂ (cdbo's minus the log's).
 //!
+//! Each window is classed by what the logged car did in it ([`Regime`]): past the road's edge,
+//! sliding, braking or driving on the road; the means are given per class too
+//! ([`Replay::by_regime`]), since a model that agrees on the road may part in slides and off
+//! it, where a learned policy that runs at the limit spends its decisive seconds.
+//!
 //! The logged state at sample i: the position at (sᵢ, dᵢ) off the centre line; the yaw
 //! ψ = θ(sᵢ) + atan((∂d/∂s)/(1 − κd)) − β, the direction of travel against the centre line's
 //! heading θ from the offset's slope (central differences over the neighbouring samples) less
@@ -66,19 +71,122 @@ pub struct Window {
     pub lateral_error_m: f64,
     /// Speed at its end, cdbo's minus the log's (m/s).
     pub speed_error_mps: f64,
+    /// What the logged car did over it.
+    pub regime: Regime,
 }
 
-/// A lap's replay: every window and their means.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Replay {
-    /// The windows, in the log's order.
-    pub windows: Vec<Window>,
+/// The body's slip angle past which a logged car is sliding (rad, about 4.6°).
+pub const SLIDE_ANGLE: f64 = 0.08;
+
+/// What a logged car did over a window, in the order of precedence: its centre past the
+/// road's edge at some sample; else its body's slip angle past [`SLIDE_ANGLE`] at some sample
+/// (where the log has it); else braking, the mean pedal below 0; else driving.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Regime {
+    /// On the road, the mean pedal at 0 or above, not sliding.
+    Driving,
+    /// On the road, the mean pedal below 0, not sliding.
+    Braking,
+    /// On the road, sliding.
+    Sliding,
+    /// Past the road's edge.
+    PastTheEdge,
+}
+
+impl Regime {
+    /// Every regime, in order.
+    pub const ALL: [Regime; 4] = [
+        Regime::Driving,
+        Regime::Braking,
+        Regime::Sliding,
+        Regime::PastTheEdge,
+    ];
+
+    /// The regime of a window's logged samples on `track`.
+    pub fn of(track: &Track, samples: &[Sample]) -> Regime {
+        let past_edge =
+            |q: &Sample| q.lateral.abs() > track.frame(track.index_at(q.distance_m)).half_width;
+        if samples.iter().any(past_edge) {
+            Regime::PastTheEdge
+        } else if samples
+            .iter()
+            .any(|q| q.slip_angle.is_some_and(|b| b.abs() > SLIDE_ANGLE))
+        {
+            Regime::Sliding
+        } else if samples.iter().map(|q| q.pedal).sum::<f64>() < 0.0 {
+            Regime::Braking
+        } else {
+            Regime::Driving
+        }
+    }
+
+    /// Its name in a report.
+    pub fn name(self) -> &'static str {
+        match self {
+            Regime::Driving => "driving",
+            Regime::Braking => "braking",
+            Regime::Sliding => "sliding",
+            Regime::PastTheEdge => "past the edge",
+        }
+    }
+}
+
+/// The windows' errors summed up.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Summary {
+    /// How many windows.
+    pub count: usize,
     /// √(mean of the windows' squared yaw-rate errors) (rad/s).
     pub yaw_rate_rms: f64,
     /// Mean |lateral error| at the windows' ends (m).
     pub mean_abs_lateral_m: f64,
     /// Mean speed error at the windows' ends (m/s): positive where cdbo's car is faster.
     pub mean_speed_error_mps: f64,
+}
+
+impl Summary {
+    /// The summary of `windows`; `None` for none.
+    pub fn of<'a>(windows: impl IntoIterator<Item = &'a Window>) -> Option<Summary> {
+        let (mut n, mut yaw, mut lateral, mut speed) = (0usize, 0.0, 0.0, 0.0);
+        for w in windows {
+            n += 1;
+            yaw += w.yaw_rate_rms.powi(2);
+            lateral += w.lateral_error_m.abs();
+            speed += w.speed_error_mps;
+        }
+        (n > 0).then(|| {
+            let k = n as f64;
+            Summary {
+                count: n,
+                yaw_rate_rms: (yaw / k).sqrt(),
+                mean_abs_lateral_m: lateral / k,
+                mean_speed_error_mps: speed / k,
+            }
+        })
+    }
+}
+
+/// A window class's summary.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct RegimeSummary {
+    /// The class.
+    pub regime: Regime,
+    /// Its windows' errors.
+    #[serde(flatten)]
+    pub summary: Summary,
+}
+
+/// A lap's replay: every window and their means, over all and per [`Regime`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Replay {
+    /// The windows, in the log's order.
+    pub windows: Vec<Window>,
+    /// All the windows' errors.
+    #[serde(flatten)]
+    pub all: Summary,
+    /// Each regime's, for those with windows, in [`Regime::ALL`]'s order.
+    pub by_regime: Vec<RegimeSummary>,
 }
 
 /// Replays `lap`, logged on `track` by `car`, window by window (module documentation).
@@ -180,20 +288,26 @@ pub fn replay(
             yaw_rate_rms: (squared / (end - i) as f64).sqrt(),
             lateral_error_m: proj.lateral - last.lateral,
             speed_error_mps: state.speed() - last.speed,
+            regime: Regime::of(track, &samples[i..=end]),
         });
     }
-    if windows.is_empty() {
+    let Some(all) = Summary::of(&windows) else {
         return Err(refuse(format!(
             "no window of {} s where the car moves at {MIN_SPEED} m/s or more",
             config.window_s
         )));
-    }
-    let n = windows.len() as f64;
+    };
+    let by_regime = Regime::ALL
+        .into_iter()
+        .filter_map(|regime| {
+            Summary::of(windows.iter().filter(|w| w.regime == regime))
+                .map(|summary| RegimeSummary { regime, summary })
+        })
+        .collect();
     Ok(Replay {
-        yaw_rate_rms: (windows.iter().map(|w| w.yaw_rate_rms.powi(2)).sum::<f64>() / n).sqrt(),
-        mean_abs_lateral_m: windows.iter().map(|w| w.lateral_error_m.abs()).sum::<f64>() / n,
-        mean_speed_error_mps: windows.iter().map(|w| w.speed_error_mps).sum::<f64>() / n,
         windows,
+        all,
+        by_regime,
     })
 }
 
@@ -248,12 +362,16 @@ mod tests {
             "{}",
             own.windows.len()
         );
-        assert!(own.yaw_rate_rms < 0.003, "{}", own.yaw_rate_rms);
-        assert!(own.mean_abs_lateral_m < 0.01, "{}", own.mean_abs_lateral_m);
+        assert!(own.all.yaw_rate_rms < 0.003, "{}", own.all.yaw_rate_rms);
         assert!(
-            own.mean_speed_error_mps.abs() < 0.01,
+            own.all.mean_abs_lateral_m < 0.01,
             "{}",
-            own.mean_speed_error_mps
+            own.all.mean_abs_lateral_m
+        );
+        assert!(
+            own.all.mean_speed_error_mps.abs() < 0.01,
+            "{}",
+            own.all.mean_speed_error_mps
         );
 
         // The same commands through a car with half as much drag again, 20 % less grip and a
@@ -265,16 +383,62 @@ mod tests {
         other.rear_tyre.mu *= 0.8;
         let apart = replay(&track, &other, &lap, &config, "own.csv").unwrap();
         assert!(
-            apart.mean_speed_error_mps < -0.03,
+            apart.all.mean_speed_error_mps < -0.03,
             "{}",
-            apart.mean_speed_error_mps
+            apart.all.mean_speed_error_mps
         );
         assert!(
-            apart.yaw_rate_rms > 3.0 * own.yaw_rate_rms,
+            apart.all.yaw_rate_rms > 3.0 * own.all.yaw_rate_rms,
             "{}",
-            apart.yaw_rate_rms
+            apart.all.yaw_rate_rms
         );
-        assert!(apart.mean_abs_lateral_m > 4.0 * own.mean_abs_lateral_m);
+        assert!(apart.all.mean_abs_lateral_m > 4.0 * own.all.mean_abs_lateral_m);
+    }
+
+    /// A window is classed by what the logged car did: past the road's edge before sliding,
+    /// sliding before braking; the classes' windows add up to all of them.
+    #[test]
+    fn a_window_is_classed_by_what_the_logged_car_did() {
+        let car = Car::spirit_300();
+        let (track, lap) = own_lap(&car);
+        let window = &lap.samples[100..150];
+        let with = |change: &dyn Fn(&mut Sample)| {
+            let mut w = window.to_vec();
+            change(&mut w[20]);
+            Regime::of(&track, &w)
+        };
+        let braking = |w: &[Sample]| w.iter().map(|q| q.pedal).sum::<f64>() < 0.0;
+        let plain = if braking(window) {
+            Regime::Braking
+        } else {
+            Regime::Driving
+        };
+        assert_eq!(Regime::of(&track, window), plain);
+        let edge = track
+            .frame(track.index_at(window[20].distance_m))
+            .half_width;
+        assert_eq!(with(&|q| q.slip_angle = Some(-0.09)), Regime::Sliding);
+        assert_eq!(with(&|q| q.slip_angle = Some(0.07)), plain);
+        assert_eq!(with(&|q| q.lateral = -(edge + 0.01)), Regime::PastTheEdge);
+        assert_eq!(with(&|q| q.lateral = edge - 0.01), plain);
+        let mut off_and_sliding = window.to_vec();
+        off_and_sliding[3].slip_angle = Some(0.2);
+        off_and_sliding[40].lateral = edge + 1.0;
+        assert_eq!(Regime::of(&track, &off_and_sliding), Regime::PastTheEdge);
+        let mut hard = window.to_vec();
+        hard.iter_mut().for_each(|q| q.pedal = -0.5);
+        assert_eq!(Regime::of(&track, &hard), Regime::Braking);
+
+        let own = replay(&track, &car, &lap, &ReplayConfig::default(), "own.csv").unwrap();
+        let counted: usize = own.by_regime.iter().map(|r| r.summary.count).sum();
+        assert_eq!(counted, own.windows.len());
+        assert!(
+            own.by_regime
+                .iter()
+                .all(|r| matches!(r.regime, Regime::Driving | Regime::Braking)),
+            "{:?}",
+            own.by_regime
+        );
     }
 
     #[test]

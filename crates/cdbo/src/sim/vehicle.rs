@@ -30,9 +30,10 @@
 //!   Σ y·(Fₓ,right − Fₓ,left) (simuv2's `car.cpp`: M_z = Σ −Fₓ·y + Fᵧ·x).
 //! - Rear wheels: driven through a spool, a free or a limited-slip differential as simuv2's
 //!   `differential.cpp` ([`Vehicle::rear_wheels`]).
-//! - Wheel slip: for the wheel-frame velocity (v_t, v_l), sₓ = (ωR − v_t)/max(|v_t|, v₀),
-//!   s_y = −v_l/max(|v_t|, v₀) with v₀ = [`SLIP_SPEED_FLOOR`]; the tyre ([`super::tyre`])
-//!   gives (Fₓ, F_y).
+//! - Wheel slip: for the wheel-frame velocity (v_t, v_l), sₓ = (ωR − v_t)/max(|v_t|, v₀) and
+//!   s_y = −v_l/max(|v|, v₀), |v| = √(v_t² + v_l²), the sine of the slip angle as simuv2's
+//!   `wheel.cpp` has it, with v₀ = [`SLIP_SPEED_FLOOR`]; the tyre ([`super::tyre`]) gives
+//!   (Fₓ, F_y).
 //! - Wheels: I·dω/dt = T_drive − T_brake·sgn ω − R·Fₓ(ω), integrated implicitly in ω (Fₓ
 //!   linearised), so that the stiff slip dynamics stay stable at the 4 ms step. As in TORCS's
 //!   simuv2 (whose differential takes its output inertia from the gear alone at each shift),
@@ -562,11 +563,13 @@ impl Vehicle {
         let turn = self.car.axles.half_track[1] * s.yaw_rate;
         let vt_rear = [s.vx - turn, s.vx + turn];
         let vl_rear = s.vy - self.b * s.yaw_rate;
-        // 1 / max(|v_t|, v₀): the slips' common denominator, per wheel.
+        // 1 / max(|v_t|, v₀), the longitudinal slip's denominator, and 1 / max(|v|, v₀), the
+        // lateral slip's (s_y = sin of the slip angle), per wheel.
         let inv_rear = [
             1.0 / vt_rear[0].abs().max(SLIP_SPEED_FLOOR),
             1.0 / vt_rear[1].abs().max(SLIP_SPEED_FLOOR),
         ];
+        let inv_speed_rear = vt_rear.map(|vt| 1.0 / vt.hypot(vl_rear).max(SLIP_SPEED_FLOOR));
         // An axle as the robot reads it: its wheels' mean spin against vₓ.
         let inv_axle = 1.0 / s.vx.abs().max(SLIP_SPEED_FLOOR);
 
@@ -645,7 +648,8 @@ impl Vehicle {
                 let inv = 1.0 / vt.abs().max(SLIP_SPEED_FLOOR);
                 let fmax = tyre.wheel_max_force(front_loads[i], friction[i]);
                 let sx = (s.omega[0] * r - vt) * inv;
-                (tyre.forces(sx, -vl * inv, fmax), fmax, inv)
+                let sy = -vl / vt.hypot(vl).max(SLIP_SPEED_FLOOR);
+                (tyre.forces(sx, sy, fmax), fmax, inv)
             };
             let wheels = [wheel(0), wheel(1)];
             // ABS: ease the pressure while the axle slides backwards past the threshold.
@@ -703,6 +707,7 @@ impl Vehicle {
                 vt: vt_rear,
                 vl: vl_rear,
                 inv_denom: inv_rear,
+                inv_speed: inv_speed_rear,
                 inv_axle,
             },
             [friction[2], friction[3]],
@@ -799,6 +804,8 @@ struct RearWheels {
     vl: f64,
     /// 1 / max(|v_t|, v₀) of each wheel.
     inv_denom: [f64; 2],
+    /// 1 / max(|v|, v₀) of each wheel, |v| = √(v_t² + v_l²).
+    inv_speed: [f64; 2],
     /// 1 / max(|vₓ|, v₀) of the car.
     inv_axle: f64,
 }
@@ -888,7 +895,7 @@ impl Vehicle {
         let forces = [0, 1].map(|i| {
             let fmax = tyre.wheel_max_force(w.loads[i], friction[i]);
             let sx = (omega[i] * r - w.vt[i]) * w.inv_denom[i];
-            let sy = -w.vl * w.inv_denom[i];
+            let sy = -w.vl * w.inv_speed[i];
             (tyre.forces(sx, sy, fmax), fmax)
         });
         let tau = [r * forces[0].0.fx, r * forces[1].0.fx];
@@ -1189,6 +1196,7 @@ mod tests {
             vt: [30.0, 30.0],
             vl: 0.0,
             inv_denom: [1.0 / 30.0; 2],
+            inv_speed: [1.0 / 30.0; 2],
             inv_axle: 1.0 / 30.0,
         };
         let spun = |kind: DiffKind, drive: f64, omega: [f64; 2], friction: f64| {
@@ -1214,6 +1222,35 @@ mod tests {
         // Both wheels on a road of friction 0.05, from rolling.
         let w = spun(DiffKind::Free, 800.0, [30.0 / r, 30.0 / r], 0.05);
         assert!(w[0] > 30.0 / r && (w[0] - w[1]).abs() < 1e-9, "{w:?}");
+    }
+
+    /// A wheel sliding at slip angle α slips sideways by sin α, as simuv2's `wheel.cpp` has it
+    /// (s_y = sin(atan2(v_l, v_t))): at α = 0.38 rad the tyre's lateral force is the one at
+    /// s_y = 0.371, 2 % short of what tan α = 0.4 would give.
+    #[test]
+    fn a_wheel_slips_sideways_by_the_sine_of_its_slip_angle() {
+        let car = Car::spirit_300();
+        let v = Vehicle::new(&car);
+        let r = car.rear_tyre.radius;
+        let (vt, vl, load) = (30.0, -12.0, 3000.0);
+        let rear = RearWheels {
+            loads: [load; 2],
+            vt: [vt; 2],
+            vl,
+            inv_denom: [1.0 / vt; 2],
+            inv_speed: [1.0 / f64::hypot(vt, vl); 2],
+            inv_axle: 1.0 / vt,
+        };
+        let mut s = v.at_rest(0.0, 0.0, 0.0);
+        s.vx = vt;
+        s.omega = [vt / r; 3];
+        let (_, fy) = v.rear_wheels(&mut s, 0.0, 0.0, &rear, [1.0; 2], 0.004);
+        let tyre = &v.tyres[1];
+        let fmax = tyre.wheel_max_force(load, 1.0);
+        let alpha = (-vl / vt).atan();
+        let by = |sy: f64| tyre.forces(0.0, sy, fmax).fy;
+        assert!((fy[0] - by(alpha.sin())).abs() < 1e-9 * fmax, "{fy:?}");
+        assert!((by(alpha.tan()) - by(alpha.sin())).abs() > 1e-3 * fmax);
     }
 
     /// Between the table's speeds the downforce per v² is the car's within 0.1 %, and a car
