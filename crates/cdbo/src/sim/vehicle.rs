@@ -358,6 +358,28 @@ impl Vehicle {
         }
     }
 
+    /// The tyres' longitudinal force per unit mass (m/s²) under which the body's vₓ changes
+    /// at `dvx_dt`, as [`Vehicle::step`] balances them: Fₓ/m = v̇ₓ − v_y·r + (F_drag +
+    /// F_roll)/m + g·sin φ, the drag 0.645·Cx·A·v·vₓ, the rolling resistance c_rr of the road
+    /// under the axles' quasi-static loads and downforce, φ the grade. Not the speed's slope:
+    /// in a slide v_y·r alone is some 2 m/s² (β = 0.1 rad at 30 m/s, r = 0.6 rad/s). Where a
+    /// logged lap is picked up ([`super::replay`]), with [`Vehicle::under_way`].
+    pub fn tyres_accel(
+        &self,
+        (vx, vy, yaw_rate): (f64, f64, f64),
+        dvx_dt: f64,
+        frame: &Frame,
+    ) -> f64 {
+        let v2 = vx * vx + vy * vy;
+        let down = self.downforce_per_v2(v2.sqrt());
+        let normal = frame.cos_pitch * frame.cos_banking + vx * vx * frame.vertical_curvature / G;
+        let loads = (self.static_load[0] + self.static_load[1]) * normal + (down[0] + down[1]) * v2;
+        let c_rr = frame.rolling_resistance.unwrap_or(self.rolling) * self.rolling_scale;
+        let roll = c_rr * loads.max(0.0) * (vx / 0.5).clamp(-1.0, 1.0);
+        let drag = self.drag_per_v2 * v2.sqrt() * vx;
+        dvx_dt - vy * yaw_rate + (drag + roll) / self.car.mass + G * frame.sin_pitch
+    }
+
     /// Under way at (x, y) facing `yaw`, with body velocities (vₓ, v_y), yaw rate r and the
     /// tyres' longitudinal force per unit mass `accel` (m/s²), in `gear` (0-based), as in a
     /// steady state: the wheels rolling at vₓ/R, the lagged load transfer settled (the
