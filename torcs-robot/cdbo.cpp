@@ -454,7 +454,8 @@ void new_track(int, tTrack *track, void *, void **settings, tSituation *) {
         } else {
             fprintf(lap.trace,
                     "t_s,distance_m,x,speed_mps,pedal,steer_rad,lateral_m,heading_error_rad,"
-                    "slip_angle_rad,gear,rpm,pos_x_m,pos_y_m,yaw_rate_rad_s\n");
+                    "slip_angle_rad,gear,rpm,pos_x_m,pos_y_m,yaw_rate_rad_s,wheel_speed_front_mps,"
+                    "wheel_speed_rear_left_mps,wheel_speed_rear_right_mps\n");
         }
     }
     if (h) GfParmReleaseHandle(h);
@@ -564,10 +565,14 @@ void drive(int, tCarElt *car, tSituation *s) {
     car->_clutchCmd = launch_clutch(car, throttle, dt);
 
     if (lap.trace) {
-        fprintf(lap.trace, "%.3f,%.3f,%.6f,%.4f,%.4f,%.5f,%.4f,%.5f,%.5f,%d,%.0f,%.3f,%.3f,%.5f\n", t,
+        // The wheels' speeds ω·R: the front axle's mean, the rear left's, the rear right's
+        // (TORCS's wheels: 0 front right, 1 front left, 2 rear right, 3 rear left).
+        auto wheel = [car](int i) { return car->_wheelSpinVel(i) * car->_wheelRadius(i); };
+        fprintf(lap.trace,
+                "%.3f,%.3f,%.6f,%.4f,%.4f,%.5f,%.4f,%.5f,%.5f,%d,%.0f,%.3f,%.3f,%.5f,%.4f,%.4f,%.4f\n", t,
                 lap.distance, x, speed, a, delta, lateral, heading_error,
                 std::atan2(vy, std::fmax(std::fabs(vx), 1e-9)), car->_gear, car->_enginerpm * 30.0 / M_PI,
-                car->_pos_X, car->_pos_Y, car->_yaw_rate);
+                car->_pos_X, car->_pos_Y, car->_yaw_rate, 0.5 * (wheel(0) + wheel(1)), wheel(3), wheel(2));
     }
 }
 

@@ -14,6 +14,7 @@
 //! | `steer_rad` | the road-wheel steering angle applied, rad | no (not fitted; [`crate::sim::replay`] needs it) |
 //! | `slip_angle_rad` | the body's slip angle atan(v_y/v_x), rad | no (replay: 0 without it) |
 //! | `gear` | the gear engaged, 1 = first (0 = neutral) | no (replay: cdbo's gearbox without it) |
+//! | `wheel_speed_front_mps`, `wheel_speed_rear_left_mps`, `wheel_speed_rear_right_mps` | the wheels' speeds ω·R, m/s (the front axle's mean) | no, all three or none (replay: the wheels rolling at vₓ without them) |
 //! | `t_s` | time since the start, s (gives the lap time of a completed lap) | no (replay needs it) |
 //! | `lap` | a lap number: rows of one lap are consecutive | no (one lap) |
 //!
@@ -46,6 +47,9 @@ pub struct Sample {
     pub slip_angle: Option<f64>,
     /// Gear engaged (1 = first, 0 = neutral), when logged.
     pub gear: Option<u8>,
+    /// The wheels' speeds ω·R (m/s): the front axle's, the rear left's, the rear right's,
+    /// when logged.
+    pub wheel_speeds: Option<[f64; 3]>,
 }
 
 impl Sample {
@@ -61,6 +65,7 @@ impl Sample {
             steer: Some(p.steer),
             slip_angle: Some(p.slip_angle),
             gear: u8::try_from(p.gear).ok(),
+            wheel_speeds: Some(p.wheel_speeds),
         }
     }
 }
@@ -135,6 +140,11 @@ const LAP: &str = "lap";
 const STEER: &str = "steer_rad";
 const SLIP_ANGLE: &str = "slip_angle_rad";
 const GEAR: &str = "gear";
+const WHEEL_SPEEDS: [&str; 3] = [
+    "wheel_speed_front_mps",
+    "wheel_speed_rear_left_mps",
+    "wheel_speed_rear_right_mps",
+];
 /// The highest gear a log may name.
 pub const MAX_GEAR: u8 = 12;
 
@@ -183,6 +193,25 @@ pub fn parse(text: &str, file: &str, length: f64) -> Result<Vec<LoggedLap>> {
     let pedal = required(PEDAL)?;
     let (time, lap_col) = (find(TIME), find(LAP));
     let (steer, slip_angle, gear) = (find(STEER), find(SLIP_ANGLE), find(GEAR));
+    let wheel_speeds = match WHEEL_SPEEDS.map(find) {
+        [Some(f), Some(l), Some(r)] => Some([f, l, r]),
+        [None, None, None] => None,
+        found => {
+            let missing = WHEEL_SPEEDS
+                .iter()
+                .zip(found)
+                .find_map(|(name, i)| i.is_none().then_some(*name))
+                .unwrap_or_default();
+            return Err(err(
+                header_line,
+                missing,
+                format!(
+                    "missing: the wheels' speeds come as all of {} or none",
+                    WHEEL_SPEEDS.join(", ")
+                ),
+            ));
+        }
+    };
 
     let mut laps: Vec<LoggedLap> = Vec::new();
     for (line, row) in lines {
@@ -248,6 +277,10 @@ pub fn parse(text: &str, file: &str, length: f64) -> Result<Vec<LoggedLap>> {
                     }
                     Some(g as u8)
                 }
+                None => None,
+            },
+            wheel_speeds: match wheel_speeds {
+                Some([f, l, r]) => Some([num(f)?, num(l)?, num(r)?]),
                 None => None,
             },
         };
@@ -417,5 +450,37 @@ mod tests {
         )
         .unwrap();
         assert_eq!(laps[0].samples[1].distance_m, 50.0);
+    }
+
+    /// The wheels' speeds come as all three columns or none, and reach the samples.
+    #[test]
+    fn the_wheels_speeds_come_as_three_columns_or_none() {
+        let head = "distance_m,speed_mps,lateral_m,yaw_rate_rad_s,pedal";
+        let laps = parse(
+            &format!(
+                "{head},wheel_speed_front_mps,wheel_speed_rear_left_mps,wheel_speed_rear_right_mps\n\
+                 0,10,0,0,1,10,10.5,10.7\n5,11,0,0,1,11,11.4,11.6\n"
+            ),
+            "l.csv",
+            100.0,
+        )
+        .unwrap();
+        assert_eq!(laps[0].samples[1].wheel_speeds, Some([11.0, 11.4, 11.6]));
+        let none = parse(&format!("{head}\n0,10,0,0,1\n5,11,0,0,1\n"), "l.csv", 100.0).unwrap();
+        assert_eq!(none[0].samples[0].wheel_speeds, None);
+        let partial = parse(
+            &format!(
+                "{head},wheel_speed_front_mps,wheel_speed_rear_right_mps\n0,10,0,0,1,10,10.7\n"
+            ),
+            "l.csv",
+            100.0,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            partial.starts_with("l.csv:1: column wheel_speed_rear_left_mps: missing")
+                && partial.contains("all of"),
+            "{partial}"
+        );
     }
 }

@@ -128,6 +128,8 @@ pub struct TracePoint {
     pub pos_y: f64,
     /// Yaw rate (rad/s, positive turning left).
     pub yaw_rate: f64,
+    /// The wheels' speeds ω·R (m/s): the front axle's, the rear left's, the rear right's.
+    pub wheel_speeds: [f64; 3],
 }
 
 /// The outcome of a lap.
@@ -388,6 +390,7 @@ impl Simulator {
                         pos_x: state.x,
                         pos_y: state.y,
                         yaw_rate: state.yaw_rate,
+                        wheel_speeds: self.vehicle.wheel_speeds(&state),
                     });
                 }
             }

@@ -255,6 +255,9 @@ pub fn replay(
             vehicle.tyres_accel(velocity, dvx_dt, frame),
             gear_index(p).unwrap_or(0),
         );
+        if let Some(speeds) = p.wheel_speeds {
+            vehicle.set_wheel_speeds(&mut state, speeds);
+        }
         // A shift the log shows under way: the last change of gear at a sample j ≤ i less than
         // the shift's time before, which leaves shift_time − (tᵢ − t_j) of it.
         let changed = |j: usize| {

@@ -358,6 +358,24 @@ impl Vehicle {
         }
     }
 
+    /// The wheels' speeds ω·R (m/s): the front axle's, the rear left's, the rear right's.
+    pub fn wheel_speeds(&self, s: &State) -> [f64; 3] {
+        [
+            s.omega[0] * self.radius[0],
+            s.omega[1] * self.radius[1],
+            s.omega[2] * self.radius[1],
+        ]
+    }
+
+    /// Sets the wheels' spins from their speeds ω·R (m/s), ordered as [`Vehicle::wheel_speeds`].
+    pub fn set_wheel_speeds(&self, s: &mut State, speeds: [f64; 3]) {
+        s.omega = [
+            speeds[0] / self.radius[0],
+            speeds[1] / self.radius[1],
+            speeds[2] / self.radius[1],
+        ];
+    }
+
     /// The tyres' longitudinal force per unit mass (m/s²) under which the body's vₓ changes
     /// at `dvx_dt`, as [`Vehicle::step`] balances them: Fₓ/m = v̇ₓ − v_y·r + (F_drag +
     /// F_roll)/m + g·sin φ, the drag 0.645·Cx·A·v·vₓ, the rolling resistance c_rr of the road

@@ -664,6 +664,9 @@ fn default_time_limit(install: &crate::torcs::Install, track: &str, category: &s
         .unwrap_or(1800.0)
 }
 
+/// The columns of the robot's trace, those of `cdbo lap --trace`.
+const TRACE_COLUMNS: usize = 17;
+
 /// The robot's trace: a header, then one row per driver step in the columns of
 /// `cdbo lap --trace`.
 pub fn read_trace(path: &Path) -> Result<Vec<TracePoint>> {
@@ -685,8 +688,11 @@ pub fn read_trace(path: &Path) -> Result<Vec<TracePoint>> {
                     .map_err(|_| bad(format!("{c:?} is not a number")))
             })
             .collect::<Result<Vec<f64>>>()?;
-        if v.len() != 14 {
-            return Err(bad(format!("expected 14 columns, found {}", v.len())));
+        if v.len() != TRACE_COLUMNS {
+            return Err(bad(format!(
+                "expected {TRACE_COLUMNS} columns, found {}",
+                v.len()
+            )));
         }
         points.push(TracePoint {
             t: v[0],
@@ -703,6 +709,7 @@ pub fn read_trace(path: &Path) -> Result<Vec<TracePoint>> {
             pos_x: v[11],
             pos_y: v[12],
             yaw_rate: v[13],
+            wheel_speeds: [v[14], v[15], v[16]],
         });
     }
     Ok(points)
