@@ -376,6 +376,27 @@ impl Vehicle {
         ];
     }
 
+    /// The road's push per unit of the car's weight at forward speed vₓ: gravity's share on
+    /// the grade φ and the banking β, and the vertical curvature's vₓ²κ_v (a crest unloads the
+    /// car): n = cos φ·cos β + vₓ²·κ_v/g.
+    #[inline]
+    fn road_push(frame: &Frame, vx: f64) -> f64 {
+        frame.cos_pitch * frame.cos_banking + vx * vx * frame.vertical_curvature / G
+    }
+
+    /// The rolling resistance coefficient on the road of `frame`: its surface's (simuv2), else
+    /// the tyres', times the calibration's scale.
+    #[inline]
+    fn road_rolling(&self, frame: &Frame) -> f64 {
+        frame.rolling_resistance.unwrap_or(self.rolling) * self.rolling_scale
+    }
+
+    /// Drag 0.645·Cx·A·v² along the velocity (|v|² = `v2`): its x component 0.645·Cx·A·v·vₓ.
+    #[inline]
+    fn drag_x(&self, v2: f64, vx: f64) -> f64 {
+        self.drag_per_v2 * v2.sqrt() * vx
+    }
+
     /// The tyres' longitudinal force per unit mass (m/s²) under which the body's vₓ changes
     /// at `dvx_dt`, as [`Vehicle::step`] balances them: Fₓ/m = v̇ₓ − v_y·r + (F_drag +
     /// F_roll)/m + g·sin φ, the drag 0.645·Cx·A·v·vₓ, the rolling resistance c_rr of the road
@@ -390,12 +411,10 @@ impl Vehicle {
     ) -> f64 {
         let v2 = vx * vx + vy * vy;
         let down = self.downforce_per_v2(v2.sqrt());
-        let normal = frame.cos_pitch * frame.cos_banking + vx * vx * frame.vertical_curvature / G;
+        let normal = Self::road_push(frame, vx);
         let loads = (self.static_load[0] + self.static_load[1]) * normal + (down[0] + down[1]) * v2;
-        let c_rr = frame.rolling_resistance.unwrap_or(self.rolling) * self.rolling_scale;
-        let roll = c_rr * loads.max(0.0) * (vx / 0.5).clamp(-1.0, 1.0);
-        let drag = self.drag_per_v2 * v2.sqrt() * vx;
-        dvx_dt - vy * yaw_rate + (drag + roll) / self.car.mass + G * frame.sin_pitch
+        let roll = self.road_rolling(frame) * loads.max(0.0) * (vx / 0.5).clamp(-1.0, 1.0);
+        dvx_dt - vy * yaw_rate + (self.drag_x(v2, vx) + roll) / self.car.mass + G * frame.sin_pitch
     }
 
     /// Under way at (x, y) facing `yaw`, with body velocities (vₓ, v_y), yaw rate r and the
@@ -551,10 +570,7 @@ impl Vehicle {
         let v2 = s.vx * s.vx + s.vy * s.vy;
         let per_v2 = self.downforce_per_v2(v2.sqrt());
         let down = [per_v2[0] * v2, per_v2[1] * v2];
-        // The road's push per unit of the car's weight: gravity's share on the grade and the
-        // banking, and the vertical curvature's vₓ²κ_v (a crest unloads the car).
-        let normal =
-            frame.cos_pitch * frame.cos_banking + s.vx * s.vx * frame.vertical_curvature / G;
+        let normal = Self::road_push(frame, s.vx);
         let transfer = self.transfer_per_accel * s.ax - self.wing_pitch_per_v2 * v2;
         let fz = [
             (self.static_load[0] * normal - transfer + down[0]).max(0.0),
@@ -774,7 +790,7 @@ impl Vehicle {
         // The road's coefficient where the track gives one (simuv2), else the tyres'.
         // A wheel on a verge rolls against its surface's coefficient: Σᵢ c_rr,i·F_z,i, taken as
         // the road's c_rr·(F_zf + F_zr) plus Σᵢ (c_rr,i − c_rr)·F_z,i.
-        let c_rr = frame.rolling_resistance.unwrap_or(self.rolling) * self.rolling_scale;
+        let c_rr = self.road_rolling(frame);
         let mut rolling_force = c_rr * (fz[0] + fz[1]);
         if let Some(w) = &ground {
             let loads = [front_loads[0], front_loads[1], rear_loads[0], rear_loads[1]];
@@ -783,8 +799,7 @@ impl Vehicle {
             }
         }
         let roll = rolling_force * (s.vx / 0.5).clamp(-1.0, 1.0);
-        // Drag 0.645·Cx·A·v² along the velocity: its x component is 0.645·Cx·A·v·vₓ.
-        let drag = self.drag_per_v2 * v2.sqrt() * s.vx;
+        let drag = self.drag_x(v2, s.vx);
         let tyres_x = front_x + fx_rear[0] + fx_rear[1];
         let force_x = tyres_x - drag - roll - m * G * frame.sin_pitch;
         // cos(ψ − θ) of the car's yaw against the road's heading.
