@@ -432,31 +432,38 @@ fn a_grid_steers_with_the_tracker_as_race_does() {
 }
 
 /// A grid's `off_track_margin` fails its laps where `cdbo race --off-track-margin` does: the
-/// same places, not the default margin's; a margin out of bounds is refused naming the file.
+/// same places, not the default margin's; without it a grid learns with the reserve `cdbo
+/// race` takes by default; a margin out of bounds is refused naming the file.
 #[test]
 fn a_grid_keeps_its_off_track_margin_as_race_does() {
     let dir = fresh_dir("margin");
-    let grid = "laps = 8\nrepeats = 1\nmethods = [\"pattern-search\"]\noff_track_margin = -1.0\n\
+    let grid = "laps = 8\nrepeats = 1\nmethods = [\"pattern-search\"]\noff_track_margin = 1.0\n\
                 [[tracks]]\ntrack = \"ridgeway\"\nkernels = [10]\n";
-    std::fs::write(dir.join("grid.toml"), grid).unwrap();
-    ok(&dir, &["experiment", "grid.toml", "--out", "g"]);
-    let run: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(dir.join("g/runs/ridgeway-m10-pattern-search-r0.json")).unwrap(),
-    )
-    .unwrap();
-    let grid_places: Vec<String> = run["laps"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|l| {
-            l["x_fail"]
-                .as_f64()
-                .map_or(String::new(), |x| format!("{x:.5}"))
-        })
-        .collect();
-    let race_places = |margin: &str| -> Vec<String> {
-        let out = format!("margin{margin}");
-        let args = [
+    let grid_places = |text: &str, out: &str| -> Vec<String> {
+        std::fs::write(dir.join("grid.toml"), text).unwrap();
+        ok(&dir, &["experiment", "grid.toml", "--out", out]);
+        let run: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(
+                dir.join(out)
+                    .join("runs/ridgeway-m10-pattern-search-r0.json"),
+            )
+            .unwrap(),
+        )
+        .unwrap();
+        run["laps"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|l| {
+                l["x_fail"]
+                    .as_f64()
+                    .map_or(String::new(), |x| format!("{x:.5}"))
+            })
+            .collect()
+    };
+    let race_places = |margin: Option<&str>| -> Vec<String> {
+        let out = format!("margin{}", margin.unwrap_or("default"));
+        let mut args = vec![
             "race",
             "--kernels",
             "10",
@@ -464,12 +471,13 @@ fn a_grid_keeps_its_off_track_margin_as_race_does() {
             "8",
             "--method",
             "pattern-search",
-            "--off-track-margin",
-            margin,
             "--json",
             "--out",
             &out,
         ];
+        if let Some(margin) = margin {
+            args.extend(["--off-track-margin", margin]);
+        }
         ok(&dir, &args);
         let csv = std::fs::read_to_string(dir.join(&out).join("laps.csv")).unwrap();
         csv.lines()
@@ -477,9 +485,13 @@ fn a_grid_keeps_its_off_track_margin_as_race_does() {
             .map(|l| l.split(',').nth(5).unwrap().to_owned())
             .collect()
     };
-    assert_eq!(grid_places, race_places("-1"));
-    assert_ne!(grid_places, race_places("1"));
-    std::fs::write(dir.join("bad.toml"), grid.replace("-1.0", "9.0")).unwrap();
+    let at_the_rule = grid_places(grid, "g");
+    assert_eq!(at_the_rule, race_places(Some("1")));
+    assert_ne!(at_the_rule, race_places(None));
+    let by_default = grid_places(&grid.replace("off_track_margin = 1.0\n", ""), "d");
+    assert_eq!(by_default, race_places(None));
+    assert_eq!(by_default, race_places(Some("-1")));
+    std::fs::write(dir.join("bad.toml"), grid.replace("1.0", "9.0")).unwrap();
     let err = String::from_utf8_lossy(&cdbo(&dir, &["experiment", "bad.toml"]).stderr).into_owned();
     assert!(
         err.contains("bad.toml") && err.contains("off-track margin"),

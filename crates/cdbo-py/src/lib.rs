@@ -26,6 +26,10 @@ fn _cdbo(m: &Bound<'_, PyModule>) -> PyResult<()> {
     )?;
     m.add("DEFAULT_BETA", cdbo::acquisition::ucb::DEFAULT_BETA)?;
     m.add("DEFAULT_BOX_RADIUS", cdbo::optimizers::DEFAULT_BOX_RADIUS)?;
+    m.add(
+        "LEARNING_OFF_TRACK_MARGIN",
+        cdbo::sim::lap::LEARNING_OFF_TRACK_MARGIN,
+    )?;
     m.add_class::<optimizer::PyOptimizer>()?;
     m.add_class::<study::PyStudy>()?;
     m.add_class::<study::PyTrial>()?;

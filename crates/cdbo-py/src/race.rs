@@ -144,13 +144,14 @@ impl PyRaceResult {
 /// the same settings): drive the demonstration, fit w0, then `laps` laps of `method`, on the
 /// line `line` (`centre`, `min-curvature` or `learn`, with `line_kernels` and `line_start` as
 /// `cdbo race --line-kernels` and `--line-start`), steered by `steering` (`pi` or `tracker`),
-/// its laps failing `off_track_margin` m past the road's edge (as `--off-track-margin`),
+/// its laps failing `off_track_margin` m past the road's edge (as `--off-track-margin`; by
+/// default 1 m inside it, `LEARNING_OFF_TRACK_MARGIN`, the reserve `cdbo race` learns with),
 /// searching w₀ ± `bounds` (as `--box-radius`; None: 1.5).
 /// `track` and `car` are objects or names; `knob` is the method's main knob (`cdbo race
 /// --knob`; None: its tuned value); `progress(record)` is called after every lap with the
 /// lap's record (a dict).
 #[pyfunction]
-#[pyo3(signature = (track = None, car = None, *, method = "cdbo", kernels = 30, laps = 300, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, demo_speed = 15.0, knob = None, max_failed = None, data_dir = None, progress = None, line = "centre", line_kernels = None, line_start = None, steering = "pi", off_track_margin = 1.0, bounds = None))]
+#[pyo3(signature = (track = None, car = None, *, method = "cdbo", kernels = 30, laps = 300, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, demo_speed = 15.0, knob = None, max_failed = None, data_dir = None, progress = None, line = "centre", line_kernels = None, line_start = None, steering = "pi", off_track_margin = cdbo::sim::lap::LEARNING_OFF_TRACK_MARGIN, bounds = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn race(
     py: Python<'_>,

@@ -13,6 +13,7 @@ use crate::evaluator::Evaluator;
 use crate::evaluator::simulator::SimEvaluator;
 use crate::line::RacingLine;
 use crate::policy::{Policy, PolicyShape};
+use crate::sim::lap::{GAME_OFF_TRACK_MARGIN, LEARNING_OFF_TRACK_MARGIN};
 use crate::sim::{LapConfig, LapResult, Simulator};
 use crate::torcs::evaluator::{TorcsEvaluator, drive, with_pedal, with_policy};
 use crate::torcs::{Game, GamePedal, LapRequest};
@@ -71,6 +72,26 @@ impl Venue {
     /// the game alike.
     pub fn off_track_at(self, margin: f64) -> Venue {
         self.configured(|config| config.off_track_margin = margin)
+    }
+
+    /// This venue as a policy learns in it: its laps failing `margin` metres past the road's
+    /// edge if given, else at [`LEARNING_OFF_TRACK_MARGIN`] in cdbo's simulator (a reserve the
+    /// world the policy is then driven in will not take away) and at the game's own rule,
+    /// [`GAME_OFF_TRACK_MARGIN`], in the game.
+    pub fn for_learning(self, margin: Option<f64>) -> Venue {
+        let margin = margin.unwrap_or(match self {
+            Venue::Simulator(_) => LEARNING_OFF_TRACK_MARGIN,
+            Venue::Game { .. } => GAME_OFF_TRACK_MARGIN,
+        });
+        self.off_track_at(margin)
+    }
+
+    /// Where this venue's laps fail: the car's centre this far past the road's edge (m).
+    pub fn off_track_margin(&self) -> f64 {
+        match self {
+            Venue::Simulator(sim) => sim.config.off_track_margin,
+            Venue::Game { request, .. } => request.config.off_track_margin,
+        }
     }
 
     /// This venue with its laps' settings changed by `change`.

@@ -127,7 +127,7 @@ pub fn run(args: &LapArgs, data: &DataPath, simulator: Simulator) -> CliResult {
     let line = base_line.line(&track, &car)?;
     let mut sim = cdbo::sim::Simulator::new(track, &car);
     sim.config.steering = args.steering.unwrap_or(steering).steering();
-    sim.config.off_track_margin = args.off_track.off_track_margin;
+    sim.config.off_track_margin = args.off_track.judging();
     sim.config.line = line;
     sim.config.trace = args.trace.is_some() || args.plot.is_some();
     let lap = sim.lap(pedal.as_mut());
@@ -199,7 +199,7 @@ fn run_torcs(args: &LapArgs, data: &DataPath) -> CliResult {
         .or(policy.as_ref().map(|p| p.steering))
         .unwrap_or_default();
     req.config.steering = steering.steering();
-    req.config.off_track_margin = args.off_track.off_track_margin;
+    req.config.off_track_margin = args.off_track.judging();
     let track = super::game_track(&args.setup.track, &game, data)?;
     // The policy's line on the base line it was raced on (none: the centre line, no table).
     if let Some(raced) = policy {

@@ -79,12 +79,21 @@ impl Simulator {
 #[derive(Debug, Clone, Copy, clap::Args)]
 pub struct OffTrackArgs {
     /// Where a lap leaves the road: once the car's centre is this far past the road's edge
-    /// (m; 1, the game's rule). A negative margin keeps the car that far inside the road while
-    /// it learns, for a policy that must survive a world harsher than the simulator: learned
-    /// so with -1 (-2), the pattern search's best policy completes in the game on 17 (20) of
-    /// TORCS's 21 road tracks, against 8 (docs/results/torcs.md, "Robust learning").
-    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true, value_parser = value::off_track_margin)]
-    pub off_track_margin: f64,
+    /// (m; negative: inside the road). Default: the game's rule, 1, for a lap judged (`lap`)
+    /// or learned in the game; -1 for a policy learned in cdbo's simulator, a reserve the
+    /// game's car will not take away: the pattern search's best policy learned so completes in
+    /// the game on all 21 of TORCS's road tracks, against 1 at 1 m (docs/results/torcs.md,
+    /// "Robust learning").
+    #[arg(long, allow_negative_numbers = true, value_parser = value::off_track_margin)]
+    pub off_track_margin: Option<f64>,
+}
+
+impl OffTrackArgs {
+    /// The margin a lap is judged by: the one given, else the game's rule.
+    pub fn judging(&self) -> f64 {
+        self.off_track_margin
+            .unwrap_or(cdbo::sim::lap::GAME_OFF_TRACK_MARGIN)
+    }
 }
 
 /// Where `--simulator` drives the laps of `setup`'s track and car, and cdbo's reading of them

@@ -172,7 +172,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     let (venue, track, car) = super::venue(&args.setup, data, simulator)?;
     let venue = venue
         .steered(args.steering.steering())
-        .off_track_at(args.off_track.off_track_margin);
+        .for_learning(args.off_track.off_track_margin);
     let track_name = track.name.clone();
     let car_name = simulator.car(&args.setup.car).to_owned();
     let out = args.out.clone().unwrap_or_else(|| {
@@ -221,6 +221,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     let wall_s = start.elapsed().as_secs_f64();
     let mut ceiling_sim = cdbo::sim::Simulator::new(track.clone(), &car);
     ceiling_sim.config.steering = args.steering.steering();
+    ceiling_sim.config.off_track_margin = venue.off_track_margin();
     let profile = cdbo::ceiling::profile(&track, &car, None);
     let (_, ceiling_mps) = cdbo::ceiling::tracked_profile(&ceiling_sim, &profile)?;
     write_outputs(&out, &outcome, config.base_line, args.steering)?;
@@ -253,7 +254,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         car: car_name,
         simulator: simulator.name(),
         steering: args.steering,
-        off_track_margin_m: args.off_track.off_track_margin,
+        off_track_margin_m: venue.off_track_margin(),
         max_failed_laps: args.max_failed_laps,
         box_radius: args
             .box_radius

@@ -30,6 +30,10 @@ pub struct ServeSimArgs {
     /// its kernels), w₀'s line the base line (d = 0).
     #[command(flatten)]
     line: super::line::LineArgs,
+    /// Where the laps leave the road, as `cdbo race` learns (default: 1 m inside the road's
+    /// edge in cdbo's simulator, the game's rule in the game).
+    #[command(flatten)]
+    off_track: super::OffTrackArgs,
 }
 
 pub fn run(args: &ServeSimArgs, data: &DataPath, simulator: Simulator) -> CliResult {
@@ -37,6 +41,7 @@ pub fn run(args: &ServeSimArgs, data: &DataPath, simulator: Simulator) -> CliRes
     // on cdbo's reading of the game's track.
     let (base_line, line_kernels) = args.line.resolve(args.kernels)?;
     let (venue, track, car) = super::venue(&args.setup, data, simulator)?;
+    let venue = venue.for_learning(args.off_track.off_track_margin);
     let venue = match base_line.line(&track, &car)? {
         Some(line) => venue.on_line(line),
         None => venue,

@@ -9,6 +9,7 @@ registered as ``cdbo/Race-v0`` when gymnasium is installed).
 from ._cdbo import (
     DEFAULT_BETA,
     DEFAULT_BOX_RADIUS,
+    LEARNING_OFF_TRACK_MARGIN,
     METHODS,
     Car,
     LapResult,
@@ -29,6 +30,7 @@ from .env import RaceEnv
 __all__ = [
     "DEFAULT_BETA",
     "DEFAULT_BOX_RADIUS",
+    "LEARNING_OFF_TRACK_MARGIN",
     "METHODS",
     "Car",
     "LapResult",

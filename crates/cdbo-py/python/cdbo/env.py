@@ -10,7 +10,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._cdbo import DEFAULT_BOX_RADIUS, Optimizer, Policy, Simulator, resolve_line
+from ._cdbo import (
+    DEFAULT_BOX_RADIUS,
+    LEARNING_OFF_TRACK_MARGIN,
+    Optimizer,
+    Policy,
+    Simulator,
+    resolve_line,
+)
 
 try:
     import gymnasium as _gym
@@ -66,8 +73,9 @@ class RaceEnv(_Base):
 
     ``steering`` is how the car steers, as ``cdbo race --steering``: ``"pi"`` (the paper's)
     or ``"tracker"`` (the path tracker); ``off_track_margin`` is where a lap leaves the road,
-    as ``--off-track-margin``: the car's centre that many metres past its edge (1, the
-    game's rule; negative: inside the road).
+    as ``--off-track-margin``: the car's centre that many metres past its edge (negative:
+    inside the road); by default ``LEARNING_OFF_TRACK_MARGIN``, -1, as ``cdbo race`` learns,
+    a reserve for the game or car the policy is then driven in (1 is the game's rule).
     """
 
     metadata = {"render_modes": []}
@@ -84,7 +92,7 @@ class RaceEnv(_Base):
         line_kernels=None,
         line_start=None,
         steering: str = "pi",
-        off_track_margin: float = 1.0,
+        off_track_margin: float = LEARNING_OFF_TRACK_MARGIN,
     ):
         self.base_line, self.line_kernels = resolve_line(
             kernels, line=line, line_kernels=line_kernels, line_start=line_start

@@ -219,7 +219,7 @@ pub fn run_at(
         Grounds::Torcs { game, car } => Venue::game(game, &spec.track, car, track.clone())?,
     }
     .steered(grid.steering.steering())
-    .off_track_at(grid.off_track_margin);
+    .for_learning(grid.off_track_margin);
     let outcome = race(&venue, &track, car, &config, progress)?;
     let ceiling_reward_mps = match venue {
         Venue::Simulator(sim) => {
