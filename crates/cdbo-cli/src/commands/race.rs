@@ -289,7 +289,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         return print_json(&summary);
     }
     println!(
-        "{} on {}, {} kernels, {} laps: best lap {} at {:.2} m/s, {:.1} % of the centre-line limit ({:.2} m/s), {:.1} % of the ceiling ({:.2} m/s), {:.2}x the demonstration ({:.2} m/s); {} laps failed",
+        "{} on {}, {} kernels, {} laps: best lap {} at {:.2} m/s, {:.1} % of the centre-line limit ({:.2} m/s), {:.1} % of the ceiling ({:.2} m/s), {:.2}x the demonstration ({:.2} m/s); {} laps failed at {}",
         summary.method,
         summary.track,
         summary.kernels,
@@ -304,7 +304,8 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         summary.ceiling_reward_mps,
         summary.best_reward_mps / summary.demo_reward_mps,
         summary.demo_reward_mps,
-        summary.failed_laps
+        summary.failed_laps,
+        edge_words(summary.off_track_margin_m)
     );
     if let Some(file) = &summary.warm_start {
         println!(
@@ -328,6 +329,18 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         );
     }
     Ok(())
+}
+
+/// Where a lap fails, in words: "1 m inside the road's edge", "1 m past the road's edge, the
+/// game's rule".
+fn edge_words(margin_m: f64) -> String {
+    match margin_m {
+        m if m == cdbo::sim::lap::GAME_OFF_TRACK_MARGIN => {
+            format!("{m} m past the road's edge, the game's rule")
+        }
+        m if m < 0.0 => format!("{} m inside the road's edge", -m),
+        m => format!("{m} m past the road's edge"),
+    }
 }
 
 fn slug(name: &str) -> String {
