@@ -96,6 +96,18 @@ impl OffTrackArgs {
     }
 }
 
+/// Where a lap fails, in words: "1 m inside the road's edge", "1 m past the road's edge, the
+/// game's rule".
+pub fn edge_words(margin_m: f64) -> String {
+    match margin_m {
+        m if m == cdbo::sim::lap::GAME_OFF_TRACK_MARGIN => {
+            format!("{m} m past the road's edge, the game's rule")
+        }
+        m if m < 0.0 => format!("{} m inside the road's edge", -m),
+        m => format!("{m} m past the road's edge"),
+    }
+}
+
 /// Where `--simulator` drives the laps of `setup`'s track and car, and cdbo's reading of them
 /// (for the limit and the plots): in the game, the game's own track and car files.
 pub fn venue(

@@ -305,7 +305,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         summary.best_reward_mps / summary.demo_reward_mps,
         summary.demo_reward_mps,
         summary.failed_laps,
-        edge_words(summary.off_track_margin_m)
+        super::edge_words(summary.off_track_margin_m)
     );
     if let Some(file) = &summary.warm_start {
         println!(
@@ -329,18 +329,6 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         );
     }
     Ok(())
-}
-
-/// Where a lap fails, in words: "1 m inside the road's edge", "1 m past the road's edge, the
-/// game's rule".
-fn edge_words(margin_m: f64) -> String {
-    match margin_m {
-        m if m == cdbo::sim::lap::GAME_OFF_TRACK_MARGIN => {
-            format!("{m} m past the road's edge, the game's rule")
-        }
-        m if m < 0.0 => format!("{} m inside the road's edge", -m),
-        m => format!("{m} m past the road's edge"),
-    }
 }
 
 fn slug(name: &str) -> String {

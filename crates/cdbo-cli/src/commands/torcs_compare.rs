@@ -63,6 +63,12 @@ pub struct CompareArgs {
     /// measure for three times the laps.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=100))]
     seeds: u64,
+    /// Where the learned policies' laps fail while they learn in cdbo's simulator, as `cdbo
+    /// race --off-track-margin` (m past the road's edge; default as `cdbo race`: 1 m inside it;
+    /// 1, the game's rule, was the default before session 35). Every drawn policy is judged at
+    /// the game's rule in both simulators.
+    #[arg(long, allow_negative_numbers = true, value_parser = super::value::off_track_margin)]
+    off_track_margin: Option<f64>,
     /// The game's built-in robot to compare the limit with.
     #[arg(long, default_value = "bt")]
     robot: String,
@@ -126,6 +132,8 @@ struct Policies {
     seeds: Vec<u64>,
     drawn: usize,
     sigma: f64,
+    /// Where the learned policies' laps failed while they learned (m past the road's edge).
+    learned_off_track_margin_m: f64,
     /// The learned policies' mean best reward in cdbo's simulator.
     learned_reward_mps: f64,
     completed_cdbo: usize,
@@ -237,6 +245,9 @@ fn compare_track(
     // Policies learned in cdbo's simulator, one a seed, then policies drawn around each,
     // named by their seed when there are several.
     let seeds: Vec<u64> = (0..args.seeds).map(|k| args.seed + k).collect();
+    let learning_margin = args
+        .off_track_margin
+        .unwrap_or(cdbo::sim::lap::LEARNING_OFF_TRACK_MARGIN);
     let mut races = Vec::with_capacity(seeds.len());
     let mut drawn: Vec<(String, RkhsPolicy)> = Vec::new();
     for &seed in &seeds {
@@ -247,7 +258,7 @@ fn compare_track(
             ..RaceConfig::default()
         };
         let outcome = race(
-            &Venue::simulator(track.clone(), &car),
+            &Venue::simulator(track.clone(), &car).off_track_at(learning_margin),
             &track,
             &car,
             &config,
@@ -309,6 +320,7 @@ fn compare_track(
         seeds: seeds.clone(),
         drawn: drawn.len(),
         sigma: args.sigma,
+        learned_off_track_margin_m: learning_margin,
         learned_reward_mps,
         completed_cdbo: ours.iter().filter(|l| l.completed).count(),
         completed_torcs: theirs.iter().filter(|l| l.completed).count(),
@@ -427,13 +439,17 @@ fn markdown(reports: &[TrackReport], args: &CompareArgs) -> String {
     }
     let _ = writeln!(
         s,
-        "\n### Policies around a learned one\n\nLearned in cdbo's simulator ({} kernels, {} laps, {}); {} policies w = w* + {}·N(0, I){}.\n\n| track | learned: cdbo | learned: TORCS | completed cdbo / TORCS | completion agreement | both completed | lap-time error mean / max | bias (TORCS − cdbo) | TORCS wall |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+        "\n### Policies around a learned one\n\nLearned in cdbo's simulator ({} kernels, {} laps, {}, laps failing at {}); {} policies w = w* + {}·N(0, I){}; their laps judged at the game's rule in both.\n\n| track | learned: cdbo | learned: TORCS | completed cdbo / TORCS | completion agreement | both completed | lap-time error mean / max | bias (TORCS − cdbo) | TORCS wall |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- |",
         args.kernels,
         args.laps,
         match args.seeds {
             1 => format!("seed {}", args.seed),
             n => format!("seeds {}–{}", args.seed, args.seed + n - 1),
         },
+        super::edge_words(
+            args.off_track_margin
+                .unwrap_or(cdbo::sim::lap::LEARNING_OFF_TRACK_MARGIN)
+        ),
         args.policies,
         args.sigma,
         match args.seeds {
