@@ -245,9 +245,8 @@ fn compare_track(
     // Policies learned in cdbo's simulator, one a seed, then policies drawn around each,
     // named by their seed when there are several.
     let seeds: Vec<u64> = (0..args.seeds).map(|k| args.seed + k).collect();
-    let learning_margin = args
-        .off_track_margin
-        .unwrap_or(cdbo::sim::lap::LEARNING_OFF_TRACK_MARGIN);
+    // Learned as `cdbo race` learns (its margin, by default the simulator's reserve).
+    let learning = Venue::simulator(track.clone(), &car).for_learning(args.off_track_margin);
     let mut races = Vec::with_capacity(seeds.len());
     let mut drawn: Vec<(String, RkhsPolicy)> = Vec::new();
     for &seed in &seeds {
@@ -257,13 +256,7 @@ fn compare_track(
             seed,
             ..RaceConfig::default()
         };
-        let outcome = race(
-            &Venue::simulator(track.clone(), &car).off_track_at(learning_margin),
-            &track,
-            &car,
-            &config,
-            |_| {},
-        )?;
+        let outcome = race(&learning, &track, &car, &config, |_| {})?;
         let best = outcome.best.pedal.clone();
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
         for i in 0..args.policies {
@@ -320,7 +313,7 @@ fn compare_track(
         seeds: seeds.clone(),
         drawn: drawn.len(),
         sigma: args.sigma,
-        learned_off_track_margin_m: learning_margin,
+        learned_off_track_margin_m: learning.off_track_margin(),
         learned_reward_mps,
         completed_cdbo: ours.iter().filter(|l| l.completed).count(),
         completed_torcs: theirs.iter().filter(|l| l.completed).count(),
@@ -446,10 +439,10 @@ fn markdown(reports: &[TrackReport], args: &CompareArgs) -> String {
             1 => format!("seed {}", args.seed),
             n => format!("seeds {}–{}", args.seed, args.seed + n - 1),
         },
-        super::edge_words(
-            args.off_track_margin
-                .unwrap_or(cdbo::sim::lap::LEARNING_OFF_TRACK_MARGIN)
-        ),
+        // Every track learns at the same margin, the flag's.
+        reports.first().map_or("–".into(), |r| super::edge_words(
+            r.policies.learned_off_track_margin_m
+        )),
         args.policies,
         args.sigma,
         match args.seeds {
