@@ -152,7 +152,7 @@ pub struct State {
     pub clutch: f64,
     /// Time with the throttle open in first gear so far (s), the launch clutch's clock.
     pub launch_time: f64,
-    /// Each wheel's bounce over rough ground ([`super::bounce`]), front left, front right,
+    /// Each wheel's bounce over rough ground and kinks ([`super::bounce`]), front left, front right,
     /// rear left, rear right.
     pub bounce: [Bounce; 4],
 }
@@ -491,9 +491,10 @@ impl Vehicle {
     /// Each wheel's ground, front left, front right, rear left, rear right: its surface's
     /// friction and rolling resistance coefficient (the tyres' where the surface gives none),
     /// and the bumps of a rough road under it ([`crate::track::Roughness::plain`] at
-    /// t = l + w/2 from the road's right edge and the station s + a); `None` while all four
-    /// stand on a smooth road, as they do whenever the road has no verges of its own
-    /// ([`Frame::has_verges`]) or the car is more than its reach inside both edges.
+    /// t = l + w/2 from the road's right edge and the station s + a) with the road's kink there
+    /// ([`Frame::kink_at`]`(a)`); `None` while all four stand on a smooth, unkinked road, as
+    /// they do whenever the road has no verges of its own ([`Frame::has_verges`]) or the car
+    /// is more than its reach inside both edges.
     ///
     /// As simuv2's `wheel.cpp` (`SimWheelUpdateRide`: `RtTrackGlobal2Local` of the wheel's
     /// position, then the segment's `surface->kFriction` and `kRollRes`), a wheel takes the
@@ -509,7 +510,8 @@ impl Vehicle {
     /// (docs/results/torcs.md, "The road's roughness").
     #[inline]
     fn wheel_ground(&self, s: &State, f: &Frame) -> Option<[Ground; 4]> {
-        let rough_road = f.roughness.is_rough() && self.corners.is_some();
+        // A rough or kinked road: the wheels on it bounce.
+        let rough_road = (f.roughness.is_rough() || f.kinked) && self.corners.is_some();
         if !f.has_verges && !rough_road {
             return None;
         }
@@ -551,7 +553,15 @@ impl Vehicle {
                 }
                 None if rough_road => {
                     // simuv2's t: the distance from the road's right edge.
-                    out[i].bumps = f.roughness.plain(f.s + a, l + f.half_width);
+                    let mut bumps = if f.roughness.is_rough() {
+                        f.roughness.plain(f.s + a, l + f.half_width)
+                    } else {
+                        Bumps::NONE
+                    };
+                    if f.kinked {
+                        (bumps.kink, bumps.kink_slope) = f.kink_at(a);
+                    }
+                    out[i].bumps = bumps;
                 }
                 None => {}
             }
@@ -593,12 +603,12 @@ impl Vehicle {
             None => [frame.friction; 4],
             Some(w) => w.map(|g| g.friction),
         };
-        // The wheels' bounce over rough ground takes some of their grip.
+        // The wheels' bounce over rough ground and the road's kinks takes some of their grip.
         if let Some(corners) = &self.corners {
             let loads = [front_loads[0], front_loads[1], rear_loads[0], rear_loads[1]];
             for (i, f) in friction.iter_mut().enumerate() {
                 let bumps = ground.map_or(Bumps::NONE, |w| w[i].bumps);
-                if bumps.amplitude != 0.0 || !s.bounce[i].settled() {
+                if bumps.any() || !s.bounce[i].settled() {
                     let k = i / 2;
                     *f *= bounce::step(
                         &mut s.bounce[i],

@@ -112,6 +112,8 @@ impl Roughness {
             amplitude: self.amplitude * (self.wavenumber * across).sin(),
             wavenumber: self.wavenumber,
             along,
+            kink: 0.0,
+            kink_slope: 0.0,
         }
     }
 }
@@ -123,9 +125,10 @@ impl Roughness {
 /// at Aalborg's 7.5 mm (λ = 0.7 m) 6 % at 20 m/s and 12 % at 60 to 80 m/s.
 pub const FELT_ROUGHNESS_M: f64 = 0.0005;
 
-/// The ground's height along a wheel's path over a rough surface, h(δ) = a·sin(k·(l + δ)) at δ
-/// metres past where the wheel stands (l along the surface): [`Roughness::plain`] or
-/// [`Roughness::kerb`] at the wheel's place.
+/// The ground's height along a wheel's path above the road's smoothed profile, h(δ) =
+/// a·sin(k·(l + δ)) + k₀ + k′·δ at δ metres past where the wheel stands (l along the surface):
+/// a rough surface's bumps ([`Roughness::plain`] at the wheel's place) and the road's kink
+/// there ([`Frame::kink_at`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Bumps {
     /// The amplitude a (m) across the wheel's path.
@@ -134,6 +137,10 @@ pub struct Bumps {
     pub wavenumber: f64,
     /// Where the wheel stands along the surface, l (m).
     pub along: f64,
+    /// The road's kink under the wheel, k (m, [`Frame::kink_at`]).
+    pub kink: f64,
+    /// Its slope along the wheel's path, k′ (m/m).
+    pub kink_slope: f64,
 }
 
 impl Bumps {
@@ -142,15 +149,24 @@ impl Bumps {
         amplitude: 0.0,
         wavenumber: 0.0,
         along: 0.0,
+        kink: 0.0,
+        kink_slope: 0.0,
     };
+
+    /// Whether there is anything under the wheel.
+    #[inline]
+    pub fn any(&self) -> bool {
+        self.amplitude != 0.0 || self.kink != 0.0 || self.kink_slope != 0.0
+    }
 
     /// h(δ) (m).
     #[inline]
     pub fn height(&self, ahead: f64) -> f64 {
+        let kink = self.kink + self.kink_slope * ahead;
         if self.amplitude == 0.0 {
-            return 0.0;
+            return kink;
         }
-        self.amplitude * (self.wavenumber * (self.along + ahead)).sin()
+        kink + self.amplitude * (self.wavenumber * (self.along + ahead)).sin()
     }
 }
 
@@ -275,16 +291,50 @@ pub struct Frame {
     /// Vertical curvature κ_v = dφ/ds of the pitch φ = atan(grade) (1/m): negative over a
     /// crest, positive in a dip; the pitch's change over [`VERTICAL_WINDOW_M`] of road.
     pub vertical_curvature: f64,
+    /// The road's kinks under this station and its neighbours: the height z less its mean
+    /// over [`VERTICAL_WINDOW_M`] around each station (m), at the stations
+    /// [`KINK_REACH`] samples before it to as many after it ([`Frame::kink_at`]).
+    pub kinks: [f64; KINK_SAMPLES],
+    /// The stations' spacing (m).
+    pub ds: f64,
+    /// Whether any of [`Frame::kinks`] reaches [`FELT_KINK_M`].
+    pub kinked: bool,
 }
+
+/// Stations either side of a frame whose kinks it keeps: a wheel stands within a car's reach
+/// of the frame's station (the nearest to the car's centre), less than 3 m on a car of 4.5 m.
+pub const KINK_REACH: usize = 3;
+/// Kinks a frame keeps.
+pub const KINK_SAMPLES: usize = 2 * KINK_REACH + 1;
+
+/// The smallest kink a car's wheels meet (m of height off the road's smoothed profile): 2 mm,
+/// a change of grade of about 0.3 % (at 30 m/s a step of 0.1 m/s in the ground's vertical
+/// speed). Below it the wheels' bounce costs grip it cannot measure against the game's laps
+/// and would run the bounce over most of every lap (measured: Forza's laps of car1-trb1 cost
+/// 2 % more simulator time at 2 mm, 66 % more at 0.1 mm, for the same agreement).
+pub const FELT_KINK_M: f64 = 0.002;
 
 /// The length of road (m) over which a frame's vertical curvature is measured: a car's
 /// wheelbase or two. The heights of TORCS's tracks are linear on sub-segments of a few metres
-/// (their `profil steps`), so the pitch is piecewise constant; its changes are spread over
-/// this window rather than felt as kinks, as a car's suspension and tyres spread them
-/// (measured: windows of 2 to 30 m place the game's failures alike).
+/// (their `profil steps`), so the pitch is piecewise constant; the car's quasi-static load
+/// takes its changes spread over this window (measured: windows of 2 to 30 m place the game's
+/// failures alike), and a car on springs meets what is left, the height less its mean over
+/// the window, as a kink under each wheel ([`Frame::kinks`], [`crate::sim::bounce`]).
 pub const VERTICAL_WINDOW_M: f64 = 6.0;
 
 impl Frame {
+    /// The road's kink (m, [`Frame::kinks`]) `along` metres from the station, and its slope
+    /// along the road: linear between the stations, as TORCS's heights are; held at the
+    /// outermost stations' past them.
+    #[inline]
+    pub fn kink_at(&self, along: f64) -> (f64, f64) {
+        let p = (along / self.ds + KINK_REACH as f64).clamp(0.0, (KINK_SAMPLES - 1) as f64);
+        let k = (p.floor() as usize).min(KINK_SAMPLES - 2);
+        let t = p - k as f64;
+        let (a, b) = (self.kinks[k], self.kinks[k + 1]);
+        (a + t * (b - a), (b - a) / self.ds)
+    }
+
     /// The point (x, y) in the station's road coordinates: (along, left) of it, the heading's
     /// unit vector and its left normal.
     #[inline]
@@ -337,6 +387,9 @@ impl Frame {
             sin_banking,
             cos_banking,
             vertical_curvature: 0.0,
+            kinks: [0.0; KINK_SAMPLES],
+            ds: 1.0,
+            kinked: false,
         }
     }
 }
@@ -370,6 +423,22 @@ impl Track {
         for (i, f) in frames.iter_mut().enumerate() {
             let pitch = |j: usize| samples[j % n].grade.atan();
             f.vertical_curvature = (pitch(i + h) - pitch(i + n - h)) / (2 * h) as f64 / ds;
+        }
+        // The kinks: z less its mean over the window around each station (the heights
+        // taken relative to the station's own, since z need not return to its start).
+        let z = |j: usize| samples[j % n].z;
+        let kink: Vec<f64> = (0..n)
+            .map(|i| {
+                let mean = (0..=2 * h).map(|k| z(i + n + k - h) - z(i)).sum::<f64>();
+                -mean / (2 * h + 1) as f64
+            })
+            .collect();
+        for (i, f) in frames.iter_mut().enumerate() {
+            for (k, v) in f.kinks.iter_mut().enumerate() {
+                *v = kink[(i + n + k - KINK_REACH) % n];
+            }
+            f.ds = ds;
+            f.kinked = f.kinks.iter().any(|k| k.abs() >= FELT_KINK_M);
         }
         Track {
             name: name.to_owned(),
@@ -769,6 +838,63 @@ mod tests {
         }
         assert!(t.frame(0).vertical_curvature < -0.98 * largest);
         assert!(t.frame(t.len() / 2).vertical_curvature > 0.98 * largest);
+    }
+
+    /// A hill of straight grades (up at 4 % from 100 m, down from 200 m, level from 300 m): a
+    /// frame's kinks are the heights less their mean over the window around each station,
+    /// as brute force has them: zero on a straight grade and on the level, largest at the
+    /// crest (the road above its smoothing by g·ds·h(h+1)/(2h + 1), h stations either side),
+    /// below it in the dips; `kink_at` interpolates them and their slope between stations.
+    #[test]
+    fn the_kinks_are_the_profile_less_its_smoothing() {
+        let g = 0.04;
+        let z = |s: f64| g * (s.clamp(100.0, 200.0) - 100.0) - g * (s.clamp(200.0, 300.0) - 200.0);
+        let pieces: Vec<Piece> = (0..600)
+            .map(|i| Piece {
+                z0: z(i as f64),
+                z1: z((i + 1) as f64),
+                width: 10.0,
+                ..Piece::flat(1.0, 0.01)
+            })
+            .collect();
+        let t = Track::from_pieces("hill", "test", &pieces, vec![]);
+        let n = t.len();
+        let h = ((0.5 * VERTICAL_WINDOW_M / t.ds).round()) as usize;
+        let at = |s: f64| (s / t.ds).round() as usize;
+        for i in 0..n {
+            let mean = (0..=2 * h)
+                .map(|k| t.sample(i + n + k - h).z - t.sample(i).z)
+                .sum::<f64>()
+                / (2 * h + 1) as f64;
+            let f = t.frame(i);
+            assert!((f.kinks[KINK_REACH] + mean).abs() < 1e-12, "{i}");
+            for k in 0..KINK_SAMPLES {
+                assert_eq!(
+                    f.kinks[k],
+                    t.frame(i + n + k - KINK_REACH).kinks[KINK_REACH]
+                );
+            }
+        }
+        for s in [50.0, 150.0, 250.0, 450.0] {
+            let f = t.frame(at(s));
+            assert!(
+                f.kinks.iter().all(|k| k.abs() < 1e-12),
+                "{s}: {:?}",
+                f.kinks
+            );
+            assert!(!f.kinked);
+        }
+        let crest = t.frame(at(200.0));
+        let top = g * t.ds * (h * (h + 1)) as f64 / (2 * h + 1) as f64;
+        assert!(
+            (crest.kinks[KINK_REACH] - top).abs() < 1e-9,
+            "{:?}",
+            crest.kinks
+        );
+        assert!(crest.kinked && t.frame(at(100.0)).kinks[KINK_REACH] < -0.4 * top);
+        let (k, slope) = crest.kink_at(0.25 * t.ds);
+        let (a, b) = (crest.kinks[KINK_REACH], crest.kinks[KINK_REACH + 1]);
+        assert!((k - (a + 0.25 * (b - a))).abs() < 1e-12 && (slope - (b - a) / t.ds).abs() < 1e-12);
     }
 
     #[test]
