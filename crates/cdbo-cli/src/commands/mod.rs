@@ -82,7 +82,7 @@ pub struct OffTrackArgs {
     /// (m; negative: inside the road). Default: the game's rule, 1, for a lap judged (`lap`)
     /// or learned in the game; -1 for a policy learned in cdbo's simulator, a reserve the
     /// game's car will not take away: the pattern search's best policy learned so completes in
-    /// the game on all 21 of TORCS's road tracks, against 1 at 1 m (docs/results/torcs.md,
+    /// the game on 20 of TORCS's 21 road tracks, against 1 at 1 m (docs/results/torcs.md,
     /// "Robust learning").
     #[arg(long, allow_negative_numbers = true, value_parser = value::off_track_margin)]
     pub off_track_margin: Option<f64>,

@@ -185,7 +185,7 @@ pub const GAME_OFF_TRACK_MARGIN: f64 = 1.0;
 /// centre 1 m *inside* the road's edge, two metres short of the game's rule. A policy learned
 /// at the very edge the simulator allows leaves the road wherever the world it is then driven
 /// in is a little harsher; this reserve is the robust learner's (issue 34): the pattern
-/// search's best policy, learned so, completes in the game on all 21 of TORCS's road tracks
+/// search's best policy, learned so, completes in the game on 20 of TORCS's 21 road tracks
 /// (1 of 21 at the game's rule) for 3.7 % of its best reward on average (docs/results/torcs.md,
 /// "Session 35"). Learning in the game itself takes the game's rule.
 pub const LEARNING_OFF_TRACK_MARGIN: f64 = -1.0;
