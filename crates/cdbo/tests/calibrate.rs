@@ -31,10 +31,10 @@ fn observed_with(track: &Track, base: &Car, truth: &Scales) -> TrackLaps {
 }
 
 /// Grip 15 % down and the launch 15 % up on the Spirit 300 round Ridgeway: the fit of those
-/// two from the stock car, on all five probes, finds both within 2 % (0.8506 and 1.131), and
-/// its cost falls some two-thousandfold (1.87 to 0.00086, since the fast probe is closed loop
-/// and the residuals are means over each station's 10 m; 99-fold before, 2.99 to 0.0303); the
-/// same fit again gives the same scales to the bit. (On the launch-and-brake and the open-loop
+/// two from the stock car, on all five probes, finds both within 1 % (measured 0.8519 and
+/// 1.1520), and its cost falls more than two-hundredfold (1.84 to 0.00051 in 59 evaluations;
+/// with COBYLA, until session 36, 0.00086 and a launch of 1.131); the same fit again gives the
+/// same scales to the bit. (On the launch-and-brake and the open-loop
 /// fast probe alone, since the road's vertical curvature loads the car, it stopped at a launch
 /// of 1.18.)
 #[test]
@@ -58,24 +58,24 @@ fn the_fit_recovers_known_scales_from_its_own_laps() {
     let fit = calibrate::fit(&base, &observed, &config).unwrap();
     eprintln!("{fit:?}");
     assert!(fit.cost < 0.005 * fit.cost_start, "{fit:?}");
-    assert!((fit.scales.grip / 0.85 - 1.0).abs() < 0.02, "{fit:?}");
-    assert!((fit.scales.launch / 1.15 - 1.0).abs() < 0.02, "{fit:?}");
+    assert!((fit.scales.grip / 0.85 - 1.0).abs() < 0.01, "{fit:?}");
+    assert!((fit.scales.launch / 1.15 - 1.0).abs() < 0.01, "{fit:?}");
     assert_eq!(calibrate::fit(&base, &observed, &config).unwrap(), fit);
 }
 
-/// All six scales of car1-trb1 perturbed at once, fitted on Forza and E-Track 2 (150
-/// evaluations, the coarse scan first): the cost falls more than tenfold, grip and drag come
-/// within 3 %, the launch within 10 % and the downforce within 20 % (measured with each wheel
-/// on its own surface: grip 0.9201 / 0.93, drag 1.0900 / 1.1, launch 0.7455 / 0.8, downforce
-/// 0.936 / 0.8, cost 0.873 → 0.0590, 14.8-fold; the road's surface for all four wheels: grip
-/// 0.9091, drag 1.0706, launch 0.8074, downforce 0.940, cost 0.970 → 0.0490; peak slip and
-/// rolling resistance only printed: drag and rolling resistance partly trade against each
-/// other, and so do grip, its peak slip and the downforce). Since the fast probe is closed
-/// loop (the profile hold at k = 0.75 on Forza, 0.7 on E-Track 2) the truth's car completes
-/// it as the stock car does; as an open-loop pedal table it stalled on E-Track 2 under the
-/// truth's drag and rolling scales, a cliff in the cost that COBYLA stopped at (grip 0.901,
-/// drag 1.114, launch 1.01, downforce 1.03; cost 2.16 → 0.87). E-Track 2 has no 20 m/s speed
-/// hold (the derated car leaves the road in its hairpin).
+/// All six scales of car1-trb1 perturbed at once, fitted on Forza and E-Track 2 (300
+/// evaluations at most, the coarse scan first, then least squares): the cost falls more than
+/// a hundredfold and every scale comes back, grip, drag, peak slip and launch within 2 %, the
+/// downforce within 4 % and rolling resistance within 5 %, though drag trades with rolling
+/// resistance along a long valley, and grip with its peak slip and the downforce (measured:
+/// grip 0.9278 / 0.93, peak slip 1.2107 / 1.2, drag 1.0981 / 1.1, downforce 0.8110 / 0.8,
+/// rolling 1.4632 / 1.5, launch 0.8071 / 0.8; cost 0.935 → 0.00318, 294-fold, in 238
+/// evaluations; COBYLA, the fit until session 36, stopped in that valley at the budget with
+/// drag 1.042, rolling 1.370, downforce 0.957, cost 0.0355). The fast probe is closed loop
+/// (the profile hold at k = 0.75 on Forza, 0.7 on E-Track 2), so the truth's car completes it
+/// as the stock car does; as an open-loop pedal table it stalled on E-Track 2 under the
+/// truth's drag and rolling scales, a cliff in the cost. E-Track 2 has no 20 m/s speed hold
+/// (the derated car leaves the road in its hairpin).
 #[test]
 #[ignore = "slow: a minute or more of simulator laps"]
 fn the_fit_recovers_all_six_scales_on_two_tracks() {
@@ -97,16 +97,17 @@ fn the_fit_recovers_all_six_scales_on_two_tracks() {
         .iter()
         .map(|t| observed_with(&common::shared_track(t), &base, &truth))
         .collect();
-    // From the stock car, with the coarse scan (without it, with E-Track 2's 20 m/s hold,
-    // measured: launch 0.980, downforce 0.943, cost 0.098).
+    // From the stock car, with the coarse scan.
     let fit = calibrate::fit(&base, &observed, &FitConfig::default()).unwrap();
     eprintln!("truth {truth:?}\nfit {fit:?}");
-    assert!(fit.cost < 0.1 * fit.cost_start, "{fit:?}");
+    assert!(fit.cost < 0.01 * fit.cost_start, "{fit:?}");
     let tolerances = [
-        ("grip", 0.03),
-        ("drag", 0.03),
-        ("launch", 0.1),
-        ("downforce", 0.2),
+        ("grip", 0.02),
+        ("peak_slip", 0.02),
+        ("drag", 0.02),
+        ("launch", 0.02),
+        ("downforce", 0.04),
+        ("rolling", 0.05),
     ];
     for (name, tolerance) in tolerances {
         let i = Scales::index(name).unwrap();

@@ -40,11 +40,16 @@
 //!    laps.
 //! 3. **Fit** ([`fit`]): first a coarse scan, one free scale at a time over [`SCAN_POINTS`]
 //!    log-spaced values of its bounds (a scale can be masked near 1: a launch torque scale
-//!    changes nothing while traction control caps the drive), then COBYLA (derivative-free;
-//!    the lap's outcome makes the cost non-smooth) on the logarithms of the free scales,
-//!    bounded by [`Scales::BOUNDS`], from the scan's best; the best point evaluated is kept. Deterministic: every lap is
-//!    deterministic and the laps' costs are summed in a fixed order.
+//!    changes nothing while traction control caps the drive), then least squares on the
+//!    logarithms of the free scales ([`least_squares`]: Levenberg–Marquardt on the stacked
+//!    residual vector, whose |r|² is the total cost, its Jacobian by forward differences of
+//!    [`FitConfig::difference_step`], halved down to an eighth where the search stalls: the
+//!    lap's driver steps make the cost piecewise flat at small scales), bounded by
+//!    [`Scales::BOUNDS`], from the scan's best; the best point evaluated is kept.
+//!    Deterministic: every lap is deterministic and the residuals are stacked in a fixed
+//!    order.
 
+pub mod least_squares;
 pub mod log;
 
 use serde::Serialize;
@@ -394,6 +399,15 @@ impl<'a> Reader<'a> {
 /// Compares cdbo's lap `sim` of a probe with the observed lap `obs` on a track of `length`
 /// metres (module documentation, step 2).
 pub fn compare(obs: &Observed, sim: &LapResult, length: f64) -> LapComparison {
+    residuals(obs, sim, length).0
+}
+
+/// [`compare`], and the lap's residual vector r: four entries per station up to the window
+/// (speed, lateral offset, yaw rate, pedal, each scaled), the station's bounded speed and three
+/// zeros where only one lap reached it, zeros where neither did, all divided by the square
+/// root of the stations counted, so that |r|² is the lap's cost. Its length depends on the
+/// observed lap alone.
+fn residuals(obs: &Observed, sim: &LapResult, length: f64) -> (LapComparison, Vec<f64>) {
     let ours: Vec<Sample> = sim.trace.iter().map(Sample::of).collect();
     let (mut a, mut b) = (Reader::new(&obs.samples), Reader::new(&ours));
     let window = obs.probe.window * length;
@@ -413,37 +427,41 @@ pub fn compare(obs: &Observed, sim: &LapResult, length: f64) -> LapComparison {
         ProbePedal::Table(_) => 0.0,
     };
     let (mut sum, mut speed_sq, mut stations, mut one_sided) = (0.0, 0.0, 0usize, 0usize);
+    let mut vector = Vec::new();
     let mut s = 0.0;
     while s <= window {
         let r = match (a.mean(s), b.mean(s)) {
-            (Some(o), Some(c)) => Some([
-                (c[0] - o[0]) / sg.speed,
-                (c[1] - o[1]) / sg.lateral,
-                (c[2] - o[2]) / sg.yaw_rate,
-                (c[3] - o[3]) * pedal_weight,
-            ]),
-            (Some(o), None) | (None, Some(o)) => {
-                let m = (o[0].abs() / sg.speed).min(MISSING);
-                sum += m * m;
-                one_sided += 1;
-                None
+            (Some(o), Some(c)) => {
+                stations += 1;
+                let r = [
+                    (c[0] - o[0]) / sg.speed,
+                    (c[1] - o[1]) / sg.lateral,
+                    (c[2] - o[2]) / sg.yaw_rate,
+                    (c[3] - o[3]) * pedal_weight,
+                ];
+                speed_sq += (r[0] * sg.speed).powi(2);
+                r
             }
-            (None, None) => None,
+            (Some(o), None) | (None, Some(o)) => {
+                one_sided += 1;
+                [(o[0].abs() / sg.speed).min(MISSING), 0.0, 0.0, 0.0]
+            }
+            (None, None) => [0.0; 4],
         };
-        if let Some(r) = r {
-            sum += r.iter().map(|v| v * v).sum::<f64>();
-            speed_sq += (r[0] * sg.speed).powi(2);
-            stations += 1;
-        }
+        sum += r.iter().map(|v| v * v).sum::<f64>();
+        vector.extend(r);
         s += STATION_M;
     }
+    let counted = stations + one_sided;
+    let norm = 1.0 / (counted.max(1) as f64).sqrt();
+    vector.iter_mut().for_each(|v| *v *= norm);
     let lap_time_error = match (sim.lap_time_s, obs.lap_time_s) {
         (Some(c), Some(o)) if obs.completed && o > 0.0 => Some((c - o) / o),
         _ => None,
     };
-    LapComparison {
-        cost: if stations + one_sided > 0 {
-            sum / (stations + one_sided) as f64
+    let comparison = LapComparison {
+        cost: if counted > 0 {
+            sum / counted as f64
         } else {
             0.0
         },
@@ -453,12 +471,34 @@ pub fn compare(obs: &Observed, sim: &LapResult, length: f64) -> LapComparison {
         observed_completed: obs.completed,
         sim_completed: sim.completed,
         lap_time_error,
-    }
+    };
+    (comparison, vector)
 }
 
 /// Every observed lap of every track against cdbo's lap of the same probe with `car`, in
-/// order (laps run on threads of their own; the results do not depend on it).
+/// order.
 pub fn compare_all(car: &Car, tracks: &[TrackLaps]) -> Vec<Vec<LapComparison>> {
+    drive_all(car, tracks, compare)
+}
+
+/// The residual vector of `car` against every observed lap: the laps' [`residuals`] in order,
+/// each divided by the square root of the number of laps, so that |r|² is [`total_cost`].
+fn residual_vector(car: &Car, tracks: &[TrackLaps]) -> Vec<f64> {
+    let laps: Vec<Vec<f64>> = drive_all(car, tracks, |o, l, len| residuals(o, l, len).1)
+        .into_iter()
+        .flatten()
+        .collect();
+    let norm = 1.0 / (laps.len().max(1) as f64).sqrt();
+    laps.into_iter().flatten().map(|v| v * norm).collect()
+}
+
+/// `each` of every observed lap against cdbo's lap of the same probe with `car`, in order
+/// (laps run on threads of their own; the results do not depend on it).
+fn drive_all<T: Send>(
+    car: &Car,
+    tracks: &[TrackLaps],
+    each: fn(&Observed, &LapResult, f64) -> T,
+) -> Vec<Vec<T>> {
     std::thread::scope(|scope| {
         let handles: Vec<Vec<_>> = tracks
             .iter()
@@ -469,7 +509,7 @@ pub fn compare_all(car: &Car, tracks: &[TrackLaps]) -> Vec<Vec<LapComparison>> {
                         scope.spawn(move || {
                             let mut sim = Simulator::new(t.track.clone(), car);
                             sim.config.trace = true;
-                            compare(obs, &obs.probe.drive(&sim), t.track.length)
+                            each(obs, &obs.probe.drive(&sim), t.track.length)
                         })
                     })
                     .collect()
@@ -549,18 +589,19 @@ pub struct FitConfig {
     /// Where the fit starts.
     pub start: Scales,
     /// Cost evaluations at most (each drives every observed lap once), the scan's
-    /// 1 + [`SCAN_POINTS`] per free scale included (COBYLA gets at least one).
+    /// 1 + [`SCAN_POINTS`] per free scale included (least squares gets at least one).
     pub max_evaluations: usize,
-    /// COBYLA's initial step in log-scale (0.1 ≈ 10 %).
-    pub step: f64,
+    /// The forward-difference step of the least-squares Jacobian, in log-scale (0.02 ≈ 2 %):
+    /// wide enough to see past the cost's steps at the scale of a driver step.
+    pub difference_step: f64,
     /// Whether to scan each scale coarsely first ([`SCAN_POINTS`]).
     pub scan: bool,
 }
 
 /// The fit's default budget of cost evaluations. Six scales from the stock car cross a long
 /// valley where drag trades with rolling resistance: measured on the six-scale recovery
-/// (`tests/calibrate.rs`, session 33's launch clutch), 150 evaluations stopped at a cost of
-/// 0.051 with drag 4.7 % short, 300 reach 0.019 and 2.8 %.
+/// (`tests/calibrate.rs`), least squares stops in 238 evaluations with every scale within
+/// 2.5 % (COBYLA, before session 36, stopped at 300 with drag 5 % short).
 pub const DEFAULT_EVALUATIONS: usize = 300;
 
 impl Default for FitConfig {
@@ -569,7 +610,7 @@ impl Default for FitConfig {
             free: (0..Scales::NAMES.len()).collect(),
             start: Scales::ONE,
             max_evaluations: DEFAULT_EVALUATIONS,
-            step: 0.1,
+            difference_step: 0.02,
             scan: true,
         }
     }
@@ -629,54 +670,34 @@ pub fn fit(base: &Car, tracks: &[TrackLaps], cfg: &FitConfig) -> Result<Fit> {
             }
         }
     }
-    let best = std::cell::Cell::new((start, start_cost, evaluations));
-    let objective = &|x: &[f64], _: &mut ()| {
-        let s = scales_at(x, start);
-        let c = cost(&s);
-        let (bs, bc, n) = best.get();
-        best.set(if c < bc {
-            (s, c, n + 1)
-        } else {
-            (bs, bc, n + 1)
-        });
-        c.min(f64::MAX)
-    };
     let bounds: Vec<(f64, f64)> = cfg
         .free
         .iter()
         .map(|&i| (Scales::BOUNDS[i].0.ln(), Scales::BOUNDS[i].1.ln()))
         .collect();
-    let cons: Vec<&dyn cobyla::Func<()>> = vec![];
-    // COBYLA's trust region shrinks on a cost that is jagged at small scales and stops in a
-    // shallow valley: it is restarted from the best point with the full step while that
-    // improves the cost and the budget lasts.
-    loop {
-        let (from, from_cost, used) = best.get();
-        if used >= cfg.max_evaluations {
-            break;
-        }
-        let x0: Vec<f64> = cfg.free.iter().map(|&i| from.get(i).ln()).collect();
-        // Its answer is among the points it evaluated, so only `best` is read.
-        let _ = cobyla::minimize(
-            objective,
-            &x0,
-            &bounds,
-            &cons,
-            (),
-            cfg.max_evaluations - used,
-            cobyla::RhoBeg::All(cfg.step),
-            // Stop when no scale moves by 0.1 % (the cost is piecewise flat at the scale of
-            // a driver step, so a tolerance on it would stop early), else at the budget.
-            Some(cobyla::StopTols {
-                xtol_abs: vec![1e-3; cfg.free.len()],
-                ..cobyla::StopTols::default()
-            }),
-        );
-        if best.get().1 >= from_cost * (1.0 - 1e-3) {
-            break;
-        }
-    }
-    let (scales, c, evaluations) = best.get();
+    let x0: Vec<f64> = cfg.free.iter().map(|&i| start.get(i).ln()).collect();
+    let found = least_squares::minimize(
+        |x| residual_vector(&scales_at(x, start).apply(base), tracks),
+        &x0,
+        &bounds,
+        &least_squares::Settings {
+            h: cfg.difference_step,
+            h_min: cfg.difference_step / 8.0,
+            max_evaluations: cfg.max_evaluations.saturating_sub(evaluations).max(1),
+            // No scale moves by 0.1 %: the cost is piecewise flat at the scale of a driver
+            // step, so a tolerance on it would stop early.
+            x_tol: 1e-4,
+        },
+    );
+    let (scales, c, evaluations) = if found.cost < start_cost {
+        (
+            scales_at(&found.x, start),
+            found.cost,
+            evaluations + found.evaluations,
+        )
+    } else {
+        (start, start_cost, evaluations + found.evaluations)
+    };
     Ok(Fit {
         scales,
         cost_start,
