@@ -653,7 +653,13 @@ pub fn fit(base: &Car, tracks: &[TrackLaps], cfg: &FitConfig) -> Result<Fit> {
         }
         s
     };
-    let cost = |s: &Scales| total_cost(&compare_all(&s.apply(base), tracks));
+    // |r|², the total cost, by the same residuals least squares fits below.
+    let cost = |s: &Scales| {
+        residual_vector(&s.apply(base), tracks)
+            .iter()
+            .map(|v| v * v)
+            .sum::<f64>()
+    };
     let cost_start = cost(&cfg.start);
     // The coarse scan: one scale at a time over SCAN_POINTS log-spaced values of its bounds.
     let (mut start, mut start_cost, mut evaluations) = (cfg.start, cost_start, 1usize);
@@ -684,7 +690,7 @@ pub fn fit(base: &Car, tracks: &[TrackLaps], cfg: &FitConfig) -> Result<Fit> {
             h: cfg.difference_step,
             h_min: cfg.difference_step / 8.0,
             max_evaluations: cfg.max_evaluations.saturating_sub(evaluations).max(1),
-            // No scale moves by 0.1 %: the cost is piecewise flat at the scale of a driver
+            // No scale moves by 0.01 %: the cost is piecewise flat at the scale of a driver
             // step, so a tolerance on it would stop early.
             x_tol: 1e-4,
         },
