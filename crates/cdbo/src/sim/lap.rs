@@ -385,7 +385,8 @@ impl Simulator {
                     )
                 };
                 let steer = steering.update(track, &self.vehicle, &state, &proj, &line, driver_dt);
-                controls = Controls::new(steer, a.max(0.0), (-a).max(0.0));
+                let brake = self.vehicle.driver_brake(&state, (-a).max(0.0));
+                controls = Controls::new(steer, a.max(0.0), brake);
                 self.vehicle.shift(&mut state, controls.throttle());
                 self.vehicle
                     .clutch(&mut state, controls.throttle(), driver_dt);

@@ -274,7 +274,8 @@ pub fn replay(
         let mut squared = 0.0;
         for k in i..end {
             let q = &samples[k];
-            let controls = Controls::new(steers[k], q.pedal.max(0.0), (-q.pedal).max(0.0));
+            let brake = vehicle.driver_brake(&state, (-q.pedal).max(0.0));
+            let controls = Controls::new(steers[k], q.pedal.max(0.0), brake);
             match gear_index(q) {
                 // A logged change of gear starts a shift, as cdbo's gearbox does.
                 Some(g) => {

@@ -461,6 +461,29 @@ impl Vehicle {
         s.gearbox.update(&self.car, &self.shift_map, w, throttle);
     }
 
+    /// The brake pedal in [0, 1] the driver applies for `brake` at a driver step. A car the
+    /// TORCS robot drives ([`Car::torcs_robot`]) gets the robot's ABS, which can only act at
+    /// the game's 50 Hz driver steps and has one brake command for the four wheels: the pedal
+    /// times Πₖ clamp(2 − σₖ/σ*ₖ, 0, 1) over the axles k whose slide σₖ = −(ω̄ₖRₖ − vₓ)/max(|vₓ|, v₀)
+    /// passes the aid threshold σ*ₖ, held until the next driver step. Another car's ABS
+    /// eases each axle's brake inside the physics step ([`Vehicle::step`]).
+    pub fn driver_brake(&self, s: &State, brake: f64) -> f64 {
+        if !self.car.torcs_robot || brake <= 0.0 {
+            return brake;
+        }
+        let inv_axle = 1.0 / s.vx.abs().max(SLIP_SPEED_FLOOR);
+        let spins = [s.omega[0], rear_omega(s)];
+        let mut eased = brake;
+        for k in 0..2 {
+            let slide = -(spins[k] * self.radius[k] - s.vx) * inv_axle;
+            let threshold = self.aid_threshold[k];
+            if threshold > 0.0 && slide > threshold {
+                eased *= (2.0 - slide / threshold).clamp(0.0, 1.0);
+            }
+        }
+        eased
+    }
+
     /// The launch clutch for the driver's throttle, taken at the driver's rate `dt` after
     /// its last step, after [`Vehicle::shift`]; for a car the TORCS robot drives
     /// ([`Car::torcs_robot`]; else the clutch stays closed), the robot's law
@@ -722,7 +745,7 @@ impl Vehicle {
             let mut brake = c.brake() * self.max_brake[0];
             let threshold = self.aid_threshold[0];
             let slide = -(s.omega[0] * r - s.vx) * inv_axle;
-            if slide > threshold {
+            if !car.torcs_robot && slide > threshold {
                 brake *= (2.0 - slide / threshold).clamp(0.0, 1.0);
             }
             // Implicit step of I·dω/dt = T − T_b·sgn ω − R·ΣFₓ(ω), with Fₓ linear in ω.
@@ -952,7 +975,7 @@ impl Vehicle {
         let mut brake = brake_pedal * self.max_brake[1];
         let threshold = self.aid_threshold[1];
         let slide = -(0.5 * (omega[0] + omega[1]) * r - s.vx) * w.inv_axle;
-        if slide > threshold {
+        if !self.car.torcs_robot && slide > threshold {
             brake *= (2.0 - slide / threshold).clamp(0.0, 1.0);
         }
 
