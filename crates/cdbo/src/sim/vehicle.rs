@@ -70,8 +70,9 @@ use crate::track::{Bumps, Frame};
 
 /// Floor of the speed that normalises slip (m/s): keeps slip finite when standing.
 pub const SLIP_SPEED_FLOOR: f64 = 2.0;
-/// ABS and traction control start easing at this fraction of the tyre's peak slip, and
-/// release fully at twice it.
+/// ABS and traction control start easing at this fraction of the tyre's peak slip as the car
+/// file gives it (the driver's setting: a calibrated car's fitted tyre leaves it), and release
+/// fully at twice it.
 const AID_SLIP_RATIO: f64 = 0.5;
 
 /// The driver's commands, held between driver updates.
@@ -235,8 +236,8 @@ impl Vehicle {
         ];
         Vehicle {
             aid_threshold: [
-                tyres[0].peak_slip * AID_SLIP_RATIO,
-                tyres[1].peak_slip * AID_SLIP_RATIO,
+                tyres[0].peak_slip / car.scales.peak_slip * AID_SLIP_RATIO,
+                tyres[1].peak_slip / car.scales.peak_slip * AID_SLIP_RATIO,
             ],
             static_load: car.static_axle_loads(),
             transfer_per_accel: car.mass * car.axles.pitch_height / l,
