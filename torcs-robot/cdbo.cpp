@@ -547,16 +547,12 @@ void drive(int, tCarElt *car, tSituation *s) {
     double delta = lap.cfg.tracker ? tracker_steer(car, speed) : steer(car, speed, dt);
     choose_gear(car, std::fmax(a, 0.0), dt);
 
-    // Traction control on the driven axle's slip speed, at the driver's steps
-    // (torcs/traction.rs); ABS as cdbo's vehicle applies it (sim/vehicle.rs).
-    double brake = std::fmax(-a, 0.0);
+    // Traction control on the driven axle's slip speed and ABS on the one brake command, at
+    // the driver's steps (torcs/traction.rs, torcs/abs.rs).
     int k = lap.cfg.driven[1] > 0.0 ? 1 : 0;
     double throttle = drive::traction_throttle(std::fmax(a, 0.0), axle_slip_speed(car, k));
-    for (int axle = 0; axle < 2 && brake > 0.0; axle++) {
-        double slide = -axle_slip(car, axle);
-        double th = lap.cfg.aid_slip[axle];
-        if (th > 0.0 && slide > th) brake *= clamp(2.0 - slide / th, 0.0, 1.0);
-    }
+    double slide[2] = {-axle_slip(car, 0), -axle_slip(car, 1)};
+    double brake = drive::abs_brake(std::fmax(-a, 0.0), slide, lap.cfg.aid_slip);
 
     car->_steerCmd = delta / car->_steerLock;
     car->_accelCmd = throttle;

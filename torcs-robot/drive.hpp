@@ -342,6 +342,20 @@ inline double traction_throttle(double throttle, double slip_speed) {
     return throttle - std::fmin(throttle, excess / kTractionRange);
 }
 
+// ---- ABS --------------------------------------------------------------------------------------
+
+/// The one brake command after ABS (torcs/abs.rs abs_brake): the pedal times
+/// clamp(2 - slide / threshold, 0, 1) for each axle (front, rear) whose slide passes a positive
+/// threshold.
+inline double abs_brake(double brake, const double slide[2], const double threshold[2]) {
+    for (int k = 0; k < 2; k++) {
+        if (threshold[k] > 0.0 && slide[k] > threshold[k]) {
+            brake *= clamp(2.0 - slide[k] / threshold[k], 0.0, 1.0);
+        }
+    }
+    return brake;
+}
+
 }  // namespace drive
 
 #endif

@@ -207,6 +207,14 @@ const std::map<std::string, Case> kCases = {
          double throttle = a.num();
          return std::vector<double>{drive::traction_throttle(throttle, a.num())};
      }},
+    {"abs_brake",  // BRAKE SLIDE_F SLIDE_R THRESHOLD_F THRESHOLD_R -> b
+     [](Args &a) {
+         double brake = a.num();
+         double slide[2], threshold[2];
+         for (double &s : slide) s = a.num();
+         for (double &t : threshold) t = a.num();
+         return std::vector<double>{drive::abs_brake(brake, slide, threshold)};
+     }},
 };
 
 }  // namespace

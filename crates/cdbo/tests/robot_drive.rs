@@ -6,7 +6,7 @@
 //! The calls replay states recorded from two laps of cdbo's simulator on the default track
 //! (the 15 m/s demonstration, and a policy learned by `cdbo race`): at every driver step the
 //! policy's action (RKHS and table), the speed hold, the steering's look-ahead, bearing and
-//! PI law, the gearbox, the launch clutch and the traction control, each given the state the Rust controller had
+//! PI law, the gearbox, the launch clutch, the traction control and the ABS, each given the state the Rust controller had
 //! (integrals, gear, time left in a shift), and the answers must equal the Rust definitions
 //! bit for bit (within 1e-12 of the simulator's O(1) form of the RKHS policy). Skips with a
 //! message where `g++` is missing.
@@ -38,7 +38,9 @@ use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 use cdbo::policy::{Policy, PolicyTable, RkhsPolicy};
 use cdbo::sim::lap::held_offset;
 use cdbo::sim::powertrain::{DOWNSHIFT_MARGIN, Gearbox, THROTTLE_LEVELS};
+use cdbo::sim::vehicle::SLIP_SPEED_FLOOR;
 use cdbo::sim::{Simulator, TracePoint};
+use cdbo::torcs::abs::abs_brake;
 use cdbo::torcs::lap::cornering_tables;
 use cdbo::torcs::launch::{LaunchCar, launch_clutch};
 use cdbo::torcs::line::LineTable;
@@ -235,6 +237,7 @@ fn the_robots_decisions_are_the_rust_ones_on_recorded_laps() {
     let steer = PiSteering::new();
     let dt = sim.config.dt * sim.config.driver_every as f64;
     let (mut upshifts, mut downshifts, mut top_gear, mut slipping, mut easing) = (0, 0, 0, 0, 0);
+    let (mut braking, thresholds) = (0, sim.vehicle.aid_threshold());
     for (lap, trace) in [("demonstration", &demo), ("learned policy", &fast)] {
         let (mut hold, mut hold_integral) = (SpeedHold::new(15.0), 0.0);
         let (mut steer_integral, mut hint) = (0.0, 0);
@@ -369,6 +372,18 @@ fn the_robots_decisions_are_the_rust_ones_on_recorded_laps() {
                 &[eased],
                 Agree::Exactly,
             );
+
+            // ABS on the recorded brake (full brake where the pedal pushes), at the recorded
+            // wheels' slides plus 0-0.3 step by step (the recorded laps hardly lock a wheel).
+            let brake = if p.pedal < 0.0 { -p.pedal } else { 1.0 };
+            let extra = 0.01 * (i % 31) as f64;
+            let slide = |w: f64| -(w - p.speed) / p.speed.abs().max(SLIP_SPEED_FLOOR) + extra;
+            let [front, rear_left, rear_right] = p.wheel_speeds;
+            let slides = [slide(front), slide(0.5 * (rear_left + rear_right))];
+            let eased = abs_brake(brake, slides, thresholds);
+            braking += usize::from(eased < brake && eased > 0.0);
+            let args = [brake, slides[0], slides[1], thresholds[0], thresholds[1]];
+            calls.check(&at, "abs_brake", &args, &[eased], Agree::Exactly);
         }
     }
     // The states span the decisions: every gear both ways, a slipping clutch, a fast lap.
@@ -379,6 +394,7 @@ fn the_robots_decisions_are_the_rust_ones_on_recorded_laps() {
     );
     assert!(slipping >= 10, "{slipping} steps with the clutch slipping");
     assert!(easing >= 100, "{easing} steps with the throttle eased");
+    assert!(braking >= 100, "{braking} steps with the brake eased");
     let fastest = fast.iter().map(|p| p.speed).fold(0.0, f64::max);
     assert!(fastest > 25.0, "{fastest} m/s");
 

@@ -50,9 +50,10 @@
 //!   scales drag, downforce and c_rr, and the drive torque in first gear (its launch).
 //! - Brakes: T = p·share·A_piston·μ_pad·r_disc per wheel, with ABS easing the pressure while an
 //!   axle's slip exceeds half the tyre's peak slip; traction control eases the throttle
-//!   likewise (the Spirit 300 has both; TORCS robots implement them in the driver), and for a
-//!   car the TORCS robot drives as the robot does, on the driven wheels' slip speed in every
-//!   gear.
+//!   likewise (the Spirit 300 has both; TORCS robots implement them in the driver). A car the
+//!   TORCS robot drives gets the robot's aids: traction control on the driven wheels' slip
+//!   speed in every gear, and ABS once a driver step on the one brake command the four wheels
+//!   share ([`Vehicle::driver_brake`]).
 //! - Launch of a car the TORCS robot drives ([`Car::torcs_robot`]): as simuv2 does, a
 //!   slipping clutch (transfer τ = 1 − c, c the robot's launch clutch, [`Vehicle::clutch`])
 //!   leaves the engine unloaded, ω̇_e = T_e(ω_e)/I_e, blended with the wheels' speed by τ⁴,
@@ -462,27 +463,22 @@ impl Vehicle {
         s.gearbox.update(&self.car, &self.shift_map, w, throttle);
     }
 
-    /// The brake pedal in [0, 1] the driver applies for `brake` at a driver step. A car the
-    /// TORCS robot drives ([`Car::torcs_robot`]) gets the robot's ABS, which can only act at
-    /// the game's 50 Hz driver steps and has one brake command for the four wheels: the pedal
-    /// times Πₖ clamp(2 − σₖ/σ*ₖ, 0, 1) over the axles k whose slide σₖ = −(ω̄ₖRₖ − vₓ)/max(|vₓ|, v₀)
-    /// passes the aid threshold σ*ₖ, held until the next driver step. Another car's ABS
-    /// eases each axle's brake inside the physics step ([`Vehicle::step`]).
+    /// The brake pedal in [0, 1] the driver applies for `brake` at a driver step, held until
+    /// the next. A car the TORCS robot drives ([`Car::torcs_robot`]) gets the robot's ABS
+    /// ([`crate::torcs::abs`]): one command for the four wheels, eased by each axle whose
+    /// slide −(ω̄R − vₓ)/max(|vₓ|, v₀) passes its aid threshold. Another car's ABS eases each
+    /// axle's brake inside the physics step ([`Vehicle::step`]).
     pub fn driver_brake(&self, s: &State, brake: f64) -> f64 {
         if !self.car.torcs_robot || brake <= 0.0 {
             return brake;
         }
         let inv_axle = 1.0 / s.vx.abs().max(SLIP_SPEED_FLOOR);
-        let spins = [s.omega[0], rear_omega(s)];
-        let mut eased = brake;
-        for k in 0..2 {
-            let slide = -(spins[k] * self.radius[k] - s.vx) * inv_axle;
-            let threshold = self.aid_threshold[k];
-            if threshold > 0.0 && slide > threshold {
-                eased *= (2.0 - slide / threshold).clamp(0.0, 1.0);
-            }
-        }
-        eased
+        let slide = |spin: f64, radius: f64| -(spin * radius - s.vx) * inv_axle;
+        let slides = [
+            slide(s.omega[0], self.radius[0]),
+            slide(rear_omega(s), self.radius[1]),
+        ];
+        crate::torcs::abs::abs_brake(brake, slides, self.aid_threshold)
     }
 
     /// The launch clutch for the driver's throttle, taken at the driver's rate `dt` after
@@ -917,7 +913,8 @@ impl Vehicle {
     ///
     /// Integrated implicitly in the spins (each τ linear in its wheel's ω, a 2×2 system),
     /// stable at the 4 ms step where simuv2 steps explicitly at 2 ms. ABS eases both brakes
-    /// on the axle's mean slip (ω̄R − vₓ)/max(|vₓ|, v₀), as the robot reads it.
+    /// on the axle's mean slip (ω̄R − vₓ)/max(|vₓ|, v₀), except on a car the TORCS robot
+    /// drives, whose brake the driver has eased already ([`Vehicle::driver_brake`]).
     fn rear_wheels(
         &self,
         s: &mut State,

@@ -11,13 +11,14 @@
 //! [`crate::drive::steering`] or the path tracker of [`crate::drive::tracker`] on the lap's
 //! line (the centre line, or the base and policy line sampled by [`line`]), the automatic
 //! gearbox of [`crate::sim::powertrain`] (its shift points are handed over from the car's
-//! [`crate::sim::vehicle::Vehicle`]), the same ABS, and the same failure rules, judged from
-//! the game's car state; its traction control acts at the game's driver steps
-//! ([`traction`]). Its decisions are the pure functions of [`ROBOT_HEADER`], which
-//! `tests/robot_drive.rs` checks against the Rust ones (and the robot's own launch clutch and
-//! traction control against [`launch`] and [`traction`]) on states recorded from laps of the
+//! [`crate::sim::vehicle::Vehicle`]), and the same failure rules, judged from the game's car
+//! state; its traction control and ABS act at the game's driver steps ([`traction`], [`abs`]).
+//! Its decisions are the pure functions of [`ROBOT_HEADER`], which `tests/robot_drive.rs`
+//! checks against the Rust ones (and the robot's own launch clutch, traction control and ABS
+//! against [`launch`], [`traction`] and [`abs`]) on states recorded from laps of the
 //! simulator.
 
+pub mod abs;
 pub mod evaluator;
 pub mod lap;
 pub mod launch;
