@@ -14,9 +14,12 @@
  * either holding the path P(s) = c(s) + d(s) n(s) of a line d(s) metres left of the centre
  * line c(s) (n the left normal; the centre line itself unless the settings give a line); the gear is chosen by cdbo's automatic gearbox
  * (crates/cdbo/src/sim/powertrain.rs) from shift points it is given; ABS and traction control
- * ease the pedals as cdbo's vehicle does; the lap fails by cdbo's rules (sim/lap.rs), judged
- * from the game's car state. On completion or failure it writes one JSON line and ends the
- * game process at once. The decisions themselves (pedal, steering laws, gearbox, launch clutch)
+ * ease the pedals once a driver step (crates/cdbo/src/torcs/abs.rs, traction.rs; cdbo's
+ * simulator applies the same ABS at its driver step and the same traction law at every physics
+ * step for a car this robot drives); the lap fails by cdbo's rules (sim/lap.rs),
+ * judged from the game's car state. On completion or failure it writes one JSON line and ends
+ * the game process at once. The decisions themselves (pedal, steering laws, gearbox, launch
+ * clutch, traction control, ABS)
  * are the pure functions of drive.hpp, checked against cdbo's Rust by its tests; this file
  * reads the game's state for them and applies their commands.
  *
