@@ -14,7 +14,7 @@
  * either holding the path P(s) = c(s) + d(s) n(s) of a line d(s) metres left of the centre
  * line c(s) (n the left normal; the centre line itself unless the settings give a line); the gear is chosen by cdbo's automatic gearbox
  * (crates/cdbo/src/sim/powertrain.rs) from shift points it is given; ABS and traction control
- * ease the pedals once a driver step (crates/cdbo/src/torcs/abs.rs, traction.rs; cdbo's
+ * ease the pedals once a driver step (crates/cdbo/src/drive/aids/abs.rs, traction.rs; cdbo's
  * simulator applies the same ABS at its driver step and the same traction law at every physics
  * step for a car this robot drives); the lap fails by cdbo's rules (sim/lap.rs),
  * judged from the game's car state. On completion or failure it writes one JSON line and ends
@@ -551,7 +551,7 @@ void drive(int, tCarElt *car, tSituation *s) {
     choose_gear(car, std::fmax(a, 0.0), dt);
 
     // Traction control on the driven axle's slip speed and ABS on the one brake command, at
-    // the driver's steps (torcs/traction.rs, torcs/abs.rs).
+    // the driver's steps (drive/aids/traction.rs, drive/aids/abs.rs).
     int k = lap.cfg.driven[1] > 0.0 ? 1 : 0;
     double throttle = drive::traction_throttle(std::fmax(a, 0.0), axle_slip_speed(car, k));
     double slide[2] = {-axle_slip(car, 0), -axle_slip(car, 1)};

@@ -295,12 +295,12 @@ inline void gear_update(const Gearbox &box, std::size_t &gear, double &shifting,
 
 // ---- The launch clutch ----------------------------------------------------------------------
 
-/// (s) the clutch's closing over throttle time while pulling away (torcs/launch.rs).
+/// (s) the clutch's closing over throttle time while pulling away (drive/aids/launch.rs).
 constexpr double kLaunchTime = 2.0;
-/// (m/s) added to the road speed when closing it early (torcs/launch.rs).
+/// (m/s) added to the road speed when closing it early (drive/aids/launch.rs).
 constexpr double kLaunchSpeed = 5.0;
 
-/// What the launch clutch reads of the car (torcs/launch.rs LaunchCar).
+/// What the launch clutch reads of the car (drive/aids/launch.rs LaunchCar).
 struct LaunchCar {
     double engine_speed;  ///< (rad/s)
     double red_line;      ///< (rad/s) the engine's red line
@@ -310,7 +310,7 @@ struct LaunchCar {
 };
 
 /// The clutch command in [0, 1] (1 = open) while pulling away in first gear
-/// (torcs/launch.rs launch_clutch): 0 after first gear; in it, `launch_time` counts the time
+/// (drive/aids/launch.rs launch_clutch): 0 after first gear; in it, `launch_time` counts the time
 /// with throttle, and the clutch closes over kLaunchTime of it,
 /// ramp = clamp(1 - time / kLaunchTime, 0, 1), sooner once the engine passes half its red
 /// line: min(ramp, max(0, 1 - rolling 2 (w - red / 2) / red)), rolling the road speed plus
@@ -330,12 +330,12 @@ inline double launch_clutch(std::size_t gear, double throttle, double dt, double
 
 // ---- Traction control ----------------------------------------------------------------------
 
-/// (m/s) the driven wheels' slip speed past which the throttle eases (torcs/traction.rs).
+/// (m/s) the driven wheels' slip speed past which the throttle eases (drive/aids/traction.rs).
 constexpr double kTractionSlip = 2.0;
 /// (m/s) the slip speed past kTractionSlip that takes the whole throttle away.
 constexpr double kTractionRange = 10.0;
 
-/// The throttle after traction control (torcs/traction.rs traction_throttle), for the driven
+/// The throttle after traction control (drive/aids/traction.rs traction_throttle), for the driven
 /// wheels' slip speed s = w R - vx: a - min(a, max(0, s - kTractionSlip) / kTractionRange).
 inline double traction_throttle(double throttle, double slip_speed) {
     double excess = std::fmax(slip_speed - kTractionSlip, 0.0);
@@ -344,7 +344,7 @@ inline double traction_throttle(double throttle, double slip_speed) {
 
 // ---- ABS --------------------------------------------------------------------------------------
 
-/// The one brake command after ABS (torcs/abs.rs abs_brake): the pedal times
+/// The one brake command after ABS (drive/aids/abs.rs abs_brake): the pedal times
 /// clamp(2 - slide / threshold, 0, 1) for each axle (front, rear) whose slide passes a positive
 /// threshold.
 inline double abs_brake(double brake, const double slide[2], const double threshold[2]) {

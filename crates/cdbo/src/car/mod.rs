@@ -320,8 +320,8 @@ pub struct Car {
     pub differential: Differential,
     /// Whether cdbo's simulator drives the car as cdbo's TORCS robot drives the game's car (a
     /// car read from TORCS files): pulling away on simuv2's slipping clutch, closed by the
-    /// robot's launch clutch ([`crate::torcs::launch`]), and with the robot's traction control
-    /// on the driven wheels' slip speed ([`crate::torcs::traction`]). Else (the built-in car)
+    /// robot's launch clutch ([`crate::drive::aids::launch`]), and with the robot's traction control
+    /// on the driven wheels' slip speed ([`crate::drive::aids::traction`]). Else (the built-in car)
     /// the clutch slips only below idle and traction control acts on the relative slip.
     pub torcs_robot: bool,
     /// Calibration scales over the car file's values ([`calibration`]): 1 for a stock car.

@@ -465,7 +465,7 @@ impl Vehicle {
 
     /// The brake pedal in [0, 1] the driver applies for `brake` at a driver step, held until
     /// the next. A car the TORCS robot drives ([`Car::torcs_robot`]) gets the robot's ABS
-    /// ([`crate::torcs::abs`]): one command for the four wheels, eased by each axle whose
+    /// ([`crate::drive::aids::abs`]): one command for the four wheels, eased by each axle whose
     /// slide −(ω̄R − vₓ)/max(|vₓ|, v₀) passes its aid threshold. Another car's ABS eases each
     /// axle's brake inside the physics step ([`Vehicle::step`]).
     pub fn driver_brake(&self, s: &State, brake: f64) -> f64 {
@@ -478,28 +478,28 @@ impl Vehicle {
             slide(s.omega[0], self.radius[0]),
             slide(rear_omega(s), self.radius[1]),
         ];
-        crate::torcs::abs::abs_brake(brake, slides, self.aid_threshold)
+        crate::drive::aids::abs::abs_brake(brake, slides, self.aid_threshold)
     }
 
     /// The launch clutch for the driver's throttle, taken at the driver's rate `dt` after
     /// its last step, after [`Vehicle::shift`]; for a car the TORCS robot drives
     /// ([`Car::torcs_robot`]; else the clutch stays closed), the robot's law
-    /// ([`crate::torcs::launch::launch_clutch`]), which opens the clutch while pulling away in
-    /// first gear and closes it over [`crate::torcs::launch::LAUNCH_TIME`] of throttle.
+    /// ([`crate::drive::aids::launch::launch_clutch`]), which opens the clutch while pulling away in
+    /// first gear and closes it over [`crate::drive::aids::launch::LAUNCH_TIME`] of throttle.
     pub fn clutch(&self, s: &mut State, throttle: f64, dt: f64) {
         let car = &self.car;
         if !car.torcs_robot {
             return;
         }
         let k = if self.driven[1] > 0.0 { 1 } else { 0 };
-        let launch = crate::torcs::launch::LaunchCar {
+        let launch = crate::drive::aids::launch::LaunchCar {
             engine_speed: s.engine_speed,
             red_line: car.rev_limiter,
             first_ratio: car.gears[0] * car.final_drive,
             wheel_radius: self.radius[k],
             speed_x: s.vx,
         };
-        s.clutch = crate::torcs::launch::launch_clutch(
+        s.clutch = crate::drive::aids::launch::launch_clutch(
             s.gearbox.gear,
             throttle,
             dt,
@@ -661,7 +661,7 @@ impl Vehicle {
 
         // Drive torque. A car the TORCS robot drives gets the robot's traction control in
         // every gear, on the driven wheels' mean slip speed ωR − vₓ
-        // ([`crate::torcs::traction`]), as the game's car does: with the rear wheels modelled
+        // ([`crate::drive::aids::traction`]), as the game's car does: with the rear wheels modelled
         // one by one, the inner wheel's spin on a corner's exit is the tyres' own. Another car
         // has its throttle eased while the driven axle's combined slip, with the wheels
         // spinning faster than the road, passes the aid threshold.
@@ -676,7 +676,7 @@ impl Vehicle {
         let combined2 = spin * spin + lateral * lateral;
         let threshold = self.aid_threshold[k];
         if self.car.torcs_robot {
-            throttle = crate::torcs::traction::traction_throttle(throttle, spin_speed);
+            throttle = crate::drive::aids::traction::traction_throttle(throttle, spin_speed);
         } else if spin > 0.0 && combined2 > threshold * threshold {
             throttle *= (2.0 - combined2.sqrt() / threshold).clamp(0.0, 1.0);
         }

@@ -12,19 +12,15 @@
 //! line (the centre line, or the base and policy line sampled by [`line`]), the automatic
 //! gearbox of [`crate::sim::powertrain`] (its shift points are handed over from the car's
 //! [`crate::sim::vehicle::Vehicle`]), and the same failure rules, judged from the game's car
-//! state; its traction control and ABS act at the game's driver steps ([`traction`], [`abs`]).
-//! Its decisions are the pure functions of [`ROBOT_HEADER`], which `tests/robot_drive.rs`
-//! checks against the Rust ones (and the robot's own launch clutch, traction control and ABS
-//! against [`launch`], [`traction`] and [`abs`]) on states recorded from laps of the
+//! state; its launch clutch, traction control and ABS act at the game's driver steps
+//! ([`crate::drive::aids`]). Its decisions are the pure functions of [`ROBOT_HEADER`], which
+//! `tests/robot_drive.rs` checks against the Rust ones on states recorded from laps of the
 //! simulator.
 
-pub mod abs;
 pub mod evaluator;
 pub mod lap;
-pub mod launch;
 pub mod line;
 pub mod panel;
-pub mod traction;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};

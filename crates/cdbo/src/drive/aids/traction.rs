@@ -1,9 +1,11 @@
-//! The robot's traction control: the second decision the TORCS robot makes differently from
-//! cdbo's simulator, defined here for the robot's `drive::traction_throttle`
-//! (`torcs-robot/drive.hpp`), which `tests/robot_drive.rs` checks against it.
+//! The robot's traction control, defined here for the robot's `drive::traction_throttle`
+//! (`torcs-robot/drive.hpp`), which `tests/robot_drive.rs` checks against it; cdbo's simulator
+//! eases a car the robot drives by the same law, at every physics step (at the driver's steps,
+//! as the robot does, it fitted the game's fast laps less well: docs/results/torcs.md,
+//! "Session 37").
 //!
-//! cdbo's vehicle eases the throttle inside its physics step, on the driven axle's relative
-//! slip past the aid threshold ([`crate::sim::vehicle::Vehicle::aid_threshold`]): eased to
+//! cdbo's vehicle eases another car's throttle inside its physics step, on the driven axle's
+//! relative slip past the aid threshold ([`crate::sim::vehicle::Vehicle::aid_threshold`]): eased to
 //! nothing at twice it. The robot can only act at the game's 50 Hz driver steps, and there
 //! that stiff band, fed the game's wheel speeds, cuts and restores the throttle step by step:
 //! the engine's speed jumps by ±2000 rpm from one step to the next and a standing start in
