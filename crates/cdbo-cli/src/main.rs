@@ -1,5 +1,9 @@
 //! `cdbo`: learn a fast racing policy in few laps with Coordinate Descent Bayesian Optimisation.
 
+// The commands' doc comments are the command line's help text (`postgresql://USER@HOST[:PORT]/DB`
+// reads as a link to rustdoc).
+#![allow(rustdoc::broken_intra_doc_links)]
+
 mod commands;
 mod figures;
 

@@ -1,8 +1,8 @@
 //! `import cdbo`: the cdbo library for Python (pyo3, abi3 for CPython ≥ 3.9).
 //!
 //! The native module `cdbo._cdbo` binds the library, not the command line: the ask/tell
-//! [`optimizer`]s, persistent [`study`] files, tracks, cars, the simulator and the policy
-//! ([`sim`]), and the library's own race loop ([`race`]). The pure-Python part of the package
+//! `optimizer`s, persistent `study` files, tracks, cars, the simulator and the policy
+//! (`sim`), and the library's own race loop (`race`). The pure-Python part of the package
 //! (`python/cdbo/`) adds the gymnasium environment and pandas output.
 //!
 //! Library errors become `ValueError` (bad input) or `OSError` (files, study databases) with

@@ -1,5 +1,5 @@
 //! Experiments that join the simulator, the policy and the optimisers: [`race`] learns to race
-//! one track with one method, on the [`line`] asked for; [`grid`] lists the runs of the paper's experiment, [`record`]
+//! one track with one method, on the [`line`](mod@line) asked for; [`grid`] lists the runs of the paper's experiment, [`record`]
 //! runs and saves one, [`folder`] keeps a grid's folder (its grid and sessions), [`shared`]
 //! spreads a grid over workers through a database, and [`summary`] aggregates the runs into
 //! the paper's figures and claims.

@@ -90,7 +90,7 @@ impl Kernel {
     }
 
     /// Replaces each squared scaled distance r² in `values` by σ_f²·κ(r²), one kernel shape
-    /// per call so that the loop vectorises (four wide with AVX2, see [`crate::simd`]).
+    /// per call so that the loop vectorises (four wide with AVX2, see `crate::simd`).
     pub fn apply_in_place(self, values: &mut [f64], signal_var: f64) {
         crate::simd::wide(
             #[inline(always)]

@@ -49,7 +49,7 @@ fn fits_a_gp(method: Method) -> bool {
 /// Seconds a race of `laps` laps with `kernels` kernels by `method` takes on one free core,
 /// roughly: the simulator's share, and the optimiser's, for CDBO the GP's refits, n³ summed
 /// over the laps: 8e-8 · n³ (2.2 s over 300 laps; 1.2 to 2.1 s in Table 1), other methods in
-/// proportion ([`optimizer_seconds`]).
+/// proportion (`optimizer_seconds`).
 pub fn race_seconds(method: Method, kernels: usize, laps: usize) -> f64 {
     let n = laps as f64;
     simulator_seconds(kernels, laps)
@@ -74,7 +74,7 @@ pub fn race_bytes(method: Method, kernels: usize, laps: usize) -> f64 {
 /// cdbo's to know), roughly: one CDBO suggestion over n observations costs about
 /// 0.35 µs · M · n (the acquisition's coordinate scans), summed over the laps
 /// 1.75e-7 · M · n², and the GP's refits 8e-8 · n³ as in [`race_seconds`]; other methods in
-/// proportion ([`optimizer_seconds`]). Calibrated on `cdbo bench suggest` (session 10, both
+/// proportion (`optimizer_seconds`). Calibrated on `cdbo bench suggest` (session 10, both
 /// cores busy): 300 observations in 30, 300 and 1000 dimensions, a median 2.9, 28.7 and 110 ms
 /// per CDBO suggestion; this gives 3.7 s for CDBO's optimiser over a 300-lap, 100-kernel
 /// race, where the README's Forza-100 races measured 4.1–5.0 s under load (the estimate was

@@ -20,7 +20,7 @@ use crate::error::{Error, Result};
 use crate::learner::{pattern_search, safe_search};
 use crate::optimizers::{bo, cmaes, linebo, random, rembo, turbo};
 
-/// A method [`Method::optimizer`] builds: the paper's CDBO, its baselines, and later peers.
+/// A method [`Spec::optimizer`] builds: the paper's CDBO, its baselines, and later peers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(into = "&'static str", try_from = "String")]
 pub enum Method {

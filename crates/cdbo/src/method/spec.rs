@@ -105,7 +105,7 @@ impl Spec {
 
     /// This specification with the method's main knob at `value` (σ₀, TuRBO's L_init, LineBO's
     /// step, REMBO's box), refused with the knob's name and range if the method cannot take it
-    /// ([`Knob::check`](super::Knob::check): the one check of a knob).
+    /// (`Knob::check`: the one check of a knob).
     pub fn knob(self, value: f64) -> Result<Spec> {
         let value = self.method.knob().check(self.method, value)?;
         Ok(self.with_checked_knob(value))

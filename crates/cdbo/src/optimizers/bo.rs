@@ -17,7 +17,7 @@
 //!
 //! Hyperparameter fits are due at the first BO step and then every `refit_every` laps. The
 //! first is fitted at once; each later one starts from the data at its lap on a thread of its
-//! own ([`FitInFlight`]) and is installed when the next is due, `refit_every` laps later, so
+//! own (`FitInFlight`) and is installed when the next is due, `refit_every` laps later, so
 //! that the laps between hide its O(n³) cost. The schedule depends on the lap count alone:
 //! the result is the same whether the thread finished early or is waited for.
 //!

@@ -56,7 +56,7 @@ pub trait Optimizer {
     /// Number of rewards told.
     fn evaluations(&self) -> usize;
 
-    /// The whole state, to resume the run later with [`Saved::resume`] exactly where it is.
+    /// The whole state, to resume the run later with [`crate::method::resume`] exactly where it is.
     fn save(&self) -> Saved;
 }
 

@@ -21,7 +21,7 @@
 //!   `car.cpp`; [`crate::car::Axles`]), lagged 70 ms.
 //! - Tyres: each wheel's budget F_z·μ·μ_r·λ(F_z) ([`super::tyre`]) under its own load, μ_r
 //!   the friction of the surface under the wheel's centre: the road's, or past the road's
-//!   edge its border's or side's ([`crate::track::Verge`], [`Vehicle::wheel_surfaces`]), as
+//!   edge its border's or side's ([`crate::track::Verge`], `Vehicle::wheel_ground`), as
 //!   simuv2's `wheel.cpp` takes each wheel's segment's surface. The
 //!   front wheels share one spin; the inner one is steered by δ, the outer one by simuv2's
 //!   Ackermann angle (`steer.cpp`), tan δ_o = L·tan|δ|/(L + T·tan|δ|), T = y_f + y_r (at
@@ -29,7 +29,7 @@
 //!   vₓ ∓ r·y_r. The wheels' longitudinal forces at ±y add a yaw moment
 //!   Σ y·(Fₓ,right − Fₓ,left) (simuv2's `car.cpp`: M_z = Σ −Fₓ·y + Fᵧ·x).
 //! - Rear wheels: driven through a spool, a free or a limited-slip differential as simuv2's
-//!   `differential.cpp` ([`Vehicle::rear_wheels`]).
+//!   `differential.cpp` (`Vehicle::rear_wheels`).
 //! - Wheel slip: for the wheel-frame velocity (v_t, v_l), sₓ = (ωR − v_t)/max(|v_t|, v₀) and
 //!   s_y = −v_l/max(|v|, v₀), |v| = √(v_t² + v_l²), the sine of the slip angle as simuv2's
 //!   `wheel.cpp` has it, with v₀ = [`SLIP_SPEED_FLOOR`]; the tyre ([`super::tyre`]) gives
@@ -42,7 +42,7 @@
 //!   m(v̇_y + vₓ r) = F_xf sin δ + F_yf cos δ + F_yr − m g sin β,
 //!   I_z ṙ = a(F_xf sin δ + F_yf cos δ) − b F_yr + y_r(F_x,rr − F_x,rl) − M_R, with β the
 //!   banking, F_xr, F_yr the rear wheels' sums and M_R the rolling resistance's moment against
-//!   the yaw, simuv2's R·L/2 (`car.cpp`; [`Vehicle::rolling_yaw_moment`]).
+//!   the yaw, simuv2's R·L/2 (`car.cpp`; `Vehicle::rolling_yaw_moment`).
 //! - Drag F = 0.645·Cx·A·v², downforce Dᵢ = 0.645·Clᵢ·A·v², rolling resistance
 //!   F = Σᵢ c_rr,i·F_z,i·sgn vₓ, c_rr,i the surface's under wheel i where the track gives one
 //!   (as TORCS's simuv2 does, `wheel.cpp`: F_z·`kRollRes` of the wheel's segment), else the

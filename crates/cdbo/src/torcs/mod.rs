@@ -9,7 +9,7 @@
 //! The robot drives exactly what [`crate::sim::Simulator`] drives: the pedal a(x) (a policy,
 //! the demonstrator or a constant), the look-ahead PI steering of
 //! [`crate::drive::steering`] or the path tracker of [`crate::drive::tracker`] on the lap's
-//! line (the centre line, or the base and policy line sampled by [`line`]), the automatic
+//! line (the centre line, or the base and policy line sampled by [`line`](mod@line)), the automatic
 //! gearbox of [`crate::sim::powertrain`] (its shift points are handed over from the car's
 //! [`crate::sim::vehicle::Vehicle`]), and the same failure rules, judged from the game's car
 //! state; its launch clutch, traction control and ABS act at the game's driver steps
