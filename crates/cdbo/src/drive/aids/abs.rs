@@ -8,9 +8,10 @@
 //! a car the robot drives the same way ([`crate::sim::vehicle::Vehicle::driver_brake`]).
 //! Eased every 4 ms and per axle instead, as cdbo's vehicle eases another car's brakes, its
 //! car1-trb1 braked from 62 m/s at 3 g where the game's brakes at 2.5 g, its rear wheels
-//! slipping more, and it shifted down 35 m early and coasted a gear too low: the calibration's
-//! launch-and-brake probe cost 46 against the game's laps (0.18 with the robot's ABS), and
-//! the fit bent the tyre and the aero to match it (docs/results/torcs.md, "Session 37").
+//! slipping more, and it shifted down early (into second 150 m early) and coasted a gear too
+//! low: the calibration's launch-and-brake probe cost 46 against the game's laps (0.18 with
+//! the robot's ABS), and the fit bent the tyre and the aero to match it
+//! (docs/results/torcs.md, "Session 37").
 
 /// The brake command after ABS, b·Πₖ clamp(2 − σₖ/σ*ₖ, 0, 1) over the axles (front, rear)
 /// whose slide σₖ passes a positive threshold σ*ₖ.
