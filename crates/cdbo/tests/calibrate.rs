@@ -79,8 +79,7 @@ fn the_stock_car_brakes_and_coasts_as_the_games_does() {
         eprintln!("skipped: no ../shared");
         return;
     };
-    let data = cdbo::data_path::DataPath::with_env(&[common::shared("")], "");
-    let car = cdbo::car::catalog::find("car1-trb1", &data).unwrap();
+    let car = common::shared_car("car1-trb1");
     let track = common::shared_track("forza");
     let probe = calibrate::probes(&track, &car)
         .unwrap()
@@ -130,8 +129,7 @@ fn the_fit_recovers_all_six_scales_on_two_tracks() {
         eprintln!("skipped: no ../shared");
         return;
     };
-    let data = cdbo::data_path::DataPath::with_env(&[common::shared("")], "");
-    let base = cdbo::car::catalog::find("car1-trb1", &data).unwrap();
+    let base = common::shared_car("car1-trb1");
     let truth = Scales {
         grip: 0.93,
         peak_slip: 1.2,

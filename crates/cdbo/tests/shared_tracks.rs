@@ -276,8 +276,7 @@ fn a_rough_road_takes_car1_trb1s_grip() {
     use cdbo::drive::ConstantPedal;
     use cdbo::sim::Simulator;
     use cdbo::track::{Piece, Roughness};
-    let data = cdbo::data_path::DataPath::with_env(&[shared("")], "");
-    let car = cdbo::car::catalog::find("car1-trb1", &data).unwrap();
+    let car = common::shared_car("car1-trb1");
     let ride = car.ride.unwrap();
     let lbs_in_s = 0.453_592_37 / 0.0254;
     assert!((ride.dampers[0].bump.slow - 400.0 * lbs_in_s).abs() < 1e-9);
@@ -319,8 +318,7 @@ fn a_rough_road_takes_car1_trb1s_grip() {
 /// the steering alternated step by step, in the game too).
 #[test]
 fn the_tracker_does_not_ring_on_car1_trb1_at_speed() {
-    let data = cdbo::data_path::DataPath::with_env(&[shared("")], "");
-    let car = cdbo::car::catalog::find("car1-trb1", &data).unwrap();
+    let car = common::shared_car("car1-trb1");
     let track = common::shared_track("forza");
     let steering = cdbo::drive::steering::Steering::Tracker(Default::default());
     let venue = cdbo::venue::Venue::simulator(track, &car).steered(steering);

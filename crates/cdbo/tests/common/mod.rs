@@ -15,6 +15,12 @@ pub fn shared_track(name: &str) -> Track {
     cdbo::track::catalog::find(name, &data).unwrap_or_else(|e| panic!("{e}"))
 }
 
+/// A car from ../shared, found by name.
+pub fn shared_car(name: &str) -> cdbo::car::Car {
+    let data = DataPath::with_env(&[shared("")], "");
+    cdbo::car::catalog::find(name, &data).unwrap_or_else(|e| panic!("{e}"))
+}
+
 /// A built-in track.
 pub fn builtin(name: &str) -> Track {
     cdbo::track::builtin::load(name)
