@@ -647,6 +647,8 @@ fn a_race_records_how_it_drove_and_its_policy_replays_so() {
     ]);
     assert_eq!(v["steering"].as_str(), Some("tracker"));
     assert_eq!(v["off_track_margin_m"].as_f64(), Some(0.5));
+    // A margin given is the whole rule: nothing else kept in reserve.
+    assert!(v["reserve"].is_null(), "{v}");
     assert_eq!(v["simulator"].as_str(), Some("cdbo"));
     let best = v["best_reward_mps"].as_f64().unwrap();
     assert!(best > 30.0, "{best}");
@@ -718,9 +720,13 @@ fn a_short_race_writes_its_results() {
         out.to_str().unwrap(),
     ];
     let v = json(args);
-    // Learning in cdbo's simulator keeps the car's centre 1 m inside the road's edge unless
-    // told otherwise, the reserve issue 34's transfer asks for.
+    // Learning in cdbo's simulator keeps a reserve unless told otherwise, the robust learner
+    // issue 34's transfer asks for: the wheels 0.25 m off slippery ground, the body 1 m off the
+    // walls, and on a road whose verges are not known (this one) the car's centre 1 m inside
+    // its edge.
     assert_eq!(v["off_track_margin_m"].as_f64(), Some(-1.0));
+    assert_eq!(v["reserve"]["wheels_m"].as_f64(), Some(0.25));
+    assert_eq!(v["reserve"]["body_m"].as_f64(), Some(1.0));
     for key in [
         "method",
         "track",

@@ -179,8 +179,8 @@ fn the_robots_table_gives_each_robots_laps_and_damage() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// `cdbo torcs compare --seeds 2` learns a policy a seed (as `cdbo race` does, a metre inside
-/// the road's edge), draws around each and pools them;
+/// `cdbo torcs compare --seeds 2` learns a policy a seed (as `cdbo race` does, keeping its
+/// reserve of the road), draws around each and pools them;
 /// it writes each drawn policy the two simulators disagree on, and nothing else, where `cdbo
 /// lap` drives it again to the lap compare.json recorded for cdbo's side (on G-Track 1 cdbo's
 /// car leaves the road at 620-660 m on a few of them, the game's at 1010-1080 m on others);
@@ -210,8 +210,9 @@ fn compare_writes_each_disagreement_as_a_policy_that_drives_again() {
         serde_json::from_str(&std::fs::read_to_string(out.join("compare.json")).unwrap()).unwrap();
     let policies = &report[0]["policies"];
     assert_eq!(policies["seeds"], serde_json::json!([0, 1]));
-    // Learned as `cdbo race` learns, a metre inside the road's edge.
+    // Learned as `cdbo race` learns, keeping its reserve.
     assert_eq!(policies["learned_off_track_margin_m"], -1.0);
+    assert_eq!(policies["learned_reserve"]["wheels_m"], 0.25);
     assert_eq!(policies["drawn"], 30);
     let disagreements = policies["disagreements"].as_array().unwrap();
     let agree = policies["agree"].as_u64().unwrap() as usize;

@@ -145,13 +145,15 @@ impl PyRaceResult {
 /// line `line` (`centre`, `min-curvature` or `learn`, with `line_kernels` and `line_start` as
 /// `cdbo race --line-kernels` and `--line-start`), steered by `steering` (`pi` or `tracker`),
 /// its laps failing `off_track_margin` m past the road's edge (as `--off-track-margin`; by
-/// default 1 m inside it, `LEARNING_OFF_TRACK_MARGIN`, the reserve `cdbo race` learns with),
+/// default, None, keeping the reserve `cdbo race` learns with: the wheels 0.25 m off slippery
+/// ground, the body 1 m off the walls, the car's centre on the road, `LEARNING_OFF_TRACK_MARGIN`
+/// where the road's verges are not known),
 /// searching w₀ ± `bounds` (as `--box-radius`; None: 1.5).
 /// `track` and `car` are objects or names; `knob` is the method's main knob (`cdbo race
 /// --knob`; None: its tuned value); `progress(record)` is called after every lap with the
 /// lap's record (a dict).
 #[pyfunction]
-#[pyo3(signature = (track = None, car = None, *, method = "cdbo", kernels = 30, laps = 300, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, demo_speed = 15.0, knob = None, max_failed = None, data_dir = None, progress = None, line = "centre", line_kernels = None, line_start = None, steering = "pi", off_track_margin = cdbo::sim::lap::LEARNING_OFF_TRACK_MARGIN, bounds = None))]
+#[pyo3(signature = (track = None, car = None, *, method = "cdbo", kernels = 30, laps = 300, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, demo_speed = 15.0, knob = None, max_failed = None, data_dir = None, progress = None, line = "centre", line_kernels = None, line_start = None, steering = "pi", off_track_margin = None, bounds = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn race(
     py: Python<'_>,
@@ -171,13 +173,16 @@ pub fn race(
     line_kernels: Option<usize>,
     line_start: Option<&str>,
     steering: &str,
-    off_track_margin: f64,
+    off_track_margin: Option<f64>,
     bounds: Option<f64>,
 ) -> PyResult<PyRaceResult> {
     let track = track_from(py, track, data_dir)?;
     let car = car_from(car, data_dir)?;
     let steering: SteeringLaw = steering.parse().py()?;
-    let off_track_margin = checked_off_track_margin(off_track_margin).py()?;
+    let off_track_margin = off_track_margin
+        .map(checked_off_track_margin)
+        .transpose()
+        .py()?;
     let (base_line, line_kernels) = line_setting(line, line_kernels, line_start)?
         .resolve(kernels)
         .py()?;
@@ -201,7 +206,7 @@ pub fn race(
         .detach(|| {
             let venue = cdbo::venue::Venue::simulator(track.clone(), &car)
                 .steered(steering.steering())
-                .off_track_at(off_track_margin);
+                .for_learning(off_track_margin);
             cdbo::experiment::race::race(&venue, &track, &car, &config, |r| {
                 if let (Some(cb), None) = (&progress, &callback_error) {
                     Python::attach(|py| {

@@ -386,7 +386,9 @@ impl PyLapResult {
 /// the minimum-curvature racing line (as `cdbo race --line min-curvature`), the demonstration's
 /// included; `steering="tracker"` steers with the path tracker (as `--steering tracker`);
 /// `off_track_margin` is where a lap leaves the road (m past its edge, as
-/// `--off-track-margin`; 1, the game's rule).
+/// `--off-track-margin`; 1, the game's rule); `reserve=True` keeps the reserve `cdbo race`
+/// learns with as well (the wheels 0.25 m off slippery ground, the body 1 m off the walls, the
+/// car's centre on the road; `off_track_margin` only where the road's verges are not known).
 #[pyclass(name = "Simulator", module = "cdbo", frozen)]
 pub struct PySimulator {
     pub sim: Simulator,
@@ -397,7 +399,8 @@ pub struct PySimulator {
 #[pymethods]
 impl PySimulator {
     #[new]
-    #[pyo3(signature = (track = None, car = None, *, data_dir = None, line = "centre", steering = "pi", off_track_margin = 1.0))]
+    #[pyo3(signature = (track = None, car = None, *, data_dir = None, line = "centre", steering = "pi", off_track_margin = 1.0, reserve = false))]
+    #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
         track: Option<&Bound<'_, PyAny>>,
@@ -406,6 +409,7 @@ impl PySimulator {
         line: &str,
         steering: &str,
         off_track_margin: f64,
+        reserve: bool,
     ) -> PyResult<Self> {
         let track = track_from(py, track, data_dir)?;
         let car = car_from(car, data_dir)?;
@@ -417,6 +421,7 @@ impl PySimulator {
         sim.config.line = held;
         sim.config.steering = steering.steering();
         sim.config.off_track_margin = off_track_margin;
+        sim.config.reserve = reserve.then_some(cdbo::sim::lap::Reserve::LEARNING);
         Ok(PySimulator { sim, base })
     }
 

@@ -13,7 +13,7 @@ use crate::evaluator::Evaluator;
 use crate::evaluator::simulator::SimEvaluator;
 use crate::line::RacingLine;
 use crate::policy::{Policy, PolicyShape};
-use crate::sim::lap::{GAME_OFF_TRACK_MARGIN, LEARNING_OFF_TRACK_MARGIN};
+use crate::sim::lap::{GAME_OFF_TRACK_MARGIN, LEARNING_OFF_TRACK_MARGIN, Reserve};
 use crate::sim::{LapConfig, LapResult, Simulator};
 use crate::torcs::evaluator::{TorcsEvaluator, drive, with_pedal, with_policy};
 use crate::torcs::{Game, GamePedal, LapRequest};
@@ -68,22 +68,37 @@ impl Venue {
     }
 
     /// This venue with a lap failing once the car's centre is `margin` metres past the road's
-    /// edge ([`LapConfig::off_track_margin`]; negative: inside the road), in the simulator and
-    /// the game alike.
+    /// edge ([`LapConfig::off_track_margin`]; negative: inside the road), and at the barriers,
+    /// nothing kept in reserve, in the simulator and the game alike.
     pub fn off_track_at(self, margin: f64) -> Venue {
-        self.configured(|config| config.off_track_margin = margin)
+        self.configured(|config| {
+            config.off_track_margin = margin;
+            config.reserve = None;
+        })
     }
 
     /// This venue as a policy learns in it: its laps failing `margin` metres past the road's
-    /// edge if given, else at [`LEARNING_OFF_TRACK_MARGIN`] in cdbo's simulator (a reserve the
-    /// world the policy is then driven in will not take away) and at the game's own rule,
+    /// edge if given; else, in cdbo's simulator, keeping [`Reserve::LEARNING`] (a reserve the
+    /// world the policy is then driven in will not take away; [`LEARNING_OFF_TRACK_MARGIN`]
+    /// where the road's verges are not known), and at the game's own rule,
     /// [`GAME_OFF_TRACK_MARGIN`], in the game.
     pub fn for_learning(self, margin: Option<f64>) -> Venue {
-        let margin = margin.unwrap_or(match self {
-            Venue::Simulator(_) => LEARNING_OFF_TRACK_MARGIN,
-            Venue::Game { .. } => GAME_OFF_TRACK_MARGIN,
-        });
-        self.off_track_at(margin)
+        match (margin, &self) {
+            (Some(margin), _) => self.off_track_at(margin),
+            (None, Venue::Simulator(_)) => self.configured(|config| {
+                config.off_track_margin = LEARNING_OFF_TRACK_MARGIN;
+                config.reserve = Some(Reserve::LEARNING);
+            }),
+            (None, Venue::Game { .. }) => self.off_track_at(GAME_OFF_TRACK_MARGIN),
+        }
+    }
+
+    /// What this venue's laps keep in reserve of the road ([`LapConfig::reserve`]).
+    pub fn reserve(&self) -> Option<Reserve> {
+        match self {
+            Venue::Simulator(sim) => sim.config.reserve,
+            Venue::Game { request, .. } => request.config.reserve,
+        }
     }
 
     /// Where this venue's laps fail: the car's centre this far past the road's edge (m).

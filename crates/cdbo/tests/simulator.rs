@@ -65,34 +65,39 @@ fn full_throttle_fails_on_forza_and_says_where() {
     assert!(f.x > 0.0 && f.x < 1.0 && f.distance_m > 100.0, "{f:?}");
 }
 
+/// A 100 m straight into a 40 m-radius bend, 10 m wide, with `verge` past both edges: a
+/// simulator of the Spirit 300 on it, tracing its laps.
+fn bend(verge: cdbo::track::Verge) -> Simulator {
+    let piece = |length: f64, curvature: f64| Piece {
+        width: 10.0,
+        verges: [verge; 2],
+        ..Piece::flat(length, curvature)
+    };
+    let pieces = [
+        piece(100.0, 0.0),
+        piece(2.0 * std::f64::consts::PI * 40.0, 1.0 / 40.0),
+    ];
+    let mut sim = Simulator::new(
+        Track::from_pieces("bend", "test", &pieces, vec![]),
+        &Car::spirit_300(),
+    );
+    sim.config.trace = true;
+    sim
+}
+
 /// A car running wide out of a bend ends its lap in the wall where the track has one, before
 /// its centre is past the edge by the off-track margin, and where the body reaches it.
 #[test]
 fn a_barrier_ends_the_lap_where_the_body_reaches_it() {
     use cdbo::track::Verge;
-    // A 100 m straight into a 40 m-radius bend, 10 m wide; a border 0.5 m wide and no side.
+    // A border 0.5 m wide and no side.
     let bend = |barrier: bool| {
-        let verge = Verge {
+        bend(Verge {
             border_width: 0.5,
             barrier,
             ..Verge::NONE
-        };
-        let pieces = [
-            Piece {
-                width: 10.0,
-                verges: [verge; 2],
-                ..Piece::flat(100.0, 0.0)
-            },
-            Piece {
-                width: 10.0,
-                verges: [verge; 2],
-                ..Piece::flat(2.0 * std::f64::consts::PI * 40.0, 1.0 / 40.0)
-            },
-        ];
-        let track = Track::from_pieces("bend", "test", &pieces, vec![]);
-        let mut sim = Simulator::new(track, &Car::spirit_300());
-        sim.config.trace = true;
-        sim.lap(&mut ConstantPedal(1.0))
+        })
+        .lap(&mut ConstantPedal(1.0))
     };
     let (walled, open) = (bend(true), bend(false));
     let (wall, edge) = (walled.failure.unwrap(), open.failure.unwrap());
@@ -108,6 +113,61 @@ fn a_barrier_ends_the_lap_where_the_body_reaches_it() {
         (5.5 - 2.1f64.hypot(0.95)..5.5 - 0.95 + 0.1).contains(&lateral),
         "{last:?}"
     );
+}
+
+/// The learning reserve ([`Reserve::LEARNING`]) on a bend whose verges are grass: full throttle
+/// runs the car wide, and the lap fails where its outer wheel first comes within 0.25 m of the
+/// grass, before the road's edge and the game's rule; where the grass is a wide run-off of
+/// asphalt it fails where the car's centre leaves the road; on a road that gives no verges it
+/// is the lap at [`LapConfig::off_track_margin`] to the bit.
+#[test]
+fn the_learning_reserve_keeps_the_wheels_off_the_grass() {
+    use cdbo::sim::lap::{LEARNING_OFF_TRACK_MARGIN, Reserve};
+    use cdbo::track::{Surface, Verge};
+    let car = Car::spirit_300();
+    let wheel = car.axles.half_track[0].max(car.axles.half_track[1]);
+    let bend = |side: Option<Surface>, reserve: Option<Reserve>, margin: f64| {
+        let mut sim = bend(side.map_or(Verge::NONE, |side| Verge {
+            side_width: 20.0,
+            side,
+            ..Verge::NONE
+        }));
+        sim.config.reserve = reserve;
+        sim.config.off_track_margin = margin;
+        sim.lap(&mut ConstantPedal(1.0))
+    };
+    let grass = Surface {
+        friction: 0.4,
+        ..Surface::PLAIN
+    };
+    let asphalt = Surface::PLAIN;
+    let learning = Some(Reserve::LEARNING);
+    let kept = bend(Some(grass), learning, LEARNING_OFF_TRACK_MARGIN);
+    let rule = bend(Some(grass), None, 1.0);
+    let run_off = bend(Some(asphalt), learning, LEARNING_OFF_TRACK_MARGIN);
+    let [kept_at, rule_at, run_off_at] =
+        [&kept, &rule, &run_off].map(|lap| lap.failure.expect("full throttle fails the bend"));
+    assert_eq!(kept_at.reason, FailureReason::OffTrack, "{kept_at:?}");
+    assert!(
+        kept_at.distance_m < run_off_at.distance_m,
+        "{kept_at:?} {run_off_at:?}"
+    );
+    assert!(
+        run_off_at.distance_m < rule_at.distance_m,
+        "{run_off_at:?} {rule_at:?}"
+    );
+    // At the last driver step the outer wheels were still more than 0.25 m from the grass,
+    // and the car's centre, running wide on the asphalt, within a step of the edge.
+    let last = kept.trace.last().unwrap();
+    assert!(last.lateral.abs() + wheel + 0.25 < 5.0 + 0.1, "{last:?}");
+    assert!(last.lateral.abs() + wheel + 0.25 > 5.0 - 0.5, "{last:?}");
+    let edge = run_off.trace.last().unwrap().lateral.abs();
+    assert!((4.5..5.0).contains(&edge), "{edge}");
+    // Without verges: the centre a metre inside the edge, the same lap as without the reserve.
+    let bare = bend(None, learning, LEARNING_OFF_TRACK_MARGIN);
+    let metre = bend(None, None, LEARNING_OFF_TRACK_MARGIN);
+    assert_eq!(bare.failure, metre.failure);
+    assert_eq!(bare.simulated_s, metre.simulated_s);
 }
 
 /// Follows the limit's speed profile, scaled, with a look-ahead: a near-ideal pedal.

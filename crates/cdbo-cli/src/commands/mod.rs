@@ -79,11 +79,13 @@ impl Simulator {
 #[derive(Debug, Clone, Copy, clap::Args)]
 pub struct OffTrackArgs {
     /// Where a lap leaves the road: once the car's centre is this far past the road's edge
-    /// (m; negative: inside the road). Default: the game's rule, 1, for a lap judged (`lap`)
-    /// or learned in the game; -1 for a policy learned in cdbo's simulator, a reserve the
-    /// game's car will not take away: the pattern search's best policy learned so completes in
-    /// the game on 20 of TORCS's 21 road tracks, against 1 at 1 m (docs/results/torcs.md,
-    /// "Robust learning").
+    /// (m; negative: inside the road), nothing else kept in reserve. Default: the game's rule,
+    /// 1, for a lap judged (`lap`) or learned in the game; for a policy learned in cdbo's
+    /// simulator, a reserve the game's car will not take away: every wheel 0.25 m off
+    /// slippery ground (grass, sand), the body 1 m off the walls, the car's centre on the road
+    /// (1 m inside its edge where the track gives no verges): the pattern search's best policy
+    /// learned so completes in the game on 20 of TORCS's 21 road tracks, against 1 at 1 m
+    /// (docs/results/torcs.md, "Session 38").
     #[arg(long, allow_negative_numbers = true, value_parser = value::off_track_margin)]
     pub off_track_margin: Option<f64>,
 }
@@ -96,15 +98,21 @@ impl OffTrackArgs {
     }
 }
 
-/// Where a lap fails, in words: "1 m inside the road's edge", "1 m past the road's edge, the
-/// game's rule".
-pub fn edge_words(margin_m: f64) -> String {
+/// Where a lap fails, in words: "at 1 m inside the road's edge", "at 1 m past the road's
+/// edge, the game's rule", or "keeping …" the reserve ([`cdbo::sim::lap::Reserve`]).
+pub fn edge_words(margin_m: f64, reserve: Option<cdbo::sim::lap::Reserve>) -> String {
+    if let Some(r) = reserve {
+        return format!(
+            "keeping the wheels {} m off slippery ground and the body {} m off the walls",
+            r.wheels_m, r.body_m
+        );
+    }
     match margin_m {
         m if m == cdbo::sim::lap::GAME_OFF_TRACK_MARGIN => {
-            format!("{m} m past the road's edge, the game's rule")
+            format!("at {m} m past the road's edge, the game's rule")
         }
-        m if m < 0.0 => format!("{} m inside the road's edge", -m),
-        m => format!("{m} m past the road's edge"),
+        m if m < 0.0 => format!("at {} m inside the road's edge", -m),
+        m => format!("at {m} m past the road's edge"),
     }
 }
 

@@ -91,8 +91,11 @@ struct Summary {
     simulator: &'static str,
     /// The steering the car drove with.
     steering: SteeringLaw,
-    /// Where a lap left the road: the car's centre this far past the road's edge (m).
+    /// Where a lap left the road: the car's centre this far past the road's edge (m; where
+    /// the road's verges are not known, if a reserve was kept).
     off_track_margin_m: f64,
+    /// What the laps kept in reserve of the road (learning in cdbo's simulator by default).
+    reserve: Option<cdbo::sim::lap::Reserve>,
     /// The failed laps allowed (`--max-failed-laps`), if any.
     #[serde(skip_serializing_if = "Option::is_none")]
     max_failed_laps: Option<usize>,
@@ -222,6 +225,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     let mut ceiling_sim = cdbo::sim::Simulator::new(track.clone(), &car);
     ceiling_sim.config.steering = args.steering.steering();
     ceiling_sim.config.off_track_margin = venue.off_track_margin();
+    ceiling_sim.config.reserve = venue.reserve();
     let profile = cdbo::ceiling::profile(&track, &car, None);
     let (_, ceiling_mps) = cdbo::ceiling::tracked_profile(&ceiling_sim, &profile)?;
     write_outputs(&out, &outcome, config.base_line, args.steering)?;
@@ -255,6 +259,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         simulator: simulator.name(),
         steering: args.steering,
         off_track_margin_m: venue.off_track_margin(),
+        reserve: venue.reserve(),
         max_failed_laps: args.max_failed_laps,
         box_radius: args
             .box_radius
@@ -289,7 +294,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         return print_json(&summary);
     }
     println!(
-        "{} on {}, {} kernels, {} laps: best lap {} at {:.2} m/s, {:.1} % of the centre-line limit ({:.2} m/s), {:.1} % of the ceiling ({:.2} m/s), {:.2}x the demonstration ({:.2} m/s); {} laps failed at {}",
+        "{} on {}, {} kernels, {} laps: best lap {} at {:.2} m/s, {:.1} % of the centre-line limit ({:.2} m/s), {:.1} % of the ceiling ({:.2} m/s), {:.2}x the demonstration ({:.2} m/s); {} laps failed {}",
         summary.method,
         summary.track,
         summary.kernels,
@@ -305,7 +310,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         summary.best_reward_mps / summary.demo_reward_mps,
         summary.demo_reward_mps,
         summary.failed_laps,
-        super::edge_words(summary.off_track_margin_m)
+        super::edge_words(summary.off_track_margin_m, summary.reserve)
     );
     if let Some(file) = &summary.warm_start {
         println!(

@@ -30,8 +30,8 @@ pub struct ServeSimArgs {
     /// its kernels), w₀'s line the base line (d = 0).
     #[command(flatten)]
     line: super::line::LineArgs,
-    /// Where the laps leave the road, as `cdbo race` learns (default: 1 m inside the road's
-    /// edge in cdbo's simulator, the game's rule in the game).
+    /// Where the laps leave the road, as `cdbo race` learns (default: the learning reserve in
+    /// cdbo's simulator, the game's rule in the game).
     #[command(flatten)]
     off_track: super::OffTrackArgs,
 }

@@ -64,9 +64,10 @@ pub struct CompareArgs {
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=100))]
     seeds: u64,
     /// Where the learned policies' laps fail while they learn in cdbo's simulator, as `cdbo
-    /// race --off-track-margin` (m past the road's edge; default as `cdbo race`: 1 m inside it;
-    /// 1, the game's rule, was the default before session 35). Every drawn policy is judged at
-    /// the game's rule in both simulators.
+    /// race --off-track-margin` (m past the road's edge; default as `cdbo race`: the learning
+    /// reserve, the wheels off slippery ground and the body off the walls; 1, the game's rule,
+    /// was the default before session 35). Every drawn policy is judged at the game's rule in
+    /// both simulators.
     #[arg(long, allow_negative_numbers = true, value_parser = super::value::off_track_margin)]
     off_track_margin: Option<f64>,
     /// The game's built-in robot to compare the limit with.
@@ -134,6 +135,8 @@ struct Policies {
     sigma: f64,
     /// Where the learned policies' laps failed while they learned (m past the road's edge).
     learned_off_track_margin_m: f64,
+    /// What they kept in reserve of the road while they learned.
+    learned_reserve: Option<cdbo::sim::lap::Reserve>,
     /// The learned policies' mean best reward in cdbo's simulator.
     learned_reward_mps: f64,
     completed_cdbo: usize,
@@ -314,6 +317,7 @@ fn compare_track(
         drawn: drawn.len(),
         sigma: args.sigma,
         learned_off_track_margin_m: learning.off_track_margin(),
+        learned_reserve: learning.reserve(),
         learned_reward_mps,
         completed_cdbo: ours.iter().filter(|l| l.completed).count(),
         completed_torcs: theirs.iter().filter(|l| l.completed).count(),
@@ -432,7 +436,7 @@ fn markdown(reports: &[TrackReport], args: &CompareArgs) -> String {
     }
     let _ = writeln!(
         s,
-        "\n### Policies around a learned one\n\nLearned in cdbo's simulator ({} kernels, {} laps, {}, laps failing at {}); {} policies w = w* + {}·N(0, I){}; their laps judged at the game's rule in both.\n\n| track | learned: cdbo | learned: TORCS | completed cdbo / TORCS | completion agreement | both completed | lap-time error mean / max | bias (TORCS − cdbo) | TORCS wall |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+        "\n### Policies around a learned one\n\nLearned in cdbo's simulator ({} kernels, {} laps, {}, laps failing {}); {} policies w = w* + {}·N(0, I){}; their laps judged at the game's rule in both.\n\n| track | learned: cdbo | learned: TORCS | completed cdbo / TORCS | completion agreement | both completed | lap-time error mean / max | bias (TORCS − cdbo) | TORCS wall |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- |",
         args.kernels,
         args.laps,
         match args.seeds {
@@ -441,7 +445,8 @@ fn markdown(reports: &[TrackReport], args: &CompareArgs) -> String {
         },
         // Every track learns at the same margin, the flag's.
         reports.first().map_or("–".into(), |r| super::edge_words(
-            r.policies.learned_off_track_margin_m
+            r.policies.learned_off_track_margin_m,
+            r.policies.learned_reserve
         )),
         args.policies,
         args.sigma,

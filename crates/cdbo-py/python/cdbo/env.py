@@ -74,8 +74,10 @@ class RaceEnv(_Base):
     ``steering`` is how the car steers, as ``cdbo race --steering``: ``"pi"`` (the paper's)
     or ``"tracker"`` (the path tracker); ``off_track_margin`` is where a lap leaves the road,
     as ``--off-track-margin``: the car's centre that many metres past its edge (negative:
-    inside the road); by default ``LEARNING_OFF_TRACK_MARGIN``, -1, as ``cdbo race`` learns,
-    a reserve for the game or car the policy is then driven in (1 is the game's rule).
+    inside the road; 1 is the game's rule); by default (None) the reserve ``cdbo race`` learns
+    with, kept for the game or car the policy is then driven in: the wheels 0.25 m off
+    slippery ground, the body 1 m off the walls, the car's centre on the road
+    (``LEARNING_OFF_TRACK_MARGIN``, 1 m inside it, where the road's verges are not known).
     """
 
     metadata = {"render_modes": []}
@@ -92,7 +94,7 @@ class RaceEnv(_Base):
         line_kernels=None,
         line_start=None,
         steering: str = "pi",
-        off_track_margin: float = LEARNING_OFF_TRACK_MARGIN,
+        off_track_margin=None,
     ):
         self.base_line, self.line_kernels = resolve_line(
             kernels, line=line, line_kernels=line_kernels, line_start=line_start
@@ -103,7 +105,10 @@ class RaceEnv(_Base):
             data_dir=data_dir,
             line=self.base_line,
             steering=steering,
-            off_track_margin=off_track_margin,
+            off_track_margin=(
+                LEARNING_OFF_TRACK_MARGIN if off_track_margin is None else off_track_margin
+            ),
+            reserve=off_track_margin is None,
         )
         demo, x, a = self.simulator.demonstrate(demo_speed)
         if not demo.completed:

@@ -18,7 +18,7 @@
 //! races the centre line, the paper's.
 //! `steering = "tracker"` drives every run with the path tracker (default `"pi"`);
 //! `off_track_margin = 1.0` fails its laps 1 m past the road's edge, the game's rule (default:
-//! 1 m inside it in cdbo's simulator, as `cdbo race`; the game's rule in the game).
+//! the learning reserve in cdbo's simulator, as `cdbo race`; the game's rule in the game).
 //!
 //! Run r of every cell has seed r, so that the methods meet the same random numbers where
 //! they draw alike. The runs are listed in a fixed order; shard I of N takes every N-th run
@@ -86,9 +86,9 @@ pub struct ExperimentConfig {
     pub steering: SteeringLaw,
     /// Where every run's laps leave the road, as `cdbo race --off-track-margin`: the car's
     /// centre this far past the road's edge (m; negative: inside the road). Default, as `cdbo
-    /// race`'s: 1 m inside it in cdbo's simulator
-    /// ([`LEARNING_OFF_TRACK_MARGIN`](crate::sim::lap::LEARNING_OFF_TRACK_MARGIN)), the game's
-    /// rule in the game ([`crate::venue::Venue::for_learning`]).
+    /// race`'s: the learning reserve in cdbo's simulator
+    /// ([`Reserve::LEARNING`](crate::sim::lap::Reserve::LEARNING)), the game's rule in the
+    /// game ([`crate::venue::Venue::for_learning`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub off_track_margin: Option<f64>,
 }

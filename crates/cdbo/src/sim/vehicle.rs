@@ -536,25 +536,21 @@ impl Vehicle {
             return None;
         }
         let (along, lateral) = f.local(s.x, s.y);
-        let far = along.abs() + self.reach;
-        if lateral.abs() + self.reach + 0.5 * f.curvature.abs() * far * far < f.half_width
-            && !rough_road
-        {
+        if self.inside_edges(f, along, lateral, 0.0) && !rough_road {
             return None;
         }
-        let (se, ce) = f.relative_heading(s.yaw_sin_cos);
         let road_rolling = f.rolling_resistance.unwrap_or(self.rolling);
-        let [yf, yr] = self.car.axles.half_track;
-        let wheels = [(self.a, yf), (self.a, -yf), (-self.b, yr), (-self.b, -yr)];
         let mut out = [Ground {
             friction: f.friction,
             rolling: road_rolling,
             bumps: Bumps::NONE,
         }; 4];
         let mut off = false;
-        for (i, (xw, yw)) in wheels.into_iter().enumerate() {
-            let a = along + xw * ce - yw * se;
-            let l = lateral + xw * se + yw * ce - 0.5 * f.curvature * a * a;
+        for (i, (a, l)) in self
+            .wheel_places(s, f, along, lateral)
+            .into_iter()
+            .enumerate()
+        {
             let excess = l.abs() - f.half_width;
             let verge = &f.verges[if l > 0.0 { 0 } else { 1 }];
             let off_road = if excess > 0.0 {
@@ -587,6 +583,57 @@ impl Vehicle {
             }
         }
         (off || rough_road).then_some(out)
+    }
+
+    /// Whether a wheel stands on a raised kerb ([`crate::track::Verge::kerb_height`], whose
+    /// ramp cdbo's wheels do not climb), or would, moved `reserve` metres further out from the
+    /// centre line, stand on slippery ground: a verge's border or side whose friction is below
+    /// `fraction`·μ_road (grass, sand, gravel; a flat kerb as grippy as the road is not). The
+    /// wheels stand where the simulator's step places them on their ground; a road without verges of its
+    /// own has none.
+    pub fn wheel_near_slippery(&self, s: &State, f: &Frame, reserve: f64, fraction: f64) -> bool {
+        if !f.has_verges {
+            return false;
+        }
+        let (along, lateral) = f.local(s.x, s.y);
+        if self.inside_edges(f, along, lateral, reserve) {
+            return false;
+        }
+        let places = self.wheel_places(s, f, along, lateral);
+        places.into_iter().any(|(_, l)| {
+            let past_edge = l.abs() - f.half_width;
+            let verge = &f.verges[if l > 0.0 { 0 } else { 1 }];
+            let on_kerb =
+                verge.kerb_height > 0.0 && past_edge > 0.0 && past_edge <= verge.border_width;
+            let excess = past_edge + reserve;
+            on_kerb
+                || (excess > 0.0
+                    && verge
+                        .surface_at(excess)
+                        .is_some_and(|ground| ground.friction < fraction * f.friction))
+        })
+    }
+
+    /// Whether every wheel of a car at (`along`, `lateral`) from the frame's station stands
+    /// more than `reserve` inside both edges, whatever its heading: its reach, and what the
+    /// road's bend adds over it, short of the edge.
+    #[inline]
+    fn inside_edges(&self, f: &Frame, along: f64, lateral: f64, reserve: f64) -> bool {
+        let far = along.abs() + self.reach;
+        lateral.abs() + self.reach + reserve + 0.5 * f.curvature.abs() * far * far < f.half_width
+    }
+
+    /// Where each wheel's centre stands, front left, front right, rear left, rear right, the
+    /// car at (`along`, `lateral`) from the frame's station: (a, l) along the road and left of
+    /// the centre line, as [`Vehicle::wheel_ground`] places them.
+    #[inline]
+    fn wheel_places(&self, s: &State, f: &Frame, along: f64, lateral: f64) -> [(f64, f64); 4] {
+        let (se, ce) = f.relative_heading(s.yaw_sin_cos);
+        let [yf, yr] = self.car.axles.half_track;
+        [(self.a, yf), (self.a, -yf), (-self.b, yr), (-self.b, -yr)].map(|(xw, yw)| {
+            let a = along + xw * ce - yw * se;
+            (a, lateral + xw * se + yw * ce - 0.5 * f.curvature * a * a)
+        })
     }
 
     fn driven_omega(&self, s: &State) -> f64 {
@@ -1191,6 +1238,61 @@ mod tests {
         let mut s = v.at_rest(100.0, 5.5, 0.0);
         s.yaw_sin_cos = (0.0, 1.0);
         assert!(v.wheel_ground(&s, plain.frame(100)).is_none());
+    }
+
+    /// The reserve's wheels keep off slippery ground and raised kerbs, and nothing else: on a
+    /// straight 12 m wide with a flat kerb 1.5 m wide as grippy as the road then grass (0.4) on
+    /// the left, and a raised kerb 1 m wide then run-off asphalt on the right, a car heading
+    /// along the road with its wheels y_w out from its centre is too near once y + y_w + r
+    /// passes 6 + 1.5 on the left, and once −y + y_w passes 6 on the right (a wheel on the
+    /// kerb, whatever the reserve), to the millimetre; past the kerb, on the asphalt, it is
+    /// not; without verges, never.
+    #[test]
+    fn the_reserve_keeps_the_wheels_off_grass_and_raised_kerbs() {
+        use crate::track::{Piece, Surface, Track, Verge};
+        let grass = Surface {
+            friction: 0.4,
+            ..Surface::PLAIN
+        };
+        let piece = Piece {
+            verges: [
+                Verge {
+                    border_width: 1.5,
+                    side_width: 5.0,
+                    side: grass,
+                    ..Verge::NONE
+                },
+                Verge {
+                    border_width: 1.0,
+                    kerb_height: 0.1,
+                    side_width: 5.0,
+                    ..Verge::NONE
+                },
+            ],
+            ..Piece::flat(500.0, 0.0)
+        };
+        let t = Track::from_pieces("verges", "test", &[piece], vec![]);
+        let frame = *t.frame(100);
+        let v = Vehicle::new(&Car::spirit_300());
+        let wheel = v.car.axles.half_track[0].max(v.car.axles.half_track[1]);
+        let near = |frame: &Frame, y: f64, reserve: f64| {
+            let mut s = v.at_rest(100.0, y, 0.0);
+            s.yaw_sin_cos = (0.0, 1.0);
+            v.wheel_near_slippery(&s, frame, reserve, 0.8)
+        };
+        for reserve in [0.0, 0.25, 1.0] {
+            let left = 7.5 - wheel - reserve;
+            assert!(!near(&frame, left - 1e-3, reserve), "r = {reserve}");
+            assert!(near(&frame, left + 1e-3, reserve), "r = {reserve}");
+            let right = 6.0 - wheel;
+            assert!(!near(&frame, -right + 1e-3, reserve), "r = {reserve}");
+            assert!(near(&frame, -right - 1e-3, reserve), "r = {reserve}");
+            assert!(near(&frame, -right - 0.99, reserve), "r = {reserve}");
+        }
+        // Every wheel past the raised kerb, on the asphalt beyond it.
+        assert!(!near(&frame, -(7.0 + wheel + 0.1), 0.25));
+        let plain = Track::from_pieces("plain", "test", &[Piece::flat(500.0, 0.0)], vec![]);
+        assert!(!near(plain.frame(100), 7.0, 0.25));
     }
 
     /// The rolling resistance turns against the yaw as simuv2's `car.cpp` has it. One 4 ms

@@ -182,6 +182,9 @@ pub struct Verge {
     pub border_width: f64,
     /// The border's surface.
     pub border: Surface,
+    /// How high a kerb the border is (m; its `height` where its `style` is `curb`, else 0):
+    /// TORCS raises the kerb's outer edge by it, a ramp cdbo's wheels do not climb.
+    pub kerb_height: f64,
     /// Width of the side past the border (m); 0 without one.
     pub side_width: f64,
     /// The side's surface.
@@ -198,6 +201,7 @@ impl Verge {
     pub const NONE: Verge = Verge {
         border_width: 0.0,
         border: Surface::PLAIN,
+        kerb_height: 0.0,
         side_width: 0.0,
         side: Surface::PLAIN,
         barrier: false,

@@ -269,6 +269,9 @@ fn resolve(
 struct Sides {
     border_width: [f64; 2],
     border_surface: [String; 2],
+    /// The borders' `height`s, and whether their `style` is `curb` (a kerb).
+    border_height: [f64; 2],
+    curb: [bool; 2],
     side_start: [f64; 2],
     side_end: [f64; 2],
     side_surface: [String; 2],
@@ -284,6 +287,8 @@ impl Sides {
         let mut s = Sides {
             border_width: [0.0; 2],
             border_surface: [String::new(), String::new()],
+            border_height: [0.0; 2],
+            curb: [false; 2],
             side_start: [0.0; 2],
             side_end: [0.0; 2],
             side_surface: [String::new(), String::new()],
@@ -292,6 +297,9 @@ impl Sides {
             (s.side_surface[k], s.side_end[k]) = Self::part(main.section(Self::SIDE[k]))?;
             s.side_start[k] = s.side_end[k];
             (s.border_surface[k], s.border_width[k]) = Self::part(main.section(Self::BORDER[k]))?;
+            if let Some(border) = main.section(Self::BORDER[k]) {
+                s.border_style(k, border)?;
+            }
         }
         Ok(s)
     }
@@ -309,6 +317,16 @@ impl Sides {
                 .transpose()?
                 .unwrap_or(0.0),
         ))
+    }
+
+    /// Border `k`'s `height` and `style` from its section, each kept where it names none (as
+    /// `track4.cpp` carries them from segment to segment; `plan` and 0 at first).
+    fn border_style(&mut self, k: usize, border: &Section) -> Result<()> {
+        self.border_height[k] = border.num_or("height", self.border_height[k])?;
+        if let Some(style) = border.str("style") {
+            self.curb[k] = style == "curb";
+        }
+        Ok(())
     }
 
     /// `AddSides` at a segment's first step: its own `Left Side` / `Left Border` (and right).
@@ -332,6 +350,7 @@ impl Sides {
                 if let Some(name) = border.str("surface") {
                     self.border_surface[k] = name.into();
                 }
+                self.border_style(k, border)?;
             }
         }
         Ok(())
@@ -354,6 +373,11 @@ impl Sides {
                 surface(&self.border_surface[k])?
             } else {
                 Verge::NONE.border
+            },
+            kerb_height: if border_width > 0.0 && self.curb[k] {
+                self.border_height[k].max(0.0)
+            } else {
+                0.0
             },
             side_width,
             side: if side_width > 0.0 {
@@ -689,8 +713,8 @@ mod tests {
 
     /// Borders and sides as `track4.cpp` carries them: the main track's start them, a
     /// segment's change them from there on, a side's width runs from its start to its end width
-    /// over the segment's steps, a surface is looked up only where it has a width, and a barrier
-    /// stands past them.
+    /// over the segment's steps, a surface is looked up only where it has a width, a `curb`
+    /// border is a kerb of its `height`, and a barrier stands past them.
     #[test]
     fn borders_and_sides_carry_from_segment_to_segment() {
         let xml = format!(
@@ -704,7 +728,8 @@ mod tests {
                <section name="Main Track"><attnum name="width" val="10"/>
                  <attnum name="profil steps length" val="10"/>
                  <section name="Left Border"><attnum name="width" val="2"/>
-                   <attstr name="surface" val="kerb"/></section>
+                   <attstr name="surface" val="kerb"/><attstr name="style" val="curb"/>
+                   <attnum name="height" val="0.1"/></section>
                  <section name="Right Side"><attnum name="width" val="5"/>
                    <attstr name="surface" val="sand"/></section>
                  <section name="Track Segments"><section name="a">{STRAIGHT}</section>
@@ -727,6 +752,8 @@ mod tests {
         let [left, right] = at(50.0);
         assert_eq!((left.border_width, left.border.friction), (2.0, 0.4));
         assert_eq!(left.border.rolling_resistance, Some(0.05));
+        // A `curb` border is a raised kerb of its `height`; no border, no kerb.
+        assert_eq!((left.kerb_height, right.kerb_height), (0.1, 0.0));
         assert_eq!(left.side_width, 0.0);
         assert_eq!((right.side_width, right.side.friction), (5.0, 0.6));
         assert_eq!(right.border_width, 0.0);
@@ -740,7 +767,7 @@ mod tests {
         // Segment b: no border; a side narrowing from 4 m to 0 over its 11 steps, step 0 at
         // 4·(1 − 0.5/11).
         let [left, right] = at(104.0);
-        assert_eq!(left.border_width, 0.0);
+        assert_eq!((left.border_width, left.kerb_height), (0.0, 0.0));
 
         assert!(
             (left.side_width - 4.0 * (1.0 - 0.5 / 11.0)).abs() < 1e-9,
