@@ -588,9 +588,9 @@ impl Vehicle {
     /// Whether a wheel stands on a raised kerb ([`crate::track::Verge::kerb_height`], whose
     /// ramp cdbo's wheels do not climb), or would, moved `reserve` metres further out from the
     /// centre line, stand on slippery ground: a verge's border or side whose friction is below
-    /// `fraction`·μ_road (grass, sand, gravel; a flat kerb as grippy as the road is not). The
-    /// wheels stand where the simulator's step places them on their ground; a road without verges of its
-    /// own has none.
+    /// `fraction`·μ_road (grass, sand, gravel; a flat kerb as grippy as the road is not). Each
+    /// wheel stands where the step finds its ground (`wheel_ground`); a road without verges of
+    /// its own has none.
     pub fn wheel_near_slippery(&self, s: &State, f: &Frame, reserve: f64, fraction: f64) -> bool {
         if !f.has_verges {
             return false;
