@@ -44,13 +44,13 @@ impl Body {
     /// than its reach inside both.
     #[inline]
     pub fn touches_barrier(&self, s: &State, f: &Frame) -> bool {
-        self.within_of_barrier(s, f, 0.0)
+        self.near_barrier(s, f, 0.0)
     }
 
     /// Whether a corner of the body is within `reserve` metres of a barrier (0: touching it,
     /// [`Body::touches_barrier`]): l + r > b_left or −l + r > b_right.
     #[inline]
-    pub fn within_of_barrier(&self, s: &State, f: &Frame, reserve: f64) -> bool {
+    pub fn near_barrier(&self, s: &State, f: &Frame, reserve: f64) -> bool {
         let nearest = f.barriers[0].min(f.barriers[1]) - reserve;
         if !nearest.is_finite() {
             return false;
@@ -123,10 +123,10 @@ mod tests {
         assert!(body.touches_barrier(&car_at(8.0 - reach + 0.01, 0.2), f));
         // Within a reserve r of the wall: the same places, r nearer the centre line.
         for r in [0.5, 1.0] {
-            assert!(!body.within_of_barrier(&car_at(7.04 - r, 0.0), f, r));
-            assert!(body.within_of_barrier(&car_at(7.06 - r, 0.0), f, r));
-            assert!(!body.within_of_barrier(&car_at(8.0 - reach - r - 0.01, 0.2), f, r));
-            assert!(body.within_of_barrier(&car_at(8.0 - reach - r + 0.01, 0.2), f, r));
+            assert!(!body.near_barrier(&car_at(7.04 - r, 0.0), f, r));
+            assert!(body.near_barrier(&car_at(7.06 - r, 0.0), f, r));
+            assert!(!body.near_barrier(&car_at(8.0 - reach - r - 0.01, 0.2), f, r));
+            assert!(body.near_barrier(&car_at(8.0 - reach - r + 0.01, 0.2), f, r));
         }
     }
 

@@ -494,7 +494,7 @@ impl Simulator {
                         .wheel_near_slippery(&state, road, reserve, Reserve::SLIPPERY)
                 }) {
                 Some(super::FailureReason::OffTrack)
-            } else if body.within_of_barrier(&state, road, walls) {
+            } else if body.near_barrier(&state, road, walls) {
                 Some(super::FailureReason::HitWall)
             } else if facing_away(&state, road)
                 || (state.vx < state.vy.abs() * INV_TAN_SPIN_SLIP_ANGLE
