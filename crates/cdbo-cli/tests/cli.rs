@@ -302,6 +302,41 @@ fn a_panel_of_the_games_laps_scores_the_simulator_without_the_game() {
     );
 }
 
+/// `torcs transfer --against` refuses a bad reference before it looks for the game or drives a
+/// lap: one line naming the file, the row and the value, and no output folder.
+#[test]
+fn transfer_refuses_a_bad_reference_before_any_lap() {
+    let out = scratch("transfer-out", "");
+    std::fs::remove_file(&out).unwrap();
+    let bad = scratch(
+        "reference.json",
+        r#"{"transfers": [{"track": "forza", "best_reward_mps": 52.0},
+                          {"track": "aalborg", "best_reward_mps": -3.5}]}"#,
+    );
+    let args = |file: &Path| {
+        [
+            "torcs",
+            "transfer",
+            "--against",
+            file.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]
+        .map(str::to_owned)
+    };
+    let a = args(&bad);
+    let a: Vec<&str> = a.iter().map(String::as_str).collect();
+    fails_with(
+        &a,
+        &["reference.json", "transfers[1].best_reward_mps", "-3.5"],
+    );
+    let torn = scratch("torn.json", r#"{"transfers": [{"track": "forza""#);
+    let a = args(&torn);
+    let a: Vec<&str> = a.iter().map(String::as_str).collect();
+    fails_with(&a, &["torn.json", "EOF"]);
+    assert!(!out.exists());
+}
+
 /// The game's laps kept beside the fidelity report (docs/results/torcs/panel_TRACK.jsonl, 300
 /// policies a track drawn around three learned ones, driven in TORCS 1.3.7): cdbo's simulator
 /// keeps agreeing with them. A change to the model that loses fidelity fails here, without the

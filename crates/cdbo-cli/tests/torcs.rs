@@ -277,3 +277,83 @@ fn compare_writes_each_disagreement_as_a_policy_that_drives_again() {
     nothing_left(&cache);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `cdbo torcs transfer` learns on each track as `cdbo race` does (keeping its reserve of the
+/// road) and drives each best policy once in the game at the game's rule: the policy file it
+/// writes is that best (`cdbo lap --policy` drives it to the lap and reward the race found),
+/// the table's difference is the two laps', and the seed's summary counts them. A track the
+/// game does not have stops it before any lap, with nothing written.
+#[test]
+fn transfer_drives_each_learned_best_policy_in_the_game() {
+    let dir = fresh_dir("transfer");
+    let Some(cache) = game_cache(&dir) else {
+        return;
+    };
+    let out = dir.join("transfer");
+    let o = torcs_cmd(&cache)
+        .args(["torcs", "transfer", "--tracks", "g-track-1", "--laps", "30"])
+        .args(["--seeds", "2", "--json", "--out", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(report["learned_off_track_margin_m"], -1.0);
+    assert_eq!(report["learned_reserve"]["wheels_m"], 0.25);
+    assert_eq!(report["judged_off_track_margin_m"], 1.0);
+    let transfers = report["transfers"].as_array().unwrap();
+    assert_eq!(transfers.len(), 2);
+    for (t, seed) in transfers.iter().zip([0, 1]) {
+        assert_eq!(t["seed"], seed);
+        let ours = t["cdbo"]["lap_time_s"].as_f64().unwrap();
+        let o = torcs_cmd(&cache)
+            .args([
+                "lap",
+                "--track",
+                "g-track-1",
+                "--car",
+                "car1-trb1",
+                "--json",
+            ])
+            .arg("--policy")
+            .arg(t["policy"].as_str().unwrap())
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let lap: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        assert_eq!(lap["lap_time_s"].as_f64(), Some(ours), "{t}");
+        assert_eq!(lap["reward_mps"], t["best_reward_mps"], "{t}");
+        match t["torcs"]["lap_time_s"].as_f64() {
+            Some(theirs) => assert_eq!(
+                t["lap_time_difference"].as_f64(),
+                Some((theirs - ours) / ours)
+            ),
+            None => assert!(t["lap_time_difference"].is_null(), "{t}"),
+        }
+        let summary = &report["seeds"][seed];
+        assert_eq!(summary["tracks"], 1);
+        let completed = t["torcs"]["lap_time_s"].is_f64() as u64;
+        assert_eq!(summary["completed_torcs"].as_u64(), Some(completed));
+        assert_eq!(summary["mean_best_reward_mps"], t["best_reward_mps"]);
+    }
+    assert!(out.join("transfer.md").is_file());
+
+    let elsewhere = dir.join("unknown");
+    let o = torcs_cmd(&cache)
+        .args([
+            "torcs",
+            "transfer",
+            "--tracks",
+            "g-track-1,nowhere",
+            "--laps",
+            "30",
+        ])
+        .args(["--out", elsewhere.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("nowhere"), "{err}");
+    assert!(!elsewhere.exists(), "{err}");
+    nothing_left(&cache);
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -72,6 +72,10 @@ pub const EXPERIMENT_GRID: Bound = Bound::new("experiment grid file", MIB);
 /// ([`LAPS`](crate::sizes::LAPS)) of about 200 bytes and 1000 best weights are 2 MB.
 pub const RUN_RECORD: Bound = Bound::new("run record", 64 * MIB);
 
+/// A transfer report read as a reference (`cdbo torcs transfer --against`), 16 MiB: a row of
+/// about 600 bytes per track and seed, 38 tracks over 100 seeds, is 2.3 MB.
+pub const TRANSFER_REPORT: Bound = Bound::new("transfer report", 16 * MIB);
+
 /// An experiment's session log (`sessions.jsonl`), 64 MiB: a session is a line of 100 bytes.
 pub const SESSION_LOG: Bound = Bound::new("session log", 64 * MIB);
 

@@ -43,6 +43,10 @@ pub enum TorcsCommand {
     /// car's logged laps (--log); write the calibrated car (car.toml, for --car) and the
     /// agreement before and after, on the calibration and the check tracks.
     Calibrate(super::torcs_calibrate::CalibrateArgs),
+    /// Learn in cdbo's simulator, race in the game: on each track (default: every road track
+    /// installed) a policy learned as `cdbo race` learns it, its best driven once in the game,
+    /// beside its simulated lap.
+    Transfer(super::torcs_transfer::TransferArgs),
     /// Time every shipped TORCS robot that can drive the car: its standing first lap and its
     /// best (flying) lap of two, alone, from a clean start, headless — the table cdbo's
     /// learned laps are judged against — beside cdbo's QSS limit on the centre line.
@@ -83,6 +87,7 @@ pub fn run(cmd: &TorcsCommand, data: &cdbo::data_path::DataPath) -> CliResult {
         TorcsCommand::Compare(args) => super::torcs_compare::run(args, data),
         TorcsCommand::Panel(args) => super::torcs_panel::run(args, data),
         TorcsCommand::Calibrate(args) => super::torcs_calibrate::run(args, data),
+        TorcsCommand::Transfer(args) => super::torcs_transfer::run(args, data),
         TorcsCommand::Robots { track, car, json } => robots(track, car, *json),
         TorcsCommand::Setup { json } => {
             let install = Install::find()?;

@@ -96,15 +96,15 @@ struct Pair {
 
 /// The gist of a lap.
 #[derive(Debug, Serialize)]
-struct Lap {
-    lap_time_s: Option<f64>,
-    failure: Option<String>,
-    x_fail: Option<f64>,
-    distance_fail_m: Option<f64>,
+pub struct Lap {
+    pub lap_time_s: Option<f64>,
+    pub failure: Option<String>,
+    pub x_fail: Option<f64>,
+    pub distance_fail_m: Option<f64>,
 }
 
 impl Lap {
-    fn of(l: &LapResult) -> Lap {
+    pub fn of(l: &LapResult) -> Lap {
         Lap {
             lap_time_s: l.lap_time_s,
             failure: l.failure.map(|f| f.reason.name().to_owned()),
@@ -113,7 +113,7 @@ impl Lap {
         }
     }
 
-    fn cell(&self) -> String {
+    pub fn cell(&self) -> String {
         match (self.lap_time_s, &self.failure) {
             (Some(t), _) => format!("{t:.2} s"),
             (None, Some(f)) => format!(

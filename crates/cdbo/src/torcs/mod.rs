@@ -21,6 +21,7 @@ pub mod evaluator;
 pub mod lap;
 pub mod line;
 pub mod panel;
+pub mod transfer;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -128,6 +129,18 @@ impl Install {
             name: format!("{name:?}"),
             detail: format!("not in {} (there: {})", tracks.display(), names.join(", ")),
         })
+    }
+
+    /// The tracks of a category (`road`, `dirt`, `oval`), by name, sorted: the folders of
+    /// `tracks/CATEGORY` that hold their `NAME.xml`.
+    pub fn tracks(&self, category: &str) -> Vec<String> {
+        let dir = self.data_dir.join("tracks").join(category);
+        let mut names: Vec<String> = read_dir_names(&dir)
+            .into_iter()
+            .filter(|n| dir.join(n).join(format!("{n}.xml")).is_file())
+            .collect();
+        names.sort();
+        names
     }
 
     /// Checks that the game has a car of this name (`cars/NAME/NAME.xml`).
