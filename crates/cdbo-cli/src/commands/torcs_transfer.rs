@@ -7,6 +7,7 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -211,6 +212,18 @@ pub fn run(args: &TransferArgs, data: &DataPath) -> CliResult {
     let jobs: Vec<(usize, u64)> = (0..venues.len())
         .flat_map(|t| (args.seed..=last_seed).map(move |s| (t, s)))
         .collect();
+    // One bar: every race's laps in cdbo's simulator, then the games.
+    let bar = if args.json {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new((jobs.len() * (args.laps + 1)) as u64)
+    };
+    bar.set_style(
+        ProgressStyle::with_template("[{bar:30}] {msg} ({elapsed}, eta {eta})")?
+            .progress_chars("=> "),
+    );
+    let raced = std::sync::atomic::AtomicUsize::new(0);
+    bar.set_message(format!("races in cdbo 0/{}", jobs.len()));
     let races = pool.install(|| {
         jobs.par_iter()
             .map(|&(t, seed)| {
@@ -219,15 +232,25 @@ pub fn run(args: &TransferArgs, data: &DataPath) -> CliResult {
                     seed,
                     ..config.clone()
                 };
-                let outcome = race(learning, track, car, &config, |_| {})?;
-                eprintln!(
-                    "{name} seed {seed}: best {:.2} m/s in cdbo's simulator",
+                let outcome = race(learning, track, car, &config, |_| bar.inc(1))?;
+                let k = raced.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                bar.set_message(format!("races in cdbo {k}/{}", jobs.len()));
+                let line = format!(
+                    "{k}/{}: {name} seed {seed}: best {:.2} m/s in cdbo's simulator",
+                    jobs.len(),
                     outcome.best_reward_mps
                 );
+                // Without a terminal (a batch job's log) the bar is hidden: print plainly.
+                if bar.is_hidden() {
+                    eprintln!("{line}");
+                } else {
+                    bar.println(line);
+                }
                 Ok(outcome)
             })
             .collect::<Result<Vec<_>, cdbo::Error>>()
     })?;
+    bar.set_message(format!("game laps of {} best policies", jobs.len()));
     let start = std::time::Instant::now();
     let laps = pool.install(|| {
         jobs.par_iter()
@@ -240,10 +263,12 @@ pub fn run(args: &TransferArgs, data: &DataPath) -> CliResult {
                 };
                 let ours = on_line(learning).drive(&outcome.best)?;
                 let theirs = on_line(judging).drive(&outcome.best)?;
+                bar.inc(1);
                 Ok((ours, theirs))
             })
             .collect::<Result<Vec<_>, cdbo::Error>>()
     })?;
+    bar.finish_and_clear();
     let torcs_wall_s = start.elapsed().as_secs_f64();
 
     let mut transfers = Vec::with_capacity(jobs.len());
