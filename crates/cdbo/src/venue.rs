@@ -93,20 +93,22 @@ impl Venue {
         }
     }
 
+    /// The settings every lap here is driven with (its steering, line and failure rules).
+    pub fn config(&self) -> &LapConfig {
+        match self {
+            Venue::Simulator(sim) => &sim.config,
+            Venue::Game { request, .. } => &request.config,
+        }
+    }
+
     /// What this venue's laps keep in reserve of the road ([`LapConfig::reserve`]).
     pub fn reserve(&self) -> Option<Reserve> {
-        match self {
-            Venue::Simulator(sim) => sim.config.reserve,
-            Venue::Game { request, .. } => request.config.reserve,
-        }
+        self.config().reserve
     }
 
     /// Where this venue's laps fail: the car's centre this far past the road's edge (m).
     pub fn off_track_margin(&self) -> f64 {
-        match self {
-            Venue::Simulator(sim) => sim.config.off_track_margin,
-            Venue::Game { request, .. } => request.config.off_track_margin,
-        }
+        self.config().off_track_margin
     }
 
     /// This venue with its laps' settings changed by `change`.

@@ -222,10 +222,9 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     })?;
     bar.finish_and_clear();
     let wall_s = start.elapsed().as_secs_f64();
+    // The ceiling is driven as the race's laps were: its steering and failure rules.
     let mut ceiling_sim = cdbo::sim::Simulator::new(track.clone(), &car);
-    ceiling_sim.config.steering = args.steering.steering();
-    ceiling_sim.config.off_track_margin = venue.off_track_margin();
-    ceiling_sim.config.reserve = venue.reserve();
+    ceiling_sim.config = venue.config().clone();
     let profile = cdbo::ceiling::profile(&track, &car, None);
     let (_, ceiling_mps) = cdbo::ceiling::tracked_profile(&ceiling_sim, &profile)?;
     write_outputs(&out, &outcome, config.base_line, args.steering)?;
