@@ -57,6 +57,25 @@ fn nothing_left(cache: &Path) {
     );
 }
 
+/// `cdbo lap --policy FILE` on G-Track 1 with car1-trb1, in cdbo's simulator: its JSON report.
+fn g_track_1_lap(cache: &Path, file: &Path) -> serde_json::Value {
+    let o = torcs_cmd(cache)
+        .args([
+            "lap",
+            "--track",
+            "g-track-1",
+            "--car",
+            "car1-trb1",
+            "--json",
+        ])
+        .arg("--policy")
+        .arg(file)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    serde_json::from_slice(&o.stdout).unwrap()
+}
+
 /// The best rewards of the runs in an experiment folder, by run.
 fn bests(out: &Path) -> Vec<(String, f64, usize)> {
     let mut runs: Vec<_> = std::fs::read_dir(out.join("runs"))
@@ -239,21 +258,7 @@ fn compare_writes_each_disagreement_as_a_policy_that_drives_again() {
             "{}.json",
             d["what"].as_str().unwrap().replace(' ', "-")
         ));
-        let o = torcs_cmd(&cache)
-            .args([
-                "lap",
-                "--track",
-                "g-track-1",
-                "--car",
-                "car1-trb1",
-                "--json",
-            ])
-            .arg("--policy")
-            .arg(&file)
-            .output()
-            .unwrap();
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        let lap: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        let lap = g_track_1_lap(&cache, &file);
         assert_eq!(lap["lap_time_s"], d["cdbo"]["lap_time_s"], "{file:?}");
         assert_eq!(
             lap["failure"]["distance_m"], d["cdbo"]["distance_fail_m"],
@@ -305,21 +310,7 @@ fn transfer_drives_each_learned_best_policy_in_the_game() {
     for (t, seed) in transfers.iter().zip([0, 1]) {
         assert_eq!(t["seed"], seed);
         let ours = t["cdbo"]["lap_time_s"].as_f64().unwrap();
-        let o = torcs_cmd(&cache)
-            .args([
-                "lap",
-                "--track",
-                "g-track-1",
-                "--car",
-                "car1-trb1",
-                "--json",
-            ])
-            .arg("--policy")
-            .arg(t["policy"].as_str().unwrap())
-            .output()
-            .unwrap();
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        let lap: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        let lap = g_track_1_lap(&cache, Path::new(t["policy"].as_str().unwrap()));
         assert_eq!(lap["lap_time_s"].as_f64(), Some(ours), "{t}");
         assert_eq!(lap["reward_mps"], t["best_reward_mps"], "{t}");
         match t["torcs"]["lap_time_s"].as_f64() {
