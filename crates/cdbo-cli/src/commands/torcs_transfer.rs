@@ -177,9 +177,10 @@ pub fn run(args: &TransferArgs, data: &DataPath) -> CliResult {
         None => None,
     };
     let game = Game::ready()?;
-    let tracks = match args.tracks.is_empty() {
-        true => game.install.tracks("road"),
-        false => args.tracks.clone(),
+    let tracks = if args.tracks.is_empty() {
+        game.install.tracks("road")
+    } else {
+        args.tracks.clone()
     };
     // Every track and car is read before any lap is driven: a name the game does not have
     // stops here, with nothing written.
