@@ -234,6 +234,22 @@ pub fn run(args: &TransferArgs, data: &DataPath) -> CliResult {
                     ..config.clone()
                 };
                 let outcome = race(learning, track, car, &config, |_| bar.inc(1))?;
+                // Kept as soon as it is learned: a game that fails later loses no race.
+                let kept = RacedPolicy {
+                    policy: outcome.best.clone(),
+                    base_line,
+                    steering: args.steering,
+                };
+                let file = policy_file(&policies, name, seed);
+                let text =
+                    serde_json::to_string_pretty(&kept).map_err(|source| cdbo::Error::Json {
+                        what: file.display().to_string(),
+                        source,
+                    })?;
+                std::fs::write(&file, text).map_err(|source| cdbo::Error::Io {
+                    path: file.clone(),
+                    source,
+                })?;
                 let k = raced.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
                 bar.set_message(format!("races in cdbo {k}/{}", jobs.len()));
                 let line = format!(
@@ -275,13 +291,6 @@ pub fn run(args: &TransferArgs, data: &DataPath) -> CliResult {
     let mut transfers = Vec::with_capacity(jobs.len());
     for ((&(t, seed), outcome), (ours, theirs)) in jobs.iter().zip(&races).zip(&laps) {
         let name = &venues[t].0;
-        let file = policies.join(format!("{name}-s{seed}.json"));
-        let raced = RacedPolicy {
-            policy: outcome.best.clone(),
-            base_line,
-            steering: args.steering,
-        };
-        std::fs::write(&file, serde_json::to_string_pretty(&raced)?)?;
         transfers.push(Transfer {
             track: name.clone(),
             seed,
@@ -297,7 +306,7 @@ pub fn run(args: &TransferArgs, data: &DataPath) -> CliResult {
                 .as_ref()
                 .and_then(|r| r.get(name))
                 .map(|r| outcome.best_reward_mps / r),
-            policy: file.display().to_string(),
+            policy: policy_file(&policies, name, seed).display().to_string(),
         });
     }
     let (_, _, _, learning, judging) = &venues[0];
@@ -331,6 +340,11 @@ pub fn run(args: &TransferArgs, data: &DataPath) -> CliResult {
     }
     print!("{md}");
     Ok(())
+}
+
+/// Where the best policy of `track`'s race with `seed` is kept.
+fn policy_file(folder: &std::path::Path, track: &str, seed: u64) -> PathBuf {
+    folder.join(format!("{track}-s{seed}.json"))
 }
 
 fn summary(seed: u64, transfers: &[Transfer]) -> SeedSummary {
