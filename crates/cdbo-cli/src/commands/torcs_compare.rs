@@ -90,40 +90,8 @@ pub struct CompareArgs {
 #[derive(Debug, Serialize)]
 struct Pair {
     what: String,
-    cdbo: Lap,
-    torcs: Lap,
-}
-
-/// The gist of a lap.
-#[derive(Debug, Serialize)]
-pub struct Lap {
-    pub lap_time_s: Option<f64>,
-    pub failure: Option<String>,
-    pub x_fail: Option<f64>,
-    pub distance_fail_m: Option<f64>,
-}
-
-impl Lap {
-    pub fn of(l: &LapResult) -> Lap {
-        Lap {
-            lap_time_s: l.lap_time_s,
-            failure: l.failure.map(|f| f.reason.name().to_owned()),
-            x_fail: l.failure.map(|f| f.x),
-            distance_fail_m: l.failure.map(|f| f.distance_m),
-        }
-    }
-
-    pub fn cell(&self) -> String {
-        match (self.lap_time_s, &self.failure) {
-            (Some(t), _) => format!("{t:.2} s"),
-            (None, Some(f)) => format!(
-                "{f} at {:.0} m (x = {:.3})",
-                self.distance_fail_m.unwrap_or(0.0),
-                self.x_fail.unwrap_or(0.0)
-            ),
-            _ => "–".into(),
-        }
-    }
+    cdbo: Outcome,
+    torcs: Outcome,
 }
 
 /// Policies drawn around the learned ones, in both simulators.
@@ -192,7 +160,7 @@ pub fn run(args: &CompareArgs, data: &DataPath) -> CliResult {
             r.track,
             r.demos
                 .iter()
-                .map(|d| format!("{} {} / {}", d.what, d.cdbo.cell(), d.torcs.cell()))
+                .map(|d| format!("{} {} / {}", d.what, d.cdbo, d.torcs))
                 .collect::<Vec<_>>()
                 .join(", "),
             r.policies.agree,
@@ -235,14 +203,14 @@ fn compare_track(
     for &v in &args.demo {
         demos.push(Pair {
             what: format!("{v} m/s"),
-            cdbo: Lap::of(&sim.lap(&mut SpeedHold::new(v))),
-            torcs: Lap::of(&in_game(GamePedal::Demo(v), false)?),
+            cdbo: Outcome::of(&sim.lap(&mut SpeedHold::new(v))),
+            torcs: Outcome::of(&in_game(GamePedal::Demo(v), false)?),
         });
     }
     let full_throttle = Pair {
         what: "full throttle".into(),
-        cdbo: Lap::of(&sim.lap(&mut ConstantPedal(1.0))),
-        torcs: Lap::of(&in_game(GamePedal::Constant(1.0), false)?),
+        cdbo: Outcome::of(&sim.lap(&mut ConstantPedal(1.0))),
+        torcs: Outcome::of(&in_game(GamePedal::Constant(1.0), false)?),
     };
 
     // Policies learned in cdbo's simulator, one a seed, then policies drawn around each,
@@ -331,8 +299,8 @@ fn compare_track(
             .iter()
             .map(|&i| Pair {
                 what: drawn[i].0.clone(),
-                cdbo: Lap::of(&ours[i]),
-                torcs: Lap::of(&theirs[i]),
+                cdbo: Outcome::of(&ours[i]),
+                torcs: Outcome::of(&theirs[i]),
             })
             .collect(),
     };
@@ -382,8 +350,8 @@ fn compare_track(
         full_throttle,
         learned: Pair {
             what: "learned".into(),
-            cdbo: Lap::of(&ours_best),
-            torcs: Lap::of(&theirs_best),
+            cdbo: Outcome::of(&ours_best),
+            torcs: Outcome::of(&theirs_best),
         },
         policies,
         limit_lap_time_s: learned.limit.lap_time_s,
@@ -415,8 +383,8 @@ fn markdown(reports: &[TrackReport], args: &CompareArgs) -> String {
                 "| {} | {} | {} | {} | {} |",
                 r.track,
                 d.what,
-                d.cdbo.cell(),
-                d.torcs.cell(),
+                d.cdbo,
+                d.torcs,
                 pct(d.torcs.lap_time_s, d.cdbo.lap_time_s)
             );
         }
@@ -429,9 +397,7 @@ fn markdown(reports: &[TrackReport], args: &CompareArgs) -> String {
         let _ = writeln!(
             s,
             "| {} | {} | {} |",
-            r.track,
-            r.full_throttle.cdbo.cell(),
-            r.full_throttle.torcs.cell()
+            r.track, r.full_throttle.cdbo, r.full_throttle.torcs
         );
     }
     let _ = writeln!(
@@ -464,8 +430,8 @@ fn markdown(reports: &[TrackReport], args: &CompareArgs) -> String {
             s,
             "| {} | {} | {} | {} / {} | {} / {} ({}) | {} | {} / {} | {} | {:.1} s |",
             r.track,
-            r.learned.cdbo.cell(),
-            r.learned.torcs.cell(),
+            r.learned.cdbo,
+            r.learned.torcs,
             p.completed_cdbo,
             p.completed_torcs,
             p.agree,
@@ -517,7 +483,7 @@ fn markdown(reports: &[TrackReport], args: &CompareArgs) -> String {
 
 /// The failed laps among `laps`, grouped by reason and place (to 10 m), most frequent first:
 /// "hit_wall at 5210 m (4), stalled at 2710 m (1)", or "–" when none failed.
-fn failure_places<'a>(laps: impl Iterator<Item = &'a Lap>) -> String {
+fn failure_places<'a>(laps: impl Iterator<Item = &'a Outcome>) -> String {
     let mut counts: std::collections::BTreeMap<(String, i64), usize> = Default::default();
     for lap in laps {
         if let (Some(reason), Some(at)) = (&lap.failure, lap.distance_fail_m) {
@@ -548,13 +514,13 @@ fn percent(fraction: Option<f64>) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::{Lap, percent};
+    use super::{Outcome, percent};
 
     /// Failures grouped by reason and place to 10 m, the most frequent first; completed laps
     /// are not counted.
     #[test]
     fn failures_are_grouped_by_reason_and_place() {
-        let lap = |failure: Option<(&str, f64)>| Lap {
+        let lap = |failure: Option<(&str, f64)>| Outcome {
             lap_time_s: failure.is_none().then_some(100.0),
             failure: failure.map(|(r, _)| r.to_owned()),
             x_fail: failure.map(|(_, d)| d / 5000.0),

@@ -12,13 +12,15 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::CliResult;
-use super::torcs_compare::Lap;
+use cdbo::car::Car;
 use cdbo::data_path::DataPath;
 use cdbo::drive::steering::SteeringLaw;
 use cdbo::experiment::line::{BaseLine, RacedPolicy};
 use cdbo::experiment::race::{RaceConfig, race};
 use cdbo::method::Method;
 use cdbo::torcs::Game;
+use cdbo::torcs::panel::Outcome;
+use cdbo::track::Track;
 use cdbo::venue::Venue;
 
 #[derive(Debug, Args)]
@@ -77,6 +79,16 @@ pub struct TransferArgs {
     json: bool,
 }
 
+/// One track's venues: its races learn in `learning` (cdbo's simulator, `car` on `track`),
+/// and the game judges their best policies in `judging`.
+struct TrackVenues {
+    name: String,
+    track: Track,
+    car: Car,
+    learning: Venue,
+    judging: Venue,
+}
+
 /// One track and seed: the best policy's lap in both simulators.
 #[derive(Debug, Serialize)]
 struct Transfer {
@@ -87,9 +99,9 @@ struct Transfer {
     /// The race's failed laps in cdbo's simulator.
     failed_laps: usize,
     /// The best policy's lap in cdbo's simulator, at the rule it learned with.
-    cdbo: Lap,
+    cdbo: Outcome,
     /// The same policy's lap in the game, at the game's rule.
-    torcs: Lap,
+    torcs: Outcome,
     /// (game − cdbo) / cdbo lap time, where both complete.
     lap_time_difference: Option<f64>,
     /// The best reward as a share of the reference's on this track (`--against`).
@@ -201,7 +213,13 @@ pub fn run(args: &TransferArgs, data: &DataPath) -> CliResult {
             .steered(steering.clone())
             .for_learning(args.off_track_margin);
         let judging = in_game.steered(steering).for_learning(None);
-        venues.push((name.clone(), track, car, learning, judging));
+        venues.push(TrackVenues {
+            name: name.clone(),
+            track,
+            car,
+            learning,
+            judging,
+        });
     }
     let policies = args.out.join("policies");
     std::fs::create_dir_all(&policies).map_err(|e| format!("{}: {e}", policies.display()))?;
@@ -228,7 +246,13 @@ pub fn run(args: &TransferArgs, data: &DataPath) -> CliResult {
     let races = pool.install(|| {
         jobs.par_iter()
             .map(|&(t, seed)| {
-                let (name, track, car, learning, _) = &venues[t];
+                let TrackVenues {
+                    name,
+                    track,
+                    car,
+                    learning,
+                    ..
+                } = &venues[t];
                 let config = RaceConfig {
                     seed,
                     ..config.clone()
@@ -273,7 +297,9 @@ pub fn run(args: &TransferArgs, data: &DataPath) -> CliResult {
         jobs.par_iter()
             .zip(&races)
             .map(|(&(t, _), outcome)| {
-                let (_, _, _, learning, judging) = &venues[t];
+                let TrackVenues {
+                    learning, judging, ..
+                } = &venues[t];
                 let on_line = |v: &Venue| match &outcome.line {
                     Some(line) => v.clone().on_line(line.clone()),
                     None => v.clone(),
@@ -290,14 +316,14 @@ pub fn run(args: &TransferArgs, data: &DataPath) -> CliResult {
 
     let mut transfers = Vec::with_capacity(jobs.len());
     for ((&(t, seed), outcome), (ours, theirs)) in jobs.iter().zip(&races).zip(&laps) {
-        let name = &venues[t].0;
+        let name = &venues[t].name;
         transfers.push(Transfer {
             track: name.clone(),
             seed,
             best_reward_mps: outcome.best_reward_mps,
             failed_laps: outcome.laps.iter().filter(|l| l.failure.is_some()).count(),
-            cdbo: Lap::of(ours),
-            torcs: Lap::of(theirs),
+            cdbo: Outcome::of(ours),
+            torcs: Outcome::of(theirs),
             lap_time_difference: ours
                 .lap_time_s
                 .zip(theirs.lap_time_s)
@@ -309,7 +335,9 @@ pub fn run(args: &TransferArgs, data: &DataPath) -> CliResult {
             policy: policy_file(&policies, name, seed).display().to_string(),
         });
     }
-    let (_, _, _, learning, judging) = &venues[0];
+    let TrackVenues {
+        learning, judging, ..
+    } = &venues[0];
     let report = Report {
         car: args.car.clone(),
         sim_car: args.sim_car.clone(),
@@ -413,9 +441,9 @@ fn markdown(r: &Report) -> String {
             "| {} | {} | {} | {} | {} | {} |",
             t.track,
             t.seed,
-            t.cdbo.cell(),
+            t.cdbo,
             t.failed_laps,
-            t.torcs.cell(),
+            t.torcs,
             t.lap_time_difference
                 .map_or("–".into(), |d| format!("{:+.2} %", 100.0 * d))
         );

@@ -4,9 +4,12 @@
 //! seconds, paired, policy by policy.
 //!
 //! One JSON object a line: `{"track": T, "what": W, "policy": P, "torcs": {"lap_time_s": t,
-//! "failure": f, "distance_fail_m": d}}`, P a policy file's object ([`Policy`]), t the lap
-//! time of a completed lap (else null), f the failure's name and d where it happened (else
-//! null). Blank lines are skipped; anything else is refused with its file and line.
+//! "failure": f, "x_fail": x, "distance_fail_m": d}}`, P a policy file's object ([`Policy`]),
+//! t the lap time of a completed lap (else null), f the failure's name, x and d where it
+//! happened (else null; x may be left out, as panels written before it were). Blank lines are
+//! skipped; anything else is refused with its file and line.
+
+use std::fmt;
 
 use serde::{Deserialize, Serialize};
 
@@ -14,13 +17,18 @@ use crate::error::{Error, Result};
 use crate::policy::Policy;
 use crate::sim::{FailureReason, LapResult};
 
-/// How a simulator drove one lap, in brief.
+/// How a simulator drove one lap, in brief: what `cdbo torcs compare`, `panel` and
+/// `transfer` keep of each lap, and print as a table's cell ("112.34 s", "off_track at 2,602 m
+/// (x = 0.423)").
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Outcome {
     /// The lap time of a completed lap (s).
     pub lap_time_s: Option<f64>,
     /// Why a failed lap failed ([`FailureReason::name`]).
     pub failure: Option<String>,
+    /// Where it failed, as a fraction of the lap.
+    #[serde(default)]
+    pub x_fail: Option<f64>,
     /// Where it failed (m from the start line).
     pub distance_fail_m: Option<f64>,
 }
@@ -31,6 +39,7 @@ impl Outcome {
         Outcome {
             lap_time_s: lap.lap_time_s,
             failure: lap.failure.map(|f| f.reason.name().to_owned()),
+            x_fail: lap.failure.map(|f| f.x),
             distance_fail_m: lap.failure.map(|f| f.distance_m),
         }
     }
@@ -38,6 +47,27 @@ impl Outcome {
     /// Whether the lap was completed.
     pub fn completed(&self) -> bool {
         self.lap_time_s.is_some()
+    }
+}
+
+impl fmt::Display for Outcome {
+    /// The lap time, where the lap failed, or "–" where neither is known.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match (self.lap_time_s, &self.failure) {
+            (Some(t), _) => write!(f, "{t:.2} s"),
+            (None, Some(reason)) => {
+                write!(
+                    f,
+                    "{reason} at {:.0} m",
+                    self.distance_fail_m.unwrap_or(0.0)
+                )?;
+                match self.x_fail {
+                    Some(x) => write!(f, " (x = {x:.3})"),
+                    None => Ok(()),
+                }
+            }
+            (None, None) => f.write_str("–"),
+        }
     }
 }
 
@@ -161,6 +191,7 @@ mod tests {
         Outcome {
             lap_time_s: Some(t),
             failure: None,
+            x_fail: None,
             distance_fail_m: None,
         }
     }
@@ -169,8 +200,28 @@ mod tests {
         Outcome {
             lap_time_s: None,
             failure: Some("off_track".into()),
+            x_fail: Some(at / 5000.0),
             distance_fail_m: Some(at),
         }
+    }
+
+    /// A table's cell: the lap time, or the failure with its place (x where it is known, as
+    /// it is not in panels written before it was kept), or a dash.
+    #[test]
+    fn an_outcome_reads_as_a_cell() {
+        assert_eq!(completed(112.346).to_string(), "112.35 s");
+        assert_eq!(
+            failed(2602.0).to_string(),
+            "off_track at 2602 m (x = 0.520)"
+        );
+        let older = r#"{"lap_time_s": null, "failure": "hit_wall", "distance_fail_m": 12.4}"#;
+        let older: Outcome = serde_json::from_str(older).unwrap();
+        assert_eq!(older.to_string(), "hit_wall at 12 m");
+        let unknown = Outcome {
+            failure: None,
+            ..older
+        };
+        assert_eq!(unknown.to_string(), "–");
     }
 
     #[test]
