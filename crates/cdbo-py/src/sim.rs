@@ -16,6 +16,7 @@ use cdbo::policy::{Policy, RkhsPolicy};
 use cdbo::sim::lap::checked_off_track_margin;
 use cdbo::sim::{LapResult, Simulator};
 use cdbo::track::Track;
+use cdbo::venue::Venue;
 
 use crate::convert::{Array, Column, IntoPy, array, columns, data_path, vector};
 
@@ -386,9 +387,10 @@ impl PyLapResult {
 /// the minimum-curvature racing line (as `cdbo race --line min-curvature`), the demonstration's
 /// included; `steering="tracker"` steers with the path tracker (as `--steering tracker`);
 /// `off_track_margin` is where a lap leaves the road (m past its edge, as
-/// `--off-track-margin`; 1, the game's rule); `reserve=True` keeps the reserve `cdbo race`
-/// learns with as well (the wheels 0.25 m off slippery ground, the body 1 m off the walls, the
-/// car's centre on the road; `off_track_margin` only where the road's verges are not known).
+/// `--off-track-margin`; 1, the game's rule); None keeps the reserve `cdbo race` learns with,
+/// as `race` and `RaceEnv` do by default (the wheels 0.25 m off slippery ground, the body 1 m
+/// off the walls, the car's centre on the road; `LEARNING_OFF_TRACK_MARGIN` where the road's
+/// verges are not known).
 #[pyclass(name = "Simulator", module = "cdbo", frozen)]
 pub struct PySimulator {
     pub sim: Simulator,
@@ -399,8 +401,7 @@ pub struct PySimulator {
 #[pymethods]
 impl PySimulator {
     #[new]
-    #[pyo3(signature = (track = None, car = None, *, data_dir = None, line = "centre", steering = "pi", off_track_margin = 1.0, reserve = false))]
-    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (track = None, car = None, *, data_dir = None, line = "centre", steering = "pi", off_track_margin = Some(1.0)))]
     fn new(
         py: Python<'_>,
         track: Option<&Bound<'_, PyAny>>,
@@ -408,21 +409,25 @@ impl PySimulator {
         data_dir: Option<&Bound<'_, PyAny>>,
         line: &str,
         steering: &str,
-        off_track_margin: f64,
-        reserve: bool,
+        off_track_margin: Option<f64>,
     ) -> PyResult<Self> {
         let track = track_from(py, track, data_dir)?;
         let car = car_from(car, data_dir)?;
         let base: BaseLine = line.parse().py()?;
         let steering: SteeringLaw = steering.parse().py()?;
-        let off_track_margin = checked_off_track_margin(off_track_margin).py()?;
+        let off_track_margin = off_track_margin
+            .map(checked_off_track_margin)
+            .transpose()
+            .py()?;
         let held = py.detach(|| base.line(&track, &car)).py()?;
-        let mut sim = Simulator::new(track, &car);
+        let venue = Venue::simulator(track, &car)
+            .steered(steering.steering())
+            .for_learning(off_track_margin);
+        let Venue::Simulator(mut sim) = venue else {
+            unreachable!("cdbo's simulator stays itself once configured")
+        };
         sim.config.line = held;
-        sim.config.steering = steering.steering();
-        sim.config.off_track_margin = off_track_margin;
-        sim.config.reserve = reserve.then_some(cdbo::sim::lap::Reserve::LEARNING);
-        Ok(PySimulator { sim, base })
+        Ok(PySimulator { sim: *sim, base })
     }
 
     /// One lap with `policy`; `line`, a second `Policy`, is a learned line d(x): its raw sum

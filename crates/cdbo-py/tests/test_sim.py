@@ -62,6 +62,20 @@ def test_the_policy_is_the_papers_kernel_sum():
     assert np.allclose(fit.weights, w, atol=1e-5)
 
 
+def test_no_margin_keeps_the_reserve_a_race_learns_with():
+    """`off_track_margin=None` is the reserve `cdbo.race` and `RaceEnv` learn with: on
+    Ridgeway, whose verges are not known, the car's centre kept a metre inside the road, so a
+    lap that runs wide fails there, before the game's rule (a metre outside) would end it."""
+    pedal = cdbo.Policy(np.full(20, 0.4))
+    kept = cdbo.Simulator(off_track_margin=None).lap(pedal)
+    game = cdbo.Simulator().lap(pedal)
+    assert kept.failure == game.failure == "off_track"
+    assert kept.x_fail < game.x_fail
+    assert cdbo.RaceEnv(kernels=20).simulator.lap(pedal).x_fail == kept.x_fail
+    with pytest.raises(ValueError, match="off-track margin"):
+        cdbo.Simulator(off_track_margin=math.nan)
+
+
 def test_bad_input_raises_with_the_librarys_message(tmp_path):
     with pytest.raises(ValueError, match='unknown track "nowhere"'):
         cdbo.Track.load("nowhere")

@@ -12,7 +12,6 @@ import numpy as np
 
 from ._cdbo import (
     DEFAULT_BOX_RADIUS,
-    LEARNING_OFF_TRACK_MARGIN,
     Optimizer,
     Policy,
     Simulator,
@@ -105,10 +104,7 @@ class RaceEnv(_Base):
             data_dir=data_dir,
             line=self.base_line,
             steering=steering,
-            off_track_margin=(
-                LEARNING_OFF_TRACK_MARGIN if off_track_margin is None else off_track_margin
-            ),
-            reserve=off_track_margin is None,
+            off_track_margin=off_track_margin,
         )
         demo, x, a = self.simulator.demonstrate(demo_speed)
         if not demo.completed:
