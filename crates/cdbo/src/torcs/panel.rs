@@ -18,7 +18,7 @@ use crate::policy::Policy;
 use crate::sim::{FailureReason, LapResult};
 
 /// How a simulator drove one lap, in brief: what `cdbo torcs compare`, `panel` and
-/// `transfer` keep of each lap, and print as a table's cell ("112.34 s", "off_track at 2,602 m
+/// `transfer` keep of each lap, and print as a table's cell ("112.34 s", "off_track at 2602 m
 /// (x = 0.423)").
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Outcome {
