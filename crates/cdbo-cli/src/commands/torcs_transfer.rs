@@ -194,6 +194,13 @@ pub fn run(args: &TransferArgs, data: &DataPath) -> CliResult {
     } else {
         args.tracks.clone()
     };
+    if tracks.is_empty() {
+        return Err(format!(
+            "no road tracks in the game's {}: name them with --tracks",
+            game.install.data_dir.join("tracks/road").display()
+        )
+        .into());
+    }
     // Every track and car is read before any lap is driven: a name the game does not have
     // stops here, with nothing written.
     game.install.check_car(&args.car)?;
