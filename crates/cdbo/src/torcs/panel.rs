@@ -5,9 +5,9 @@
 //!
 //! One JSON object a line: `{"track": T, "what": W, "policy": P, "torcs": {"lap_time_s": t,
 //! "failure": f, "x_fail": x, "distance_fail_m": d}}`, P a policy file's object ([`Policy`]),
-//! t the lap time of a completed lap (else null), f the failure's name, x and d where it
-//! happened (else null; x may be left out, as panels written before it were). Blank lines are
-//! skipped; anything else is refused with its file and line.
+//! t the lap time of a completed lap (else null), f the failure's name, x (a fraction of the
+//! lap) and d where it happened (else null; x may be left out, as panels written before it
+//! were). Blank lines are skipped; anything else is refused with its file and line.
 
 use std::fmt;
 
@@ -107,16 +107,17 @@ pub fn parse(text: &str, file: &str) -> Result<Vec<PanelLap>> {
             .map_err(|e| at(e.to_string()))?;
         let t = &lap.torcs;
         let sound = match (t.lap_time_s, &t.failure) {
-            (Some(s), None) => s.is_finite() && s > 0.0,
+            (Some(s), None) => s.is_finite() && s > 0.0 && t.x_fail.is_none(),
             (None, Some(f)) => {
                 FailureReason::from_name(f).is_some()
                     && t.distance_fail_m.is_some_and(f64::is_finite)
+                    && t.x_fail.is_none_or(|x| (0.0..=1.0).contains(&x))
             }
             _ => false,
         };
         if !sound {
             return Err(at(
-                "the game's lap needs either a positive lap_time_s, or a known failure and a finite distance_fail_m"
+                "the game's lap needs either a positive lap_time_s, or a known failure, a finite distance_fail_m and x_fail, if given, within [0, 1]"
                     .into(),
             ));
         }
@@ -264,5 +265,11 @@ mod tests {
         }))
         .unwrap();
         assert!(bad(&unknown).contains("known failure"));
+        let past_the_lap = line(&lap(Outcome {
+            x_fail: Some(1.5),
+            ..failed(1.0)
+        }))
+        .unwrap();
+        assert!(bad(&past_the_lap).contains("x_fail, if given, within [0, 1]"));
     }
 }
