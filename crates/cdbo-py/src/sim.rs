@@ -16,7 +16,6 @@ use cdbo::policy::{Policy, RkhsPolicy};
 use cdbo::sim::lap::checked_off_track_margin;
 use cdbo::sim::{LapResult, Simulator};
 use cdbo::track::Track;
-use cdbo::venue::Venue;
 
 use crate::convert::{Array, Column, IntoPy, array, columns, data_path, vector};
 
@@ -420,14 +419,11 @@ impl PySimulator {
             .transpose()
             .py()?;
         let held = py.detach(|| base.line(&track, &car)).py()?;
-        let venue = Venue::simulator(track, &car)
-            .steered(steering.steering())
-            .for_learning(off_track_margin);
-        let Venue::Simulator(mut sim) = venue else {
-            unreachable!("cdbo's simulator stays itself once configured")
-        };
+        let mut sim = Simulator::new(track, &car);
+        sim.config.steering = steering.steering();
+        sim.config.learn_with(off_track_margin);
         sim.config.line = held;
-        Ok(PySimulator { sim: *sim, base })
+        Ok(PySimulator { sim, base })
     }
 
     /// One lap with `policy`; `line`, a second `Policy`, is a learned line d(x): its raw sum

@@ -13,7 +13,7 @@ use crate::evaluator::Evaluator;
 use crate::evaluator::simulator::SimEvaluator;
 use crate::line::RacingLine;
 use crate::policy::{Policy, PolicyShape};
-use crate::sim::lap::{GAME_OFF_TRACK_MARGIN, LEARNING_OFF_TRACK_MARGIN, Reserve};
+use crate::sim::lap::{GAME_OFF_TRACK_MARGIN, Reserve};
 use crate::sim::{LapConfig, LapResult, Simulator};
 use crate::torcs::evaluator::{TorcsEvaluator, drive, with_pedal, with_policy};
 use crate::torcs::{Game, GamePedal, LapRequest};
@@ -71,25 +71,17 @@ impl Venue {
     /// edge ([`LapConfig::off_track_margin`]; negative: inside the road), and at the barriers,
     /// nothing kept in reserve, in the simulator and the game alike.
     pub fn off_track_at(self, margin: f64) -> Venue {
-        self.configured(|config| {
-            config.off_track_margin = margin;
-            config.reserve = None;
-        })
+        self.configured(|config| config.fail_at(margin))
     }
 
-    /// This venue as a policy learns in it: its laps failing `margin` metres past the road's
-    /// edge if given; else, in cdbo's simulator, keeping [`Reserve::LEARNING`] (a reserve the
-    /// world the policy is then driven in will not take away; [`LEARNING_OFF_TRACK_MARGIN`]
-    /// where the road's verges are not known), and at the game's own rule,
-    /// [`GAME_OFF_TRACK_MARGIN`], in the game.
+    /// This venue as a policy learns in it: in cdbo's simulator, its laps failing `margin`
+    /// metres past the road's edge if given, else keeping a reserve of the road
+    /// ([`LapConfig::learn_with`]); in the game, failing at `margin` if given, else at the
+    /// game's own rule, [`GAME_OFF_TRACK_MARGIN`].
     pub fn for_learning(self, margin: Option<f64>) -> Venue {
-        match (margin, &self) {
-            (Some(margin), _) => self.off_track_at(margin),
-            (None, Venue::Simulator(_)) => self.configured(|config| {
-                config.off_track_margin = LEARNING_OFF_TRACK_MARGIN;
-                config.reserve = Some(Reserve::LEARNING);
-            }),
-            (None, Venue::Game { .. }) => self.off_track_at(GAME_OFF_TRACK_MARGIN),
+        match &self {
+            Venue::Simulator(_) => self.configured(|config| config.learn_with(margin)),
+            Venue::Game { .. } => self.off_track_at(margin.unwrap_or(GAME_OFF_TRACK_MARGIN)),
         }
     }
 

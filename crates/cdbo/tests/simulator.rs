@@ -115,25 +115,29 @@ fn a_barrier_ends_the_lap_where_the_body_reaches_it() {
     );
 }
 
-/// The learning reserve ([`Reserve::LEARNING`]) on a bend whose verges are grass: full throttle
-/// runs the car wide, and the lap fails where its outer wheel first comes within 0.25 m of the
-/// grass, before the road's edge and the game's rule; where the grass is a wide run-off of
-/// asphalt it fails where the car's centre leaves the road; on a road that gives no verges it
-/// is the lap at [`LapConfig::off_track_margin`] to the bit.
+/// The learning reserve ([`Reserve::LEARNING`], a lap configured with
+/// [`LapConfig::learn_with`]`(None)`) on a bend whose verges are grass: full throttle runs the
+/// car wide, and the lap fails where its outer wheel first comes within 0.25 m of the grass,
+/// before the road's edge and the game's rule; where the grass is a wide run-off of asphalt it
+/// fails where the car's centre leaves the road; on a road that gives no verges it is the lap
+/// failing at [`LEARNING_OFF_TRACK_MARGIN`] to the bit.
 #[test]
 fn the_learning_reserve_keeps_the_wheels_off_the_grass() {
     use cdbo::sim::lap::{LEARNING_OFF_TRACK_MARGIN, Reserve};
     use cdbo::track::{Surface, Verge};
     let car = Car::spirit_300();
     let wheel = car.axles.half_track[0].max(car.axles.half_track[1]);
-    let bend = |side: Option<Surface>, reserve: Option<Reserve>, margin: f64| {
+    let bend = |side: Option<Surface>, margin: Option<f64>| {
         let mut sim = bend(side.map_or(Verge::NONE, |side| Verge {
             side_width: 20.0,
             side,
             ..Verge::NONE
         }));
-        sim.config.reserve = reserve;
-        sim.config.off_track_margin = margin;
+        sim.config.learn_with(margin);
+        if margin.is_none() {
+            assert_eq!(sim.config.reserve, Some(Reserve::LEARNING));
+            assert_eq!(sim.config.off_track_margin, LEARNING_OFF_TRACK_MARGIN);
+        }
         sim.lap(&mut ConstantPedal(1.0))
     };
     let grass = Surface {
@@ -141,10 +145,9 @@ fn the_learning_reserve_keeps_the_wheels_off_the_grass() {
         ..Surface::PLAIN
     };
     let asphalt = Surface::PLAIN;
-    let learning = Some(Reserve::LEARNING);
-    let kept = bend(Some(grass), learning, LEARNING_OFF_TRACK_MARGIN);
-    let rule = bend(Some(grass), None, 1.0);
-    let run_off = bend(Some(asphalt), learning, LEARNING_OFF_TRACK_MARGIN);
+    let kept = bend(Some(grass), None);
+    let rule = bend(Some(grass), Some(1.0));
+    let run_off = bend(Some(asphalt), None);
     let [kept_at, rule_at, run_off_at] =
         [&kept, &rule, &run_off].map(|lap| lap.failure.expect("full throttle fails the bend"));
     assert_eq!(kept_at.reason, FailureReason::OffTrack, "{kept_at:?}");
@@ -164,8 +167,8 @@ fn the_learning_reserve_keeps_the_wheels_off_the_grass() {
     let edge = run_off.trace.last().unwrap().lateral.abs();
     assert!((4.5..5.0).contains(&edge), "{edge}");
     // Without verges: the centre a metre inside the edge, the same lap as without the reserve.
-    let bare = bend(None, learning, LEARNING_OFF_TRACK_MARGIN);
-    let metre = bend(None, None, LEARNING_OFF_TRACK_MARGIN);
+    let bare = bend(None, None);
+    let metre = bend(None, Some(LEARNING_OFF_TRACK_MARGIN));
     assert_eq!(bare.failure, metre.failure);
     assert_eq!(bare.simulated_s, metre.simulated_s);
 }

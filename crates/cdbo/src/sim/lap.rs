@@ -266,6 +266,29 @@ impl Default for LapConfig {
     }
 }
 
+impl LapConfig {
+    /// Laps failing once the car's centre is `margin` metres past the road's edge (negative:
+    /// inside the road), and at the barriers, nothing kept in reserve.
+    pub fn fail_at(&mut self, margin: f64) {
+        self.off_track_margin = margin;
+        self.reserve = None;
+    }
+
+    /// Laps as a policy learns them in cdbo's simulator: failing `margin` metres past the
+    /// road's edge if given ([`LapConfig::fail_at`]); else keeping [`Reserve::LEARNING`] (a
+    /// reserve the world the policy is then driven in will not take away), with
+    /// [`LEARNING_OFF_TRACK_MARGIN`] where the road's verges are not known.
+    pub fn learn_with(&mut self, margin: Option<f64>) {
+        match margin {
+            Some(margin) => self.fail_at(margin),
+            None => {
+                self.off_track_margin = LEARNING_OFF_TRACK_MARGIN;
+                self.reserve = Some(Reserve::LEARNING);
+            }
+        }
+    }
+}
+
 /// 1 / tan(60°): a body slip angle above 60° means vₓ < |v_y| / tan 60°.
 const INV_TAN_SPIN_SLIP_ANGLE: f64 = 0.577_350_269_189_625_8;
 const SPIN_MIN_SPEED: f64 = 3.0;
