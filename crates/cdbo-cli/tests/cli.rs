@@ -813,6 +813,37 @@ fn a_short_race_writes_its_results() {
     let _ = std::fs::remove_dir_all(&out);
 }
 
+/// A race's line says by which rule its laps failed, as it applies on the track: the reserve
+/// where the track gives its road's verges (Forza), the car's centre a metre inside the edge
+/// where it does not (the built-in Ridgeway: no grass or walls to keep off), the game's rule
+/// when told.
+#[test]
+fn a_race_says_by_which_rule_its_laps_failed() {
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("cdbo-cli-race-rule-{}", std::process::id()));
+    let dir = out.to_str().unwrap();
+    let race = |extra: &[&str]| {
+        let mut args = vec!["race", "--laps", "2", "--kernels", "10", "--out", dir];
+        args.extend_from_slice(extra);
+        String::from_utf8(succeed(&args).stdout).unwrap()
+    };
+    let reserve =
+        "laps failed keeping the wheels 0.25 m off slippery ground and the body 1 m off the walls";
+    let forza = race(&["--data-dir", shared().to_str().unwrap(), "--track", "forza"]);
+    assert!(forza.contains(reserve), "{forza}");
+    let ridgeway = race(&[]);
+    assert!(
+        ridgeway.contains("laps failed at 1 m inside the road's edge"),
+        "{ridgeway}"
+    );
+    let game = race(&["--off-track-margin", "1"]);
+    assert!(
+        game.contains("laps failed at 1 m past the road's edge, the game's rule"),
+        "{game}"
+    );
+    let _ = std::fs::remove_dir_all(&out);
+}
+
 #[test]
 fn a_cdbo_race_points_to_the_learner_beyond_the_paper() {
     let out = Path::new(env!("CARGO_TARGET_TMPDIR"))

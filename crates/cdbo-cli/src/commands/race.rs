@@ -309,7 +309,11 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         summary.best_reward_mps / summary.demo_reward_mps,
         summary.demo_reward_mps,
         summary.failed_laps,
-        super::edge_words(summary.off_track_margin_m, summary.reserve)
+        super::edge_words(
+            summary.off_track_margin_m,
+            summary.reserve,
+            track.has_verges()
+        )
     );
     if let Some(file) = &summary.warm_start {
         println!(

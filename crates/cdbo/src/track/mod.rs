@@ -473,6 +473,14 @@ impl Track {
         &self.samples[if i < n { i } else { i % n }]
     }
 
+    /// Whether the track gives what lies past its road's edges anywhere ([`Frame::has_verges`]):
+    /// TORCS version-4 files do; the built-in and CSV tracks, where a learning lap's reserve
+    /// of road is the car's centre [`LapConfig::off_track_margin`](crate::sim::LapConfig::off_track_margin)
+    /// from the edge, do not.
+    pub fn has_verges(&self) -> bool {
+        self.frames.iter().any(|f| f.has_verges)
+    }
+
     /// The pre-computed trigonometry of sample `i` (wrapping around the lap).
     #[inline]
     pub fn frame(&self, i: usize) -> &Frame {
