@@ -100,10 +100,9 @@ impl OffTrackArgs {
 }
 
 /// Where a lap fails, in words: "at 1 m inside the road's edge", "at 1 m past the road's
-/// edge, the game's rule", or "keeping …" the reserve ([`cdbo::sim::lap::Reserve`]) on a track
-/// that gives its road's verges (`verges`); on one that does not, the reserve is the margin.
-pub fn edge_words(margin_m: f64, reserve: Option<cdbo::sim::lap::Reserve>, verges: bool) -> String {
-    if let Some(r) = reserve.filter(|_| verges) {
+/// edge, the game's rule", or "keeping …" the reserve ([`cdbo::sim::lap::Reserve`]).
+pub fn edge_words(margin_m: f64, reserve: Option<cdbo::sim::lap::Reserve>) -> String {
+    if let Some(r) = reserve {
         return format!(
             "keeping the wheels {} m off slippery ground and the body {} m off the walls",
             r.wheels_m, r.body_m

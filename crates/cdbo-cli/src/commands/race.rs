@@ -309,10 +309,10 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         summary.best_reward_mps / summary.demo_reward_mps,
         summary.demo_reward_mps,
         summary.failed_laps,
+        // A reserve keeps to what the track gives: without verges it is the margin alone.
         super::edge_words(
             summary.off_track_margin_m,
-            summary.reserve,
-            track.has_verges()
+            summary.reserve.filter(|_| track.has_verges())
         )
     );
     if let Some(file) = &summary.warm_start {

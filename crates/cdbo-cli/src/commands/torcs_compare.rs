@@ -410,11 +410,9 @@ fn markdown(reports: &[TrackReport], args: &CompareArgs) -> String {
             n => format!("seeds {}–{}", args.seed, args.seed + n - 1),
         },
         // Every track learns at the same margin, the flag's.
-        // (the game's road tracks all give their verges)
         reports.first().map_or("–".into(), |r| super::edge_words(
             r.policies.learned_off_track_margin_m,
-            r.policies.learned_reserve,
-            true
+            r.policies.learned_reserve
         )),
         args.policies,
         args.sigma,

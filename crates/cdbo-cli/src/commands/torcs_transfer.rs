@@ -427,10 +427,9 @@ fn markdown(r: &Report) -> String {
         r.sim_car
             .as_ref()
             .map_or(format!("{}'s car file", r.car), |c| format!("car {c}")),
-        // (the game's road tracks all give their verges)
-        super::edge_words(r.learned_off_track_margin_m, r.learned_reserve, true),
+        super::edge_words(r.learned_off_track_margin_m, r.learned_reserve),
         r.car,
-        super::edge_words(r.judged_off_track_margin_m, None, true),
+        super::edge_words(r.judged_off_track_margin_m, None),
     );
     let against = r.against.is_some();
     let _ = writeln!(
