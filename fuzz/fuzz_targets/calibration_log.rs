@@ -7,7 +7,7 @@ use libfuzzer_sys::fuzz_target;
 fuzz_target!(|data: &[u8]| {
     let length = 1000.0;
     if let Ok(text) = std::str::from_utf8(data)
-        && let Ok(laps) = cdbo::calibrate::log::parse(text, "fuzz.csv", length)
+        && let Ok(laps) = cdbo::sim::log::parse(text, "fuzz.csv", length)
     {
         for lap in &laps {
             assert!(lap.samples.len() >= 2);

@@ -3,7 +3,7 @@
 
 use cdbo::Result;
 use cdbo::car::Car;
-use cdbo::experiment::line::RacedPolicy;
+use cdbo::policy::RacedPolicy;
 use cdbo::sim::Simulator;
 use cdbo::track::Track;
 use serde::Serialize;
@@ -80,7 +80,7 @@ pub fn drive(track: Track, car: &Car, key: String, raced: &RacedPolicy) -> Resul
 #[cfg(test)]
 mod tests {
     use super::*;
-    use cdbo::experiment::line::BaseLine;
+    use cdbo::line::BaseLine;
     use cdbo::policy::{Policy, RkhsPolicy};
 
     /// A learned line is drawn (within the road less half the car's width, as the lap holds

@@ -4,8 +4,8 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use cdbo::drive::steering::SteeringLaw;
-use cdbo::experiment::line::{BaseLine, LineKind, LineSetting};
 use cdbo::experiment::race::{LapRecord, RaceConfig, RaceOutcome};
+use cdbo::line::{BaseLine, LineKind, LineSetting};
 use cdbo::sim::lap::checked_off_track_margin;
 
 use crate::convert::IntoPy;

@@ -8,8 +8,8 @@ use pyo3::types::{PyDict, PyType};
 
 use cdbo::car::Car;
 use cdbo::drive::steering::SteeringLaw;
-use cdbo::experiment::line::BaseLine;
 use cdbo::limit::{Limit, limit_lap};
+use cdbo::line::BaseLine;
 use cdbo::optimizers::FailedLap;
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 use cdbo::policy::{Policy, RkhsPolicy};

@@ -9,7 +9,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyType};
 
 use cdbo::drive::steering::SteeringLaw;
-use cdbo::experiment::line::LineKind;
+use cdbo::line::LineKind;
 use cdbo::policy::rkhs::default_lengthscale;
 use cdbo::study::{Outcome, Study, StudyConfig, Trial};
 

@@ -40,29 +40,23 @@
 //! (limit → tracked profile) and the policy class's (tracked profile → fitted policy), and
 //! what is left to an optimiser.
 //!
-//! [`REPAIR_SPACINGS`]: crate::learner::repair::REPAIR_SPACINGS
-//! [`REPAIR_STEP`]: crate::learner::repair::REPAIR_STEP
+//! [`REPAIR_SPACINGS`]: crate::policy::repair::REPAIR_SPACINGS
+//! [`REPAIR_STEP`]: crate::policy::repair::REPAIR_STEP
 
 use serde::Serialize;
 
 use crate::car::Car;
+use crate::drive::profile::{PREVIEW_S, TRACKER_FLOOR_MPS, TRACKER_GAIN};
 use crate::drive::{Observation, Pedal};
 use crate::error::{Error, Result};
-use crate::learner::repair::PedalRepair;
 use crate::limit::{Limit, LimitOptions};
 use crate::line::RacingLine;
 use crate::policy::RkhsPolicy;
+use crate::policy::repair::PedalRepair;
 use crate::policy::rkhs::DEFAULT_RIDGE;
 use crate::sim::Simulator;
 use crate::track::Track;
 
-/// Proportional gain of the profile tracker (per m/s): full pedal at 1 m/s off the target.
-pub const TRACKER_GAIN: f64 = 1.0;
-/// Preview time τ of the profile tracker (s).
-pub const PREVIEW_S: f64 = 0.3;
-/// The floor v_min of the tracker's target (m/s): below the demonstrator's 15 m/s, which
-/// every track of the paper completes.
-pub const TRACKER_FLOOR_MPS: f64 = 10.0;
 /// Bisection steps on k.
 pub const BISECTION_STEPS: usize = 14;
 /// Laps below the bisection's k searched for a faster completed lap.
@@ -282,7 +276,7 @@ mod tests {
         use crate::drive::tracker::PathTracker;
         let (mut sim, centre) = ridgeway();
         let car = Car::spirit_300();
-        let line = crate::experiment::race::BaseLine::MinCurvature
+        let line = crate::line::BaseLine::MinCurvature
             .line(&sim.track, &car)
             .unwrap();
         let limit = profile(&sim.track, &car, line.as_deref());

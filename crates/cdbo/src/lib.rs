@@ -57,37 +57,59 @@
 //! # }
 //! ```
 
-pub mod acquisition;
-pub mod benchmarks;
+// The layers, bottom to top: a module uses only modules of its own layer or below, and no two
+// modules use each other (docs/design.md; checked by `tests/layers.rs`).
+
+// Foundation: errors, bounds on input, numerics shared by everything above.
 pub mod bounded;
-pub mod calibrate;
-pub mod car;
-pub mod ceiling;
 pub mod data_path;
-pub mod drive;
 pub mod error;
-pub mod evaluator;
-pub mod experiment;
-pub mod gp;
+pub mod geometry;
 pub mod interp;
-pub mod learner;
-pub mod limit;
-pub mod line;
-pub mod method;
-pub mod optimizers;
 pub mod params;
-pub mod policy;
-pub mod prelude;
+pub mod rng;
 #[cfg(test)]
 mod scratch;
-pub mod serve;
-pub mod sim;
 mod simd;
 pub mod sizes;
-pub mod store;
-pub mod study;
-pub mod torcs;
+
+// Generic optimisation of weights in Rᵈ: Gaussian processes, acquisitions, optimisers.
+pub mod acquisition;
+pub mod benchmarks;
+pub mod gp;
+pub mod optimizers;
+
+// The model: track, car, and the vehicle's physics.
+pub mod car;
 pub mod track;
+pub mod vehicle;
+
+// Lines, then the drive (controllers) that follows them, then policies.
+pub mod drive;
+pub mod line;
+pub mod policy;
+
+// The lap simulator and its replay; the physical limit and the drive stack's ceiling.
+pub mod ceiling;
+pub mod limit;
+pub mod sim;
+
+// Learners that know they learn laps, and the registry of methods.
+pub mod learner;
+pub mod method;
+
+// Where laps come from and where results are kept.
+pub mod evaluator;
+pub mod store;
+pub mod torcs;
 pub mod venue;
+
+// Applications: calibration, studies, experiments, the lap service.
+pub mod calibrate;
+pub mod experiment;
+pub mod serve;
+pub mod study;
+
+pub mod prelude;
 
 pub use error::{Error, Result};

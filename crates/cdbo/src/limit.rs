@@ -6,7 +6,7 @@
 //! where n(v) = 1 for [`limit_lap`] (flat, crest-blind: the yardstick every "% of the limit"
 //! uses) and, with [`LimitOptions::crests`] ([`limit_lap_with`]), the road's push per unit of
 //! the car's weight as the simulator's vehicle feels it
-//! ([`Vehicle::step`](crate::sim::vehicle::Vehicle::step)):
+//! ([`Vehicle::step`](crate::vehicle::Vehicle::step)):
 //! n(v) = cos φ·cos β + v²·κ_v/g, κ_v the road's vertical curvature
 //! ([`Frame::vertical_curvature`](crate::track::Frame::vertical_curvature), negative over a
 //! crest), each axle's load kept ≥ 0 as the vehicle keeps it.
@@ -42,8 +42,8 @@ use serde::Serialize;
 use crate::car::G;
 use crate::car::{Car, Drive};
 use crate::line::RacingLine;
-use crate::sim::tyre::TyreModel;
 use crate::track::Track;
+use crate::vehicle::tyre::TyreModel;
 
 /// The limit lap.
 #[derive(Debug, Clone, PartialEq, Serialize)]

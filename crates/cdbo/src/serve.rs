@@ -131,8 +131,8 @@ pub struct Info {
     pub line: Option<crate::policy::Block>,
     /// The line the car holds, from which a learned line's offsets are measured; absent: the
     /// centre line.
-    #[serde(skip_serializing_if = "crate::experiment::line::BaseLine::is_centre")]
-    pub base_line: crate::experiment::line::BaseLine,
+    #[serde(skip_serializing_if = "crate::line::BaseLine::is_centre")]
+    pub base_line: crate::line::BaseLine,
 }
 
 /// Where and why a lap failed, as replied.

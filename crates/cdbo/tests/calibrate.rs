@@ -8,7 +8,7 @@ mod common;
 use cdbo::calibrate::{self, FitConfig, Observed, TrackLaps};
 use cdbo::car::calibration::Calibration;
 use cdbo::car::{Car, Scales};
-use cdbo::sim::Simulator;
+use cdbo::sim::{self, Simulator};
 use cdbo::track::Track;
 
 /// The probes of `base` on `track` driven by cdbo's simulator with `truth` applied: what a
@@ -91,7 +91,7 @@ fn the_stock_car_brakes_and_coasts_as_the_games_does() {
         "/../../docs/results/torcs/log_forza_launch_brake.csv"
     );
     let text = std::fs::read_to_string(file).unwrap();
-    let logged = calibrate::log::parse(&text, file, track.length).unwrap();
+    let logged = sim::log::parse(&text, file, track.length).unwrap();
     let game = Observed {
         probe: probe.clone(),
         samples: logged[0].samples.clone(),

@@ -27,26 +27,27 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use cdbo::calibrate::ProbePedal;
 use cdbo::car::Car;
-use cdbo::drive::aids::abs::abs_brake;
-use cdbo::drive::aids::launch::{LaunchCar, launch_clutch};
-use cdbo::drive::aids::traction::traction_throttle;
 use cdbo::drive::demo::{self, SpeedHold};
 use cdbo::drive::profile::ProfileHold;
 use cdbo::drive::steering::{self, PiSteering, Steering};
 use cdbo::drive::tracker::{self, PathTracker, TrackerCar, TrackerInput};
-use cdbo::drive::{Observation, Pedal, geometry, pedal_command, pi_control};
+use cdbo::drive::{Observation, Pedal, pedal_command, pi_control};
 use cdbo::experiment::race::BaseLine;
+use cdbo::geometry;
 use cdbo::policy::actions::PolicyDriver;
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 use cdbo::policy::{Policy, PolicyTable, RkhsPolicy};
 use cdbo::sim::lap::held_offset;
-use cdbo::sim::powertrain::{DOWNSHIFT_MARGIN, Gearbox, THROTTLE_LEVELS};
-use cdbo::sim::vehicle::SLIP_SPEED_FLOOR;
 use cdbo::sim::{Simulator, TracePoint};
 use cdbo::torcs::lap::cornering_tables;
 use cdbo::torcs::line::LineTable;
 use cdbo::torcs::{ROBOT_CXXFLAGS, ROBOT_HEADER, ROBOT_HEADER_NAME};
 use cdbo::track::builtin::DEFAULT;
+use cdbo::vehicle::SLIP_SPEED_FLOOR;
+use cdbo::vehicle::aids::abs::abs_brake;
+use cdbo::vehicle::aids::launch::{LaunchCar, launch_clutch};
+use cdbo::vehicle::aids::traction::traction_throttle;
+use cdbo::vehicle::powertrain::{DOWNSHIFT_MARGIN, Gearbox, THROTTLE_LEVELS};
 use common::builtin;
 
 /// The harness's source, compiled beside the header.
@@ -616,9 +617,9 @@ fn the_robots_profile_hold_is_the_rust_one_on_a_recorded_lap() {
         "profile_constants",
         &[],
         &[
-            cdbo::ceiling::TRACKER_GAIN,
-            cdbo::ceiling::PREVIEW_S,
-            cdbo::ceiling::TRACKER_FLOOR_MPS,
+            cdbo::drive::profile::TRACKER_GAIN,
+            cdbo::drive::profile::PREVIEW_S,
+            cdbo::drive::profile::TRACKER_FLOOR_MPS,
         ],
         Agree::Exactly,
     );
@@ -645,7 +646,7 @@ fn the_robots_profile_hold_is_the_rust_one_on_a_recorded_lap() {
         between += usize::from(a.abs() < 1.0);
         for speed in [p.speed, p.speed - 5.0, p.speed + 5.0] {
             let target = hold.target(p.x, speed);
-            floor += usize::from(target == cdbo::ceiling::TRACKER_FLOOR_MPS);
+            floor += usize::from(target == cdbo::drive::profile::TRACKER_FLOOR_MPS);
             let a = hold.pedal(&Observation { speed, ..obs });
             full += usize::from(a == 1.0);
             braking += usize::from(a == -1.0);

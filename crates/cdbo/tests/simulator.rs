@@ -7,9 +7,9 @@ use cdbo::car::G;
 use cdbo::drive::demo::SpeedHold;
 use cdbo::drive::{ConstantPedal, Observation, Pedal};
 use cdbo::limit::limit_lap;
-use cdbo::sim::vehicle::{Controls, Vehicle};
 use cdbo::sim::{FailureReason, Simulator};
 use cdbo::track::{Piece, Track};
+use cdbo::vehicle::{Controls, Vehicle};
 use common::{builtin, shared_track};
 
 fn demo(track: Track) -> cdbo::sim::LapResult {
@@ -269,7 +269,7 @@ fn drive_straight(
     throttle: f64,
     brake: f64,
     seconds: f64,
-) -> (cdbo::sim::vehicle::State, Vehicle) {
+) -> (cdbo::vehicle::State, Vehicle) {
     let track = straight(5000.0);
     let car = Car::spirit_300();
     let vehicle = Vehicle::new(&car);
@@ -359,7 +359,7 @@ fn braking_never_beats_the_friction_limit() {
     // Full brakes from 30 m/s: the stopping distance is at least v²/(2·μ_peak·g) (ABS on).
     let v0 = 30.0;
     let (s, vehicle) = drive_straight(v0, 0.0, 1.0, 4.0);
-    let mu_peak = vehicle.car.front_tyre.mu * cdbo::sim::tyre::LOAD_FACTOR_MAX;
+    let mu_peak = vehicle.car.front_tyre.mu * cdbo::vehicle::tyre::LOAD_FACTOR_MAX;
     assert!(s.vx.abs() < 0.5, "still moving at {}", s.vx);
     assert!(s.x >= v0 * v0 / (2.0 * mu_peak * G), "stopped in {} m", s.x);
     // The Spirit's brakes are biased to the front (52 % of the pressure on much larger
@@ -489,7 +489,7 @@ fn the_robot_pulls_away_on_the_slipping_clutch() {
     let (r, rear) = (car.rear_tyre.radius, &vehicle.tyres()[1]);
     let fz = car.mass * G * car.cg_to_front() / car.wheelbase;
     let slope = rear.axle_max_force(fz, frame.friction) * rear.b * rear.c;
-    let floor = cdbo::sim::vehicle::SLIP_SPEED_FLOOR;
+    let floor = cdbo::vehicle::SLIP_SPEED_FLOOR;
     let omega = te * g * dt / (2.0 * car.rear_tyre.inertia + dt * r * r * slope / floor);
     assert!(
         (s.omega[1] - omega).abs() < 1e-9 * omega,

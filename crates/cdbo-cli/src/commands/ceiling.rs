@@ -6,7 +6,7 @@ use super::{CliResult, Setup, print_json};
 use cdbo::ceiling::ceiling_with;
 use cdbo::data_path::DataPath;
 use cdbo::drive::steering::SteeringLaw;
-use cdbo::experiment::line::RacedPolicy;
+use cdbo::policy::RacedPolicy;
 
 #[derive(Debug, Args)]
 pub struct CeilingArgs {

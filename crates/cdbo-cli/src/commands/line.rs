@@ -4,7 +4,7 @@
 
 use clap::Args;
 
-use cdbo::experiment::line::{BaseLine, LineKind, LineSetting};
+use cdbo::line::{BaseLine, LineKind, LineSetting};
 
 /// The line flags.
 #[derive(Debug, Args, Clone, Copy, Default)]

@@ -10,8 +10,8 @@ use crate::figures::{TrackMap, draw, read_trace_speeds};
 use cdbo::car::Car;
 use cdbo::car::catalog as cars;
 use cdbo::data_path::DataPath;
-use cdbo::experiment::line::RacedPolicy;
 use cdbo::line::{LineOptions, RacingLine, SAFETY_MARGIN};
+use cdbo::policy::RacedPolicy;
 use cdbo::sim::Simulator;
 use cdbo::track::Track;
 

@@ -6,7 +6,7 @@ use clap::Subcommand;
 
 use super::CliResult;
 use cdbo::bounded;
-use cdbo::experiment::line::RacedPolicy;
+use cdbo::policy::RacedPolicy;
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 use cdbo::policy::{Policy, RkhsPolicy};
 
@@ -112,7 +112,7 @@ pub fn read_raced_policy(path: &Path) -> Result<RacedPolicy, Box<dyn std::error:
         #[derive(serde::Deserialize)]
         struct Raced {
             #[serde(default)]
-            base_line: cdbo::experiment::line::BaseLine,
+            base_line: cdbo::line::BaseLine,
         }
         let text = bounded::read_text(&summary, &bounded::POLICY_FILE)?;
         let raced_on: Raced = serde_json::from_str(&text)

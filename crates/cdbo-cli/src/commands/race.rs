@@ -11,10 +11,10 @@ use super::policy::read_policy;
 use super::{CliResult, Setup, Simulator, from_flag, print_json};
 use cdbo::data_path::DataPath;
 use cdbo::drive::steering::SteeringLaw;
-use cdbo::experiment::line::RacedPolicy;
 use cdbo::experiment::race::{BaseLine, RaceConfig, RaceOutcome, check_warm_start, race};
 use cdbo::method::{KnobKind, Method};
 use cdbo::policy::Policy;
+use cdbo::policy::RacedPolicy;
 
 /// Policy kernels M when neither `--kernels` nor a warm start gives them.
 const DEFAULT_KERNELS: usize = 30;

@@ -6,8 +6,8 @@ use std::path::PathBuf;
 use clap::Args;
 
 use super::{CliResult, Setup, print_json};
-use cdbo::calibrate::log;
 use cdbo::data_path::DataPath;
+use cdbo::sim::log;
 use cdbo::sim::replay::{RegimeSummary, Replay, ReplayConfig, SLIDE_ANGLE, replay};
 
 #[derive(Debug, Args)]

@@ -8,7 +8,7 @@ use clap::Args;
 use super::{CliResult, Setup, Simulator};
 use cdbo::data_path::DataPath;
 use cdbo::evaluator::Evaluator;
-use cdbo::experiment::line::BaseLine;
+use cdbo::line::BaseLine;
 use cdbo::optimizers::{DEFAULT_BOX_RADIUS, SearchBox};
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 use cdbo::policy::{Block, PolicyShape, RkhsPolicy};

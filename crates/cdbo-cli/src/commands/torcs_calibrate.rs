@@ -10,10 +10,11 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::CliResult;
-use cdbo::calibrate::{self, Agreement, Fit, FitConfig, Observed, TrackLaps, log};
+use cdbo::calibrate::{self, Agreement, Fit, FitConfig, Observed, TrackLaps};
 use cdbo::car::calibration::Calibration;
 use cdbo::car::{Car, Scales};
 use cdbo::data_path::DataPath;
+use cdbo::sim::log;
 use cdbo::torcs::Game;
 
 #[derive(Debug, Args)]

@@ -55,7 +55,7 @@ mod tests {
     fn draws_have_the_given_mean_and_covariance() {
         let means = [1.0, -2.0];
         let cov = Mat::from_fn(2, 2, |i, j| [[2.0, 0.6], [0.6, 0.5]][i][j]);
-        let mut rng = crate::optimizers::rng_for(3, 0);
+        let mut rng = crate::rng::rng_for(3, 0);
         let n = 40_000;
         let draws: Vec<Vec<f64>> = (0..n)
             .map(|_| draw(&means, &cov, 1.0, &mut rng).unwrap())
@@ -83,7 +83,7 @@ mod tests {
     #[test]
     fn singular_covariance_is_jittered() {
         let cov = Mat::from_fn(2, 2, |_, _| 1.0);
-        let mut rng = crate::optimizers::rng_for(1, 0);
+        let mut rng = crate::rng::rng_for(1, 0);
         let d = draw(&[0.0, 0.0], &cov, 1.0, &mut rng).unwrap();
         assert!((d[0] - d[1]).abs() < 1e-3);
     }
@@ -93,7 +93,7 @@ mod tests {
     #[test]
     fn rounding_error_of_the_prior_is_jittered() {
         let cov = Mat::from_fn(2, 2, |i, j| if i == j { 1e-16 } else { 1e-14 });
-        let mut rng = crate::optimizers::rng_for(1, 0);
+        let mut rng = crate::rng::rng_for(1, 0);
         assert!(draw(&[0.0, 0.0], &cov, 1e-16, &mut rng).is_err());
         let d = draw(&[0.0, 0.0], &cov, 1.0, &mut rng).unwrap();
         assert!(d.iter().all(|x| x.abs() < 1e-3), "{d:?}");

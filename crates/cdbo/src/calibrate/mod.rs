@@ -50,7 +50,6 @@
 //!    order.
 
 pub mod least_squares;
-pub mod log;
 
 use serde::Serialize;
 
@@ -60,8 +59,8 @@ use crate::error::{Error, Result};
 use crate::policy::PolicyTable;
 use crate::sim::Simulator;
 use crate::sim::lap::LapResult;
+pub use crate::sim::log::{LoggedLap, Sample};
 use crate::track::Track;
-pub use log::{LoggedLap, Sample};
 
 /// Distance between the stations the residuals are taken at (m).
 pub const STATION_M: f64 = 10.0;
@@ -280,7 +279,7 @@ impl Observed {
         })
     }
 
-    /// The lap as a [`LoggedLap`] numbered `lap` (to write with [`log::write`]).
+    /// The lap as a [`LoggedLap`] numbered `lap` (to write with [`log::write`](crate::sim::log::write)).
     pub fn logged(&self, lap: i64) -> LoggedLap {
         LoggedLap {
             lap,

@@ -131,7 +131,7 @@ impl Scales {
 
     /// `base` with these scales: grip and peak slip go into its tyres (μ·grip, stiffness /
     /// peak_slip), the other four are kept in [`Car::scales`] and applied where the forces
-    /// are computed ([`Car::drag`], [`Car::downforce`], [`crate::sim::vehicle`]).
+    /// are computed ([`Car::drag`], [`Car::downforce`], [`crate::vehicle`]).
     pub fn apply(&self, base: &Car) -> Car {
         let mut car = base.clone();
         for tyre in [&mut car.front_tyre, &mut car.rear_tyre] {

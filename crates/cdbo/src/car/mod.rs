@@ -183,7 +183,7 @@ pub enum DiffKind {
 }
 
 /// The rear differential as TORCS's simuv2 drives the rear wheels through it
-/// (`differential.cpp`; [`crate::sim::vehicle`] has the formulas).
+/// (`differential.cpp`; [`crate::vehicle`] has the formulas).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Differential {
     /// Its kind.
@@ -281,7 +281,7 @@ pub struct Car {
     /// (simuv2's `engine.cpp`), so a closed throttle brakes harder the faster it turns.
     pub engine_brake: f64,
     /// Engine rotational inertia (kg·m²). TORCS's simuv2 does not load the wheels with it,
-    /// and neither does [`crate::sim::vehicle`].
+    /// and neither does [`crate::vehicle`].
     pub engine_inertia: f64,
     /// Forward gear ratios, first gear first.
     pub gears: Vec<f64>,
@@ -320,8 +320,8 @@ pub struct Car {
     pub differential: Differential,
     /// Whether cdbo's simulator drives the car as cdbo's TORCS robot drives the game's car (a
     /// car read from TORCS files): pulling away on simuv2's slipping clutch, closed by the
-    /// robot's launch clutch ([`crate::drive::aids::launch`]), and with the robot's traction control
-    /// on the driven wheels' slip speed ([`crate::drive::aids::traction`]). Else (the built-in car)
+    /// robot's launch clutch ([`crate::vehicle::aids::launch`]), and with the robot's traction control
+    /// on the driven wheels' slip speed ([`crate::vehicle::aids::traction`]). Else (the built-in car)
     /// the clutch slips only below idle and traction control acts on the relative slip.
     pub torcs_robot: bool,
     /// Calibration scales over the car file's values ([`calibration`]): 1 for a stock car.

@@ -5,9 +5,7 @@
 //! brake < 0), and may name a line d(x) to hold (the centre line unless it does). Steering is
 //! the environment's [`steering::Steering`] controller, which holds that line.
 
-pub mod aids;
 pub mod demo;
-pub mod geometry;
 pub mod profile;
 pub mod steering;
 pub mod tracker;

@@ -8,8 +8,8 @@
 //! intervals, x the lap fraction, L the lap's length, v the speed, v(u) linear between the
 //! profile's n + 1 values; the minimum is over v(u₀), v(u₁) and the values at the stations
 //! strictly between. K_p, τ and the floor v_min are the ceiling's profile tracker's
-//! ([`crate::ceiling::TRACKER_GAIN`], [`crate::ceiling::PREVIEW_S`],
-//! [`crate::ceiling::TRACKER_FLOOR_MPS`]); unlike it, which reads the profile at the nearest
+//! ([`TRACKER_GAIN`], [`PREVIEW_S`],
+//! [`TRACKER_FLOOR_MPS`]); unlike it, which reads the profile at the nearest
 //! station, the target is continuous in x and v, so that the pedal is too: the tracker's
 //! target steps down by k·Δv at each station of a braking curve, and its pedal follows in a
 //! saw-tooth whose teeth move with the smallest change of the car, noise in a calibration's
@@ -17,7 +17,14 @@
 //! arithmetic, checked by `tests/robot_drive.rs`.
 
 use super::{Observation, Pedal};
-use crate::ceiling::{PREVIEW_S, TRACKER_FLOOR_MPS, TRACKER_GAIN};
+
+/// Proportional gain of the profile tracker (per m/s): full pedal at 1 m/s off the target.
+pub const TRACKER_GAIN: f64 = 1.0;
+/// Preview time τ of the profile tracker (s).
+pub const PREVIEW_S: f64 = 0.3;
+/// The floor v_min of the tracker's target (m/s): below the demonstrator's 15 m/s, which
+/// every track of the paper completes.
+pub const TRACKER_FLOOR_MPS: f64 = 10.0;
 
 /// A speed controller holding k times a speed profile (module documentation).
 #[derive(Debug, Clone, Copy)]

@@ -16,11 +16,11 @@
 //! TORCS robot's `torcs-robot/drive.hpp`, which finds its target on the game's track, can be
 //! checked against them (`tests/robot_drive.rs`).
 
-use super::geometry::bearing;
 use super::pi_control;
 use super::tracker::PathTracker;
-use crate::sim::vehicle::{State, Vehicle};
+use crate::geometry::bearing;
 use crate::track::{Projection, Track};
+use crate::vehicle::{State, Vehicle};
 
 /// Look-ahead time (s).
 pub const LOOKAHEAD_TIME: f64 = 0.8;
@@ -215,14 +215,4 @@ pub fn steering_law(
     dt: f64,
 ) -> f64 {
     pi_control(2.0 * wheelbase / d, ki, steer_lock, integral, e, dt)
-}
-
-/// An angle wrapped into (−π, π].
-pub fn wrap_angle(a: f64) -> f64 {
-    let t = (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
-    if t == -std::f64::consts::PI {
-        std::f64::consts::PI
-    } else {
-        t
-    }
 }

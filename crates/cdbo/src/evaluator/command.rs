@@ -21,8 +21,9 @@ use super::{Evaluator, Outcome};
 use crate::bounded;
 use crate::drive::steering::SteeringLaw;
 use crate::error::{Error, Result};
-use crate::experiment::line::{BaseLine, RacedPolicy};
+use crate::line::BaseLine;
 use crate::policy::PolicyShape;
+use crate::policy::RacedPolicy;
 use crate::store::claim::process_exists;
 
 /// Points of the (x, a) table written with each policy.

@@ -26,8 +26,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::line::{BaseLine, LineKind, LineSetting};
 use crate::drive::steering::SteeringLaw;
+use crate::line::{BaseLine, LineKind, LineSetting};
 use crate::method::{Method, Spec};
 use crate::sim::lap::{GAME_OFF_TRACK_MARGIN, checked_off_track_margin};
 

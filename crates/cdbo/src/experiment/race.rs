@@ -18,7 +18,7 @@ use crate::study::run::{Event, InMemory, run};
 use crate::track::Track;
 use crate::venue::Venue;
 
-pub use super::line::BaseLine;
+pub use crate::line::BaseLine;
 
 /// Settings of a race.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

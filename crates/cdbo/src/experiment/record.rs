@@ -8,12 +8,13 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::grid::{ExperimentConfig, RunSpec};
-use super::line::{BaseLine, LineSetting, RacedPolicy};
 use super::race::{LapRecord, RaceConfig, race};
 use crate::bounded;
 use crate::car::Car;
 use crate::drive::steering::SteeringLaw;
 use crate::error::{Error, Result};
+use crate::line::{BaseLine, LineSetting};
+use crate::policy::RacedPolicy;
 use crate::policy::{Block, PolicyShape};
 use crate::track::Track;
 use crate::venue::Venue;

@@ -9,5 +9,4 @@
 
 pub mod budget;
 pub mod pattern_search;
-pub mod repair;
 pub mod safe_search;

@@ -10,6 +10,9 @@
 
 pub mod min_curvature;
 pub mod path;
+pub mod setting;
+
+pub use setting::{BaseLine, LineKind, LineSetting};
 
 use serde::Serialize;
 

@@ -55,7 +55,7 @@ impl RacingLine {
             heading = if k == 0 {
                 raw
             } else {
-                heading + crate::drive::steering::wrap_angle(raw - heading)
+                heading + crate::geometry::wrap_angle(raw - heading)
             };
             samples.push(Sample {
                 s: uk,

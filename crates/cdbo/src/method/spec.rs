@@ -386,4 +386,44 @@ mod tests {
         let problem = Spec::problem(Method::Cmaes, 3.0).unwrap();
         assert_eq!(problem.sigma0_value(), 0.2);
     }
+
+    /// A cliff: laps fail wherever Σw > 0.5, else the reward rises towards the cliff.
+    fn lap(w: &[f64]) -> (f64, Option<crate::optimizers::FailedLap>) {
+        let s: f64 = w.iter().sum();
+        if s > 0.5 {
+            (0.0, Some(crate::optimizers::FailedLap::too_fast(0.5)))
+        } else {
+            (10.0 + s, None)
+        }
+    }
+
+    /// Within a budget of 3, at most 3 laps fail over 80, for each of 10 seeds; saved halfway
+    /// and resumed, the run asks the same weights as the uninterrupted one.
+    #[test]
+    fn a_budget_caps_failures_and_resumes_bit_for_bit() {
+        for seed in 0..10 {
+            let spec = Spec::race(Method::Random).seed(seed).max_failed_laps(3);
+            let mut a = spec.optimizer(vec![0.0; 4]).unwrap();
+            let mut failed = 0;
+            let mut resumed = None;
+            for k in 0..80 {
+                if k == 40 {
+                    resumed = Some(resume(a.save()).unwrap());
+                }
+                let w = a.ask().unwrap();
+                if let Some(b) = resumed.as_mut() {
+                    assert_eq!(b.ask().unwrap(), w, "seed {seed} lap {k}");
+                }
+                let (reward, failure) = lap(&w);
+                failed += usize::from(failure.is_some());
+                a.tell_lap(&w, reward, failure).unwrap();
+                if let Some(b) = resumed.as_mut() {
+                    b.tell_lap(&w, reward, failure).unwrap();
+                }
+            }
+            assert!(failed <= 3, "seed {seed}: {failed} failed laps");
+            assert_eq!(a.evaluations(), 80);
+            assert!(a.best().unwrap().1 > 10.0, "seed {seed}: no gain");
+        }
+    }
 }

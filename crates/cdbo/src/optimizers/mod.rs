@@ -14,6 +14,8 @@ pub mod random;
 pub mod rembo;
 pub mod turbo;
 
+pub use crate::rng::rng_for;
+
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use serde_json::value::RawValue;
@@ -214,13 +216,4 @@ pub(crate) fn check_tell_lap(
         )),
         _ => Ok(()),
     }
-}
-
-/// A generator for draw number `stream` of a run seeded with `seed`: every random choice is a
-/// pure function of (seed, stream), so a resumed run makes the same choices.
-pub fn rng_for(seed: u64, stream: u64) -> rand_chacha::ChaCha8Rng {
-    use rand::SeedableRng;
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-    rng.set_stream(stream);
-    rng
 }

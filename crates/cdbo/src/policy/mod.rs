@@ -3,9 +3,12 @@
 
 pub mod actions;
 pub mod demo;
+pub mod raced;
+pub mod repair;
 pub mod rkhs;
 pub mod table;
 
 pub use actions::{Block, Policy, PolicyShape};
+pub use raced::RacedPolicy;
 pub use rkhs::RkhsPolicy;
 pub use table::PolicyTable;

@@ -32,11 +32,11 @@
 use serde::Serialize;
 
 use super::LapConfig;
-use super::vehicle::{Controls, Vehicle};
-use crate::calibrate::log::{LoggedLap, Sample};
 use crate::car::Car;
 use crate::error::{Error, Result};
+use crate::sim::log::{LoggedLap, Sample};
 use crate::track::Track;
+use crate::vehicle::{Controls, Vehicle};
 
 /// Windows start only where the logged car moves at least this fast (m/s).
 pub const MIN_SPEED: f64 = 5.0;

@@ -25,8 +25,8 @@ use crate::drive::steering::Steering;
 use crate::error::{Error, Result};
 use crate::policy::RkhsPolicy;
 use crate::sim::lap::{Failure, LapConfig, LapResult, TracePoint};
-use crate::sim::powertrain::{DOWNSHIFT_MARGIN, THROTTLE_LEVELS};
-use crate::sim::vehicle::Vehicle;
+use crate::vehicle::Vehicle;
+use crate::vehicle::powertrain::{DOWNSHIFT_MARGIN, THROTTLE_LEVELS};
 
 /// What the robot's pedal follows.
 #[derive(Debug, Clone, PartialEq)]

@@ -10,10 +10,10 @@
 //! the demonstrator or a constant), the look-ahead PI steering of
 //! [`crate::drive::steering`] or the path tracker of [`crate::drive::tracker`] on the lap's
 //! line (the centre line, or the base and policy line sampled by [`line`](mod@line)), the automatic
-//! gearbox of [`crate::sim::powertrain`] (its shift points are handed over from the car's
-//! [`crate::sim::vehicle::Vehicle`]), and the same failure rules, judged from the game's car
+//! gearbox of [`crate::vehicle::powertrain`] (its shift points are handed over from the car's
+//! [`crate::vehicle::Vehicle`]), and the same failure rules, judged from the game's car
 //! state; its launch clutch, traction control and ABS act at the game's driver steps
-//! ([`crate::drive::aids`]). Its decisions are the pure functions of [`ROBOT_HEADER`], which
+//! ([`crate::vehicle::aids`]). Its decisions are the pure functions of [`ROBOT_HEADER`], which
 //! `tests/robot_drive.rs` checks against the Rust ones on states recorded from laps of the
 //! simulator.
 
@@ -427,4 +427,42 @@ fn link_contents(from: &Path, to: &Path) -> Result<()> {
         })?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::ROBOT_SOURCE;
+    use crate::sim::lap::{
+        BACKWARDS_DISTANCE, INV_TAN_SPIN_SLIP_ANGLE, SPIN_MIN_SPEED, STALL_SPEED, STALL_TIME,
+    };
+    use crate::vehicle::SLIP_SPEED_FLOOR;
+
+    /// The value of `const double NAME = VALUE;` in the robot's source.
+    fn robot_constant(name: &str) -> f64 {
+        let prefix = format!("const double {name} = ");
+        let line = ROBOT_SOURCE
+            .lines()
+            .find_map(|l| l.trim().strip_prefix(prefix.as_str()))
+            .unwrap_or_else(|| panic!("no `{prefix}…;` in torcs-robot/cdbo.cpp"));
+        let value = line.split(';').next().unwrap_or_default().trim();
+        value
+            .parse()
+            .unwrap_or_else(|e| panic!("{name} = {value:?}: {e}"))
+    }
+
+    /// The robot ends a game's lap by the rules a lap of cdbo's simulator ends by: its copies
+    /// of the spin, backwards and stall thresholds and of the slip's speed floor are these.
+    #[test]
+    fn the_robot_fails_a_lap_by_the_simulators_rules() {
+        for (name, ours) in [
+            ("kSpinSlipTan", INV_TAN_SPIN_SLIP_ANGLE),
+            ("kSpinMinSpeed", SPIN_MIN_SPEED),
+            ("kBackwardsDistance", BACKWARDS_DISTANCE),
+            ("kStallSpeed", STALL_SPEED),
+            ("kStallTime", STALL_TIME),
+            ("kSlipSpeedFloor", SLIP_SPEED_FLOOR),
+        ] {
+            assert_eq!(robot_constant(name), ours, "{name}");
+        }
+    }
 }

@@ -116,7 +116,7 @@ pub struct PatternSearchConfig {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pedal_kernels: Option<usize>,
     /// The push's first repair step δ₀ at each new place (the default
-    /// [`REPAIR_STEP`](crate::learner::repair::REPAIR_STEP) is not written).
+    /// [`REPAIR_STEP`](crate::policy::repair::REPAIR_STEP) is not written).
     #[serde(default = "repair_step", skip_serializing_if = "is_repair_step")]
     pub repair_step: f64,
     /// Repair the start where its lap fails, as a push is repaired (push 0, of size 0;
@@ -144,7 +144,7 @@ pub struct PatternSearchConfig {
 
 /// The push's default repair step.
 fn repair_step() -> f64 {
-    crate::learner::repair::REPAIR_STEP
+    crate::policy::repair::REPAIR_STEP
 }
 
 /// Whether a push's repair step is the default, left out of a saved search.

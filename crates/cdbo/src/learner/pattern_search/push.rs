@@ -56,11 +56,11 @@ use serde::{Deserialize, Serialize};
 
 use super::PatternSearchConfig;
 use crate::error::Result;
-#[cfg(test)]
-use crate::learner::repair::REPAIR_STEP;
-use crate::learner::repair::{PedalRepair, REPAIR_SPACINGS};
 use crate::optimizers::{FailedLap, SearchBox, rng_for};
 use crate::policy::RkhsPolicy;
+#[cfg(test)]
+use crate::policy::repair::REPAIR_STEP;
+use crate::policy::repair::{PedalRepair, REPAIR_SPACINGS};
 use crate::policy::rkhs::DEFAULT_RIDGE;
 
 /// The first push's size U₀ (pedal units), chosen by a sweep on the training panels and

@@ -30,9 +30,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::Result;
 use crate::learner::pattern_search::push::REPAIR_DISTANCE;
-use crate::learner::repair::REPAIR_SPACINGS;
 use crate::optimizers::FailedLap;
 use crate::policy::RkhsPolicy;
+use crate::policy::repair::REPAIR_SPACINGS;
 
 /// Pedal samples per kernel spacing, when the weights are a lap policy's.
 const SAMPLES_PER_SPACING: usize = 4;

@@ -10,7 +10,7 @@
 //! Longitudinal and lateral forces share this one budget along the slip vector:
 //! Fₓ = F·sₓ/s, F_y = F·s_y/s (the friction ellipse of combined slip).
 //!
-//! The vehicle ([`super::vehicle`]) gives each wheel its own budget F_z·μ·μ_surface·λ(F_z)
+//! The vehicle ([`super`]) gives each wheel its own budget F_z·μ·μ_surface·λ(F_z)
 //! under its own load, as TORCS applies it per wheel; the limit solver and the cornering
 //! stiffness lump an axle's two tyres at equal loads, F_z·μ·μ_surface·λ(F_z/2).
 //!

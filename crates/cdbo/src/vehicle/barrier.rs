@@ -13,7 +13,7 @@
 //! curvature (the centre line bends by κ·a²/2 over a). The corner touches the left barrier at
 //! l > b_left and the right one at −l > b_right.
 
-use super::vehicle::State;
+use super::State;
 use crate::car::Car;
 use crate::track::Frame;
 
@@ -99,7 +99,7 @@ mod tests {
 
     fn car_at(lateral: f64, yaw: f64) -> State {
         let car = Car::spirit_300();
-        let mut s = crate::sim::vehicle::Vehicle::new(&car).at_rest(100.0, lateral, 0.0);
+        let mut s = crate::vehicle::Vehicle::new(&car).at_rest(100.0, lateral, 0.0);
         s.yaw = yaw;
         s.yaw_sin_cos = yaw.sin_cos();
         s

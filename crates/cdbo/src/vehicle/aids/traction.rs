@@ -5,7 +5,7 @@
 //! "Session 37").
 //!
 //! cdbo's vehicle eases another car's throttle inside its physics step, on the driven axle's
-//! relative slip past the aid threshold ([`crate::sim::vehicle::Vehicle::aid_threshold`]): eased to
+//! relative slip past the aid threshold ([`crate::vehicle::Vehicle::aid_threshold`]): eased to
 //! nothing at twice it. The robot can only act at the game's 50 Hz driver steps, and there
 //! that stiff band, fed the game's wheel speeds, cuts and restores the throttle step by step:
 //! the engine's speed jumps by ±2000 rpm from one step to the next and a standing start in

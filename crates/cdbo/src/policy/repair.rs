@@ -115,7 +115,6 @@ impl PedalRepair {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sim::lap::FailureReason;
 
     /// A repair moves the targets over two spacings before the failure only, down for a spin
     /// and up for a stall; a reversal within one spacing halves δ, a failure further on
@@ -124,25 +123,25 @@ mod tests {
     fn a_repair_moves_the_targets_before_the_failure() {
         let mut repair = PedalRepair::new(11);
         let mut targets: Vec<(f64, f64)> = (0..=100).map(|i| (i as f64 / 100.0, 0.5)).collect();
-        repair.repair(&mut targets, 0.5, FailureReason::Spun.too_slow());
+        repair.repair(&mut targets, 0.5, false /* spun: too fast */);
         let close = |a: f64, b: f64| (a - b).abs() < 1e-12;
         for (i, &(x, a)) in targets.iter().enumerate() {
             let moved = (30..=50).contains(&i);
             assert!(close(a, if moved { 0.4 } else { 0.5 }), "x {x}: {a}");
         }
-        repair.repair(&mut targets, 0.52, FailureReason::Stalled.too_slow());
+        repair.repair(&mut targets, 0.52, true /* stalled: too slow */);
         assert_eq!(repair.step, REPAIR_STEP / 2.0);
         assert!(close(targets[51].1, 0.55) && close(targets[50].1, 0.45));
         assert!(close(targets[31].1, 0.4) && close(targets[32].1, 0.45));
-        repair.repair(&mut targets, 0.53, FailureReason::Stalled.too_slow());
+        repair.repair(&mut targets, 0.53, true /* stalled: too slow */);
         assert_eq!(repair.step, REPAIR_STEP / 2.0);
-        repair.repair(&mut targets, 0.8, FailureReason::OffTrack.too_slow());
+        repair.repair(&mut targets, 0.8, false /* off the road: too fast */);
         assert_eq!(repair.step, REPAIR_STEP);
         assert!(close(targets[80].1, 0.4) && close(targets[57].1, 0.5));
         // Over a window of its own: 0.055 of the lap before the failure, not two spacings.
         let mut narrow = PedalRepair::new(11).over(0.055);
         let mut targets: Vec<(f64, f64)> = (0..=100).map(|i| (i as f64 / 100.0, 0.5)).collect();
-        narrow.repair(&mut targets, 0.5, FailureReason::Spun.too_slow());
+        narrow.repair(&mut targets, 0.5, false /* spun: too fast */);
         for (i, &(x, a)) in targets.iter().enumerate() {
             let moved = (45..=50).contains(&i);
             assert!(close(a, if moved { 0.4 } else { 0.5 }), "x {x}: {a}");

@@ -17,7 +17,7 @@
 //! At simuv2's own step Δt = 2 ms ([`SIMUV2_STEP`]), each wheel with e its suspension's
 //! extension past the quasi-static length (m, at the wheel), u its speed towards the body
 //! (simuv2's `rel_vel`), b the rise of the body's corner above it and F_qs the load the car's
-//! quasi-static model gives the wheel ([`super::vehicle`]):
+//! quasi-static model gives the wheel ([`super`]):
 //!
 //! - e ← e − u·Δt, and where that puts the wheel below the ground, e ← b − h and u ← 0 (the
 //!   ground pushes the wheel up: `max_extend`);
@@ -36,7 +36,7 @@
 //! roughest road (R = 1.5 cm at λ = 0.7 m) car1-trb1 keeps 94 % of its grip at 20 m/s and 88 %
 //! at 60 to 80 m/s; on grass (5 cm at 0.5 m) its wheels would be in the air a third of the time and
 //! keep 80 %, but the game's verges cost nothing measurable, so only the road's roughness is
-//! laid under the wheels ([`super::vehicle`], docs/results/torcs.md, "The road's roughness").
+//! laid under the wheels ([`super`], docs/results/torcs.md, "The road's roughness").
 //!
 //! Approximations: each corner rises on its own where simuv2 moves the body as one (heave,
 //! pitch and roll), and the bumps are met at the car's speed along the centre line from the

@@ -1,6 +1,6 @@
 //! The robot's launch clutch, defined here for the robot's `drive::launch_clutch`
 //! (`torcs-robot/drive.hpp`), which `tests/robot_drive.rs` checks against it; cdbo's simulator
-//! pulls away with it in a car the robot drives ([`crate::sim::vehicle::Vehicle::clutch`]).
+//! pulls away with it in a car the robot drives ([`crate::vehicle::Vehicle::clutch`]).
 //!
 //! cdbo's powertrain lets the clutch slip below idle with the engine giving its idle torque;
 //! the game's engine gives no torque below idle and drives the wheels only while it turns

@@ -5,7 +5,7 @@
 //! game's 50 Hz: it eases the pedal b by every axle k whose slide σₖ = −(ω̄ₖRₖ − vₓ)/max(|vₓ|, v₀)
 //! passes the aid threshold σ*ₖ (half the car file's peak slip), by clamp(2 − σₖ/σ*ₖ, 0, 1),
 //! and the game's brakes hold the result for the next ten 2 ms steps. cdbo's simulator brakes
-//! a car the robot drives the same way ([`crate::sim::vehicle::Vehicle::driver_brake`]).
+//! a car the robot drives the same way ([`crate::vehicle::Vehicle::driver_brake`]).
 //! Eased every 4 ms and per axle instead, as cdbo's vehicle eases another car's brakes, its
 //! car1-trb1 braked from 62 m/s at 3 g where the game's brakes at 2.5 g, its rear wheels
 //! slipping more, and it shifted down early (into second 150 m early) and coasted a gear too
