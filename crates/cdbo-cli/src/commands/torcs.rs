@@ -51,9 +51,10 @@ pub enum TorcsCommand {
     /// best (flying) lap of two, alone, from a clean start, headless — the table cdbo's
     /// learned laps are judged against — beside cdbo's QSS limit on the centre line.
     Robots {
-        /// TORCS track name.
-        #[arg(long, default_value = "forza")]
-        track: String,
+        /// TORCS track names, comma-separated, or `road` for every road track installed; more
+        /// than one track ends with a table of the fastest robot on each.
+        #[arg(long, default_value = "forza", value_delimiter = ',')]
+        track: Vec<String>,
         /// TORCS car name.
         #[arg(long, default_value = torcs::DEFAULT_CAR)]
         car: String,
@@ -171,10 +172,116 @@ struct RobotRow {
     error: Option<String>,
 }
 
-/// `cdbo torcs robots`: every robot of the installed game but the human driver and cdbo's own
-/// (those with a `drivers/NAME/NAME.xml`), one at a time, fastest standing first lap first.
-fn robots(track: &str, car: &str, json: bool) -> CliResult {
+/// A robot and its lap (s).
+type RobotLap<'a> = Option<(&'a str, f64)>;
+
+/// The robots table of one track ([`robots_on`]).
+#[derive(Debug, Serialize)]
+struct RobotsTable {
+    track: String,
+    car: String,
+    limit_lap_time_s: f64,
+    robots: Vec<RobotRow>,
+}
+
+impl RobotsTable {
+    /// The fastest robot's standing first lap and best (flying) lap, each with its robot.
+    fn fastest(&self) -> (RobotLap<'_>, RobotLap<'_>) {
+        let best = |lap: fn(&RobotRow) -> Option<f64>| {
+            self.robots
+                .iter()
+                .filter_map(|r| Some((r.robot.as_str(), lap(r)?)))
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+        };
+        (best(|r| r.first_lap_s), best(|r| r.best_lap_s))
+    }
+}
+
+/// A lap time in a table's cell: `83.85 s`, or `–` where there is none.
+fn lap_cell(lap: Option<f64>) -> String {
+    lap.map_or("–".into(), |v| format!("{v:.2} s"))
+}
+
+/// `cdbo torcs robots`: the robots table of each track (`road`: every road track installed),
+/// then, for more than one track, the fastest robot on each.
+fn robots(tracks: &[String], car: &str, json: bool) -> CliResult {
     let game = Game::ready()?;
+    let tracks: Vec<String> = if tracks.iter().any(|t| t == "road") {
+        game.install.tracks("road")
+    } else {
+        tracks.to_vec()
+    };
+    if tracks.is_empty() {
+        return Err(format!(
+            "no road tracks in the game's {}: name them with --track",
+            game.install.data_dir.join("tracks/road").display()
+        )
+        .into());
+    }
+    let tables = tracks
+        .iter()
+        .map(|track| robots_on(&game, track, car, json))
+        .collect::<Result<Vec<_>, _>>()?;
+    if json {
+        return match tables.as_slice() {
+            [one] => print_json(one),
+            _ => print_json(&tables),
+        };
+    }
+    for table in &tables {
+        println!(
+            "{} on {}, each robot alone from a standing start; cdbo's QSS limit on the centre line {:.2} s",
+            table.car, table.track, table.limit_lap_time_s
+        );
+        println!("| robot | standing first lap | best (flying) lap | first lap / limit | damage |");
+        println!("| --- | --- | --- | --- | --- |");
+        for r in &table.robots {
+            println!(
+                "| {} | {} | {} | {} | {} |",
+                r.robot,
+                r.first_lap_s.map_or_else(
+                    || format!("– ({})", r.error.as_deref().unwrap_or("no lap")),
+                    |v| format!("{v:.2} s")
+                ),
+                lap_cell(r.best_lap_s),
+                r.first_lap_s.map_or("–".into(), |v| format!(
+                    "{:.1} %",
+                    100.0 * table.limit_lap_time_s / v
+                )),
+                r.damage.map_or("–".into(), |d| format!("{d:.0}")),
+            );
+        }
+        println!();
+    }
+    if tables.len() > 1 {
+        println!("{car}: the fastest robot on each track, alone, headless, from a clean start");
+        println!("| track | fastest standing lap | fastest flying lap | cdbo's QSS limit |");
+        println!("| --- | --- | --- | --- |");
+        for table in &tables {
+            let (standing, flying) = table.fastest();
+            let cell = |lap: RobotLap| {
+                lap.map_or("–".into(), |(robot, t)| format!("{t:.2} s ({robot})"))
+            };
+            println!(
+                "| {} | {} | {} | {:.2} s |",
+                table.track,
+                cell(standing),
+                cell(flying),
+                table.limit_lap_time_s
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Every robot of the installed game but the human driver and cdbo's own (those with a
+/// `drivers/NAME/NAME.xml`) on one track, one at a time, fastest standing first lap first.
+fn robots_on(
+    game: &Game,
+    track: &str,
+    car: &str,
+    json: bool,
+) -> Result<RobotsTable, Box<dyn std::error::Error>> {
     let req = game.request(track, car, GamePedal::Demo(15.0))?;
     let data = cdbo::data_path::DataPath::new(std::slice::from_ref(&game.install.data_dir));
     let limit = cdbo::limit::limit_lap(&cdbo::track::catalog::find(track, &data)?, &req.car);
@@ -192,12 +299,14 @@ fn robots(track: &str, car: &str, json: bool) -> CliResult {
             let laps = game.robot_laps(&robot, track, car);
             if !json {
                 eprintln!(
-                    "{robot}: {}",
+                    "{track}, {robot}: {}",
                     laps.as_ref().map_or_else(
                         |e| e.to_string(),
                         |l| format!(
-                            "first lap {:.2} s, best {:?} s, damage {}",
-                            l.first, l.best, l.damage
+                            "first lap {:.2} s, best {}, damage {}",
+                            l.first,
+                            lap_cell(l.best),
+                            l.damage
                         )
                     )
                 );
@@ -215,44 +324,48 @@ fn robots(track: &str, car: &str, json: bool) -> CliResult {
         let key = |r: &RobotRow| r.first_lap_s.unwrap_or(f64::INFINITY);
         key(a).total_cmp(&key(b))
     });
-    #[derive(Serialize)]
-    struct Table {
-        track: String,
-        car: String,
-        limit_lap_time_s: f64,
-        robots: Vec<RobotRow>,
-    }
-    let table = Table {
+    Ok(RobotsTable {
         track: track.to_owned(),
         car: car.to_owned(),
         limit_lap_time_s: limit.lap_time_s,
         robots: laps,
-    };
-    if json {
-        return print_json(&table);
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(robot: &str, first: Option<f64>, best: Option<f64>) -> RobotRow {
+        RobotRow {
+            robot: robot.into(),
+            first_lap_s: first,
+            best_lap_s: best,
+            damage: first.map(|_| 0.0),
+            error: first.is_none().then(|| "no lap".into()),
+        }
     }
-    println!(
-        "{} on {}, each robot alone from a standing start; cdbo's QSS limit on the centre line {:.2} s",
-        table.car, table.track, table.limit_lap_time_s
-    );
-    println!("| robot | standing first lap | best (flying) lap | first lap / limit | damage |");
-    println!("| --- | --- | --- | --- | --- |");
-    for r in &table.robots {
-        let s = |v: Option<f64>| v.map_or("–".into(), |v| format!("{v:.2} s"));
-        println!(
-            "| {} | {} | {} | {} | {} |",
-            r.robot,
-            r.first_lap_s.map_or_else(
-                || format!("– ({})", r.error.as_deref().unwrap_or("no lap")),
-                |v| format!("{v:.2} s")
-            ),
-            s(r.best_lap_s),
-            r.first_lap_s.map_or("–".into(), |v| format!(
-                "{:.1} %",
-                100.0 * table.limit_lap_time_s / v
-            )),
-            r.damage.map_or("–".into(), |d| format!("{d:.0}")),
+
+    /// The fastest standing and flying laps are each the least of their column, with their own
+    /// robots, and a lap that is missing prints as a dash, not as an `Option`.
+    #[test]
+    fn the_fastest_robot_is_taken_per_lap() {
+        let table = RobotsTable {
+            track: "aalborg".into(),
+            car: "car1-trb1".into(),
+            limit_lap_time_s: 79.32,
+            robots: vec![
+                row("berniw2", Some(78.15), Some(73.96)),
+                row("bt", Some(81.56), None),
+                row("olethros", None, None),
+                row("inferno", Some(85.65), Some(72.5)),
+            ],
+        };
+        assert_eq!(
+            table.fastest(),
+            (Some(("berniw2", 78.15)), Some(("inferno", 72.5)))
         );
+        assert_eq!(lap_cell(Some(105.278)), "105.28 s");
+        assert_eq!(lap_cell(None), "–");
     }
-    Ok(())
 }
