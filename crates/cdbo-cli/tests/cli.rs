@@ -341,9 +341,8 @@ fn transfer_refuses_a_bad_reference_before_any_lap() {
 /// policies a track drawn around three learned ones, driven in TORCS 1.3.7): cdbo's simulator
 /// keeps agreeing with them. A change to the model that loses fidelity fails here, without the
 /// game: on Forza, E-Track 2 and Aalborg it completed where the game did on 286, 287 and 294
-/// of 300 when they were kept (session 34), and its laps were 0.2–0.5 % faster; session 33's
-/// model (its tyres slipping sideways by tan α, not sin α) agrees on 282, 292 and 294 of them,
-/// the model before it (no rolling resistance against the yaw, no pitch from the wings' drag,
+/// of 300 when they were kept, and its laps were 0.2–0.5 % faster; the model before it (its tyres slipping sideways by tan α, not sin α) agrees on 282, 292 and 294 of them,
+/// and the one before that (no rolling resistance against the yaw, no pitch from the wings' drag,
 /// the launch clutch blended at cdbo's own step) on 287, 279 and 290.
 #[test]
 fn the_simulator_still_agrees_with_the_games_kept_laps() {
@@ -756,7 +755,7 @@ fn a_short_race_writes_its_results() {
     ];
     let v = json(args);
     // Learning in cdbo's simulator keeps a reserve unless told otherwise, the robust learner
-    // issue 34's transfer asks for: the wheels 0.25 m off slippery ground, the body 1 m off the
+    // a transfer to the game asks for: the wheels 0.25 m off slippery ground, the body 1 m off the
     // walls, and on a road whose verges are not known (this one) the car's centre 1 m inside
     // its edge.
     assert_eq!(v["off_track_margin_m"].as_f64(), Some(-1.0));

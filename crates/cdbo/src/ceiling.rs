@@ -268,8 +268,7 @@ mod tests {
     /// Past some scale a lap can complete and yet be slower: on Ridgeway's minimum-curvature
     /// line, with the path tracker, the two-track Spirit 300 completes the whole profile
     /// (k = 1, the bisection's top) sliding out of the hairpins, slower than its lap a few
-    /// hundredths below, which the ceiling takes: above 95 % of the centre line's limit
-    /// (issue 35).
+    /// hundredths below, which the ceiling takes: above 95 % of the centre line's limit.
     #[test]
     fn an_over_driven_lap_is_not_the_ceiling() {
         use crate::drive::steering::Steering;

@@ -33,7 +33,7 @@ fn observed_with(track: &Track, base: &Car, truth: &Scales) -> TrackLaps {
 /// Grip 15 % down and the launch 15 % up on the Spirit 300 round Ridgeway: the fit of those
 /// two from the stock car, on all five probes, finds both within 1 % (measured 0.8519 and
 /// 1.1520), and its cost falls more than two-hundredfold (1.84 to 0.00051 in 59 evaluations;
-/// with COBYLA, until session 36, 0.00086 and a launch of 1.131); the same fit again gives the
+/// with COBYLA, the fit it replaced, 0.00086 and a launch of 1.131); the same fit again gives the
 /// same scales to the bit. (On the launch-and-brake and the open-loop
 /// fast probe alone, since the road's vertical curvature loads the car, it stopped at a launch
 /// of 1.18.)
@@ -72,7 +72,7 @@ fn the_fit_recovers_known_scales_from_its_own_laps() {
 /// every 4 ms and per axle rather than as the robot eases its one brake command once a driver
 /// step, cdbo's car braked at 3 g where the game's brakes at 2.5 g, shifted down early,
 /// coasted a gear too low and stopped at 944 m, 8 m/s behind at 600 m: cost 46, 6.8 m/s RMS,
-/// the most of the calibration's (session 37).
+/// the most of the calibration's.
 #[test]
 fn the_stock_car_brakes_and_coasts_as_the_games_does() {
     let Some(_) = common::shared_if_present("") else {
@@ -116,7 +116,7 @@ fn the_stock_car_brakes_and_coasts_as_the_games_does() {
 /// resistance along a long valley, and grip with its peak slip and the downforce (measured:
 /// grip 0.9278 / 0.93, peak slip 1.2107 / 1.2, drag 1.0981 / 1.1, downforce 0.8110 / 0.8,
 /// rolling 1.4632 / 1.5, launch 0.8071 / 0.8; cost 0.935 → 0.00318, 294-fold, in 238
-/// evaluations; COBYLA, the fit until session 36, stopped in that valley at the budget with
+/// evaluations; COBYLA, the fit it replaced, stopped in that valley at the budget with
 /// drag 1.042, rolling 1.370, downforce 0.957, cost 0.0355). The fast probe is closed loop
 /// (the profile hold at k = 0.75 on Forza, 0.7 on E-Track 2), so the truth's car completes it
 /// as the stock car does; as an open-loop pedal table it stalled on E-Track 2 under the

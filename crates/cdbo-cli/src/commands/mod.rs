@@ -86,7 +86,7 @@ pub struct OffTrackArgs {
     /// slippery ground (grass, sand), the body 1 m off the walls, the car's centre on the road
     /// (1 m inside its edge where the track gives no verges): the pattern search's best policy
     /// learned so completes in the game on 21, 19 and 21 of TORCS's 21 road tracks (seeds 0–2),
-    /// against 1 at 1 m (docs/results/torcs.md, "Session 38").
+    /// against 1 at 1 m (docs/results/torcs.md).
     #[arg(long, allow_negative_numbers = true, value_parser = value::off_track_margin)]
     pub off_track_margin: Option<f64>,
 }

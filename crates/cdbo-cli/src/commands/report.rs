@@ -57,7 +57,7 @@ fn colour(method: &str) -> RGBColor {
 }
 
 /// The failure budgets a report weighs methods by, as shares of a run's laps: 10 % (30 of the
-/// paper's 300 laps, issue 36's cap for a real car) and 30 % (a crash every third lap, where
+/// paper's 300 laps, the cap for a real car) and 30 % (a crash every third lap, where
 /// the pattern search and CDBO sit).
 const FAILURE_SHARES: [f64; 2] = [0.1, 0.3];
 

@@ -65,8 +65,7 @@ pub struct CompareArgs {
     seeds: u64,
     /// Where the learned policies' laps fail while they learn in cdbo's simulator, as `cdbo
     /// race --off-track-margin` (m past the road's edge; default as `cdbo race`: the learning
-    /// reserve, the wheels off slippery ground and the body off the walls; 1, the game's rule,
-    /// was the default before session 35). Every drawn policy is judged at the game's rule in
+    /// reserve, the wheels off slippery ground and the body off the walls; 1: the game's rule). Every drawn policy is judged at the game's rule in
     /// both simulators.
     #[arg(long, allow_negative_numbers = true, value_parser = super::value::off_track_margin)]
     off_track_margin: Option<f64>,

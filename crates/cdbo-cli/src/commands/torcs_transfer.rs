@@ -71,8 +71,9 @@ pub struct TransferArgs {
     out: PathBuf,
     /// A transfer report (an earlier run's transfer.json, or a file of its shape) to read the
     /// best rewards against: each track's as a share of the report's on that track (the mean
-    /// over its seeds), and each seed's count of tracks at ≥ 95 % of it (issue 34's pace line;
-    /// docs/results/torcs/transfer-session19.json is that issue's reference).
+    /// over its seeds), and each seed's count of tracks at ≥ 95 % of it (the pace line;
+    /// docs/results/torcs/transfer-bc6f3c4.json is the reference, the transfer measured at
+    /// bc6f3c4).
     #[arg(long, value_name = "transfer.json")]
     against: Option<PathBuf>,
     /// Print transfer.json rather than the table.

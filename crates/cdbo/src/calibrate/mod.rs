@@ -600,7 +600,7 @@ pub struct FitConfig {
 /// The fit's default budget of cost evaluations. Six scales from the stock car cross a long
 /// valley where drag trades with rolling resistance: measured on the six-scale recovery
 /// (`tests/calibrate.rs`), least squares stops in 238 evaluations with every scale within
-/// 2.5 % (COBYLA, before session 36, stopped at 300 with drag 5 % short).
+/// 2.5 % (COBYLA, the fit it replaced, stopped at 300 with drag 5 % short).
 pub const DEFAULT_EVALUATIONS: usize = 300;
 
 impl Default for FitConfig {

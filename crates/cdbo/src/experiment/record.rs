@@ -38,8 +38,8 @@ pub struct RunRecord {
     pub limit_reward_mps: f64,
     /// Reward of the ceiling: the tracked limit profile's lap
     /// ([`tracked_profile`](crate::ceiling::tracked_profile)), the crest-aware profile's
-    /// ([`profile`](crate::ceiling::profile)) in records written after session 20; absent in
-    /// records written before it was stored.
+    /// ([`profile`](crate::ceiling::profile)) in records that store it; absent in records
+    /// written before it was stored.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ceiling_reward_mps: Option<f64>,
     /// Reward of the initial policy π(w₀).

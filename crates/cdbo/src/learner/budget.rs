@@ -1,4 +1,4 @@
-//! A budget of failed laps around any method (issue 36's hard cap): the method proposes laps as
+//! A budget of failed laps around any method, a hard cap: the method proposes laps as
 //! usual until `max_failed` of them have failed; from then on only the best completed lap is
 //! driven again. In a deterministic simulator that lap completes again, so a run fails at most
 //! `max_failed` laps; on a real car it is the lap the learner is most certain of.

@@ -74,7 +74,7 @@ pub fn race_bytes(method: Method, kernels: usize, laps: usize) -> f64 {
 /// cdbo's to know), roughly: one CDBO suggestion over n observations costs about
 /// 0.35 µs · M · n (the acquisition's coordinate scans), summed over the laps
 /// 1.75e-7 · M · n², and the GP's refits 8e-8 · n³ as in [`race_seconds`]; other methods in
-/// proportion (`optimizer_seconds`). Calibrated on `cdbo bench suggest` (session 10, both
+/// proportion (`optimizer_seconds`). Calibrated on `cdbo bench suggest` (both
 /// cores busy): 300 observations in 30, 300 and 1000 dimensions, a median 2.9, 28.7 and 110 ms
 /// per CDBO suggestion; this gives 3.7 s for CDBO's optimiser over a 300-lap, 100-kernel
 /// race, where the README's Forza-100 races measured 4.1–5.0 s under load (the estimate was

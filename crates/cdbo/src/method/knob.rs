@@ -82,7 +82,7 @@ impl Knob {
 }
 
 impl Method {
-    /// The method's one main knob (issue 15: every peer's is chosen by the same small sweep on
+    /// The method's one main knob (every peer's is chosen by the same small sweep on
     /// the training panels ridgeway-30, forza-30, e-track-2-30 and forza-50, 300 laps, seeds
     /// from 100, by the mean best reward of the four; docs/results/beyond): random search's σ
     /// 0.01, CMA-ES's σ₀ 0.03, the pattern search's first step 0.15 (seeds 100–105); TuRBO's

@@ -195,9 +195,9 @@ pub struct LapConfig {
 ///   give (the built-in and CSV tracks), [`LapConfig::off_track_margin`] (by default
 ///   [`LEARNING_OFF_TRACK_MARGIN`], a metre inside it): nothing is known past that edge.
 ///
-/// Measured on TORCS's 21 road tracks over seeds 0–2 (docs/results/torcs.md, "Session 38"):
+/// Measured on TORCS's 21 road tracks over seeds 0–2 (docs/results/torcs.md):
 /// the pattern search's best policies complete in the game on 21, 19 and 21 of 21, against 19,
-/// 20 and 20 with the car's centre a metre inside every edge, at 95.7 % of issue 34's
+/// 20 and 20 with the car's centre a metre inside every edge, at 95.7 % of the transfer's
 /// reference reward on average against 95.5 %.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Reserve {
@@ -230,8 +230,8 @@ pub const GAME_OFF_TRACK_MARGIN: f64 = 1.0;
 /// does not give ([`Reserve`]; the built-in and CSV tracks): the car's centre 1 m *inside* the
 /// road's edge, two metres short of the game's rule. A policy learned at the very edge the
 /// simulator allows leaves the road wherever the world it is then driven in is a little
-/// harsher; on TORCS's road tracks this metre, everywhere, was the robust learner's reserve in
-/// sessions 35–37 (docs/results/torcs.md, "Session 35"). Learning in the game itself takes the
+/// harsher; on TORCS's road tracks this metre, everywhere, was the robust learner's reserve
+/// (docs/results/torcs.md). Learning in the game itself takes the
 /// game's rule.
 pub const LEARNING_OFF_TRACK_MARGIN: f64 = -1.0;
 

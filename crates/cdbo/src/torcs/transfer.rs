@@ -1,6 +1,7 @@
 //! The reference a transfer is read against (`cdbo torcs transfer --against`): the best reward
 //! each track's race reached in an earlier run, so that a new run's rewards read as a share of
-//! it, track by track (issue 34 reads the transfer's pace against session 19's).
+//! it, track by track (docs/results/torcs/transfer-bc6f3c4.json, the transfer measured at
+//! bc6f3c4, is the reference the pace line is read against).
 //!
 //! The file is a transfer report (`transfer.json`, as `cdbo torcs transfer` writes it) or any
 //! JSON object of that shape: `{"transfers": [{"track": T, "best_reward_mps": r}, …]}`, other
@@ -86,13 +87,13 @@ mod tests {
         assert_eq!(r["aalborg"], 30.0);
     }
 
-    /// Issue 34's reference, kept in docs/results/torcs: session 19's best laps on the 21 road
+    /// The reference kept in docs/results/torcs: the best laps measured at bc6f3c4 on the 21 road
     /// tracks, as rewards (Forza: its 5,784.11 m in 111.21 s).
     #[test]
-    fn issue_34s_reference_reads_as_session_19s_laps() {
+    fn the_kept_reference_reads_as_its_laps() {
         let path = concat!(
             env!("CARGO_MANIFEST_DIR"),
-            "/../../docs/results/torcs/transfer-session19.json"
+            "/../../docs/results/torcs/transfer-bc6f3c4.json"
         );
         let text = std::fs::read_to_string(path).unwrap();
         let r = reference(&text, path).unwrap();

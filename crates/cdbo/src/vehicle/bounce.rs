@@ -13,7 +13,7 @@
 //! away and back by 0.2 to 0.5 rad/s within 0.1 s: 13 of 17 such jolts on the 20 learned
 //! policies' laps within 4 m of a kink past the random place's 90th percentile), and replayed
 //! from the game's logs cdbo's car with the kinks parts from it by 20 % less in yaw rate on
-//! the road and 32 % less under braking (docs/results/torcs.md, "Session 35").
+//! the road and 32 % less under braking (docs/results/torcs.md).
 //! At simuv2's own step Δt = 2 ms ([`SIMUV2_STEP`]), each wheel with e its suspension's
 //! extension past the quasi-static length (m, at the wheel), u its speed towards the body
 //! (simuv2's `rel_vel`), b the rise of the body's corner above it and F_qs the load the car's

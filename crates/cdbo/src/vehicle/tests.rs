@@ -225,7 +225,7 @@ fn the_rolling_resistance_turns_against_the_yaw() {
 /// The slipping launch clutch blends the engine's speed with the wheels' at the game's own
 /// 2 ms step, whatever cdbo's: pulling away at half throttle with the clutch 70 % open
 /// (τ = 0.3), the engine's speed after 0.15 s at steps of 2 and 4 ms agrees within 1 %
-/// (blending by τ⁴ once per 4 ms step, as before session 33, left it 23 % higher).
+/// (blending by τ⁴ once per 4 ms step instead left it 23 % higher).
 #[test]
 fn the_launch_clutch_blends_at_the_games_step() {
     let v = Vehicle::new(&Car::spirit_300());

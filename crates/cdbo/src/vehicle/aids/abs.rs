@@ -11,7 +11,7 @@
 //! slipping more, and it shifted down early (into second 150 m early) and coasted a gear too
 //! low: the calibration's launch-and-brake probe cost 46 against the game's laps (0.18 with
 //! the robot's ABS), and the fit bent the tyre and the aero to match it
-//! (docs/results/torcs.md, "Session 37").
+//! (docs/results/torcs.md).
 
 /// The brake command after ABS, b·Πₖ clamp(2 − σₖ/σ*ₖ, 0, 1) over the axles (front, rear)
 /// whose slide σₖ passes a positive threshold σ*ₖ.

@@ -1,8 +1,7 @@
 //! The robot's traction control, defined here for the robot's `drive::traction_throttle`
 //! (`torcs-robot/drive.hpp`), which `tests/robot_drive.rs` checks against it; cdbo's simulator
 //! eases a car the robot drives by the same law, at every physics step (at the driver's steps,
-//! as the robot does, it fitted the game's fast laps less well: docs/results/torcs.md,
-//! "Session 37").
+//! as the robot does, it fitted the game's fast laps less well: docs/results/torcs.md).
 //!
 //! cdbo's vehicle eases another car's throttle inside its physics step, on the driven axle's
 //! relative slip past the aid threshold ([`crate::vehicle::Vehicle::aid_threshold`]): eased to
