@@ -537,7 +537,7 @@ fn speed_at(rows: &[(f64, f64)], s: f64) -> f64 {
     rows[i.saturating_sub(1).min(rows.len() - 1)].1
 }
 
-/// Renders `f` into a PNG or SVG file chosen by the extension.
+/// Renders `f` into a PNG or SVG file chosen by the extension; every error names the file.
 pub fn draw(path: &Path, figure: &impl Figure) -> CliResult {
     static FONT: Once = Once::new();
     FONT.call_once(|| {
@@ -548,25 +548,31 @@ pub fn draw(path: &Path, figure: &impl Figure) -> CliResult {
             dejavu::sans::regular(),
         );
     });
-    match path.extension().and_then(|e| e.to_str()) {
-        Some("svg") => {
+    let folder = path.parent().filter(|p| !p.as_os_str().is_empty());
+    if let Some(folder) = folder.filter(|f| !f.is_dir()) {
+        return Err(format!(
+            "{}: cannot write the plot: the folder {} does not exist",
+            path.display(),
+            folder.display()
+        )
+        .into());
+    }
+    let drawn: CliResult = match path.extension().and_then(|e| e.to_str()) {
+        Some("svg") => (|| {
             let root = SVGBackend::new(path, figure.size()).into_drawing_area();
             root.fill(&WHITE)?;
             figure.render(&root)?;
             root.present()?;
-        }
-        Some("png") => {
+            Ok(())
+        })(),
+        Some("png") => (|| {
             let root = BitMapBackend::new(path, figure.size()).into_drawing_area();
             root.fill(&WHITE)?;
             figure.render(&root)?;
-            root.present()
-                .map_err(|e| format!("{}: {e}", path.display()))?;
-        }
-        _ => {
-            return Err(
-                format!("{}: the plot file must end in .png or .svg", path.display()).into(),
-            );
-        }
-    }
-    Ok(())
+            root.present()?;
+            Ok(())
+        })(),
+        _ => Err("the plot file must end in .png or .svg".into()),
+    };
+    drawn.map_err(|e| format!("{}: {e}", path.display()).into())
 }

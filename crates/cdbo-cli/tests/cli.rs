@@ -423,6 +423,19 @@ const TRACK: &str = r#"<?xml version="1.0"?>
 </params>
 "#;
 
+/// A plot into a folder that does not exist names the file and the folder, in one line.
+#[test]
+fn a_plot_into_a_missing_folder_names_the_path() {
+    fails_with(
+        &["plot", "track", "ridgeway", "-o", "/missing/dir/x.svg"],
+        &["/missing/dir/x.svg", "/missing/dir does not exist"],
+    );
+    fails_with(
+        &["plot", "track", "ridgeway", "-o", "/missing/dir/x.png"],
+        &["/missing/dir/x.png", "does not exist"],
+    );
+}
+
 #[test]
 fn a_hand_written_track_file_loads() {
     let p = scratch("oval.xml", TRACK);
@@ -572,7 +585,7 @@ fn the_box_radius_bounds_the_search() {
     );
     let (radius, moved) = farthest(None);
     assert!(radius == 1.5 && moved > 0.1, "{radius} {moved}");
-    for bad in ["0", "-1", "nan"] {
+    for bad in ["0", "-1", "nan", "inf", "1e308", "1000.5"] {
         let out = cdbo(&["race", "--laps", "2", "--box-radius", bad]);
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(

@@ -283,6 +283,18 @@ pub mod value {
             Err("must be above 0".into())
         }
     }
+    /// A search box's half-width: above 0, at most [`cdbo::optimizers::MAX_BOX_RADIUS`].
+    pub fn box_radius(text: &str) -> Result<f64, String> {
+        let v = positive(text)?;
+        if v <= cdbo::optimizers::MAX_BOX_RADIUS {
+            Ok(v)
+        } else {
+            Err(format!(
+                "must be at most {}: the weights saturate within a few units",
+                cdbo::optimizers::MAX_BOX_RADIUS
+            ))
+        }
+    }
     /// A finite number of at least zero (β, the ridge factor).
     pub fn non_negative(text: &str) -> Result<f64, String> {
         let v = number(text)?;

@@ -89,7 +89,7 @@ pub struct InitialPolicy {
     max_failed_laps: Option<usize>,
     /// Half-width r of the box [w₀ − r, w₀ + r] the method searches, as `cdbo race
     /// --box-radius` (default 1.5).
-    #[arg(long, value_name = "R", allow_negative_numbers = true, value_parser = super::value::positive)]
+    #[arg(long, value_name = "R", allow_negative_numbers = true, value_parser = super::value::box_radius)]
     box_radius: Option<f64>,
     /// The line, as `cdbo race --line` (with `--line learn`, w₀'s line is the base line, d = 0,
     /// unless --weights gives one).

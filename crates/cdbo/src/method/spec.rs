@@ -88,10 +88,10 @@ impl Spec {
         Ok(Spec { beta, ..self })
     }
 
-    /// This specification searching the box [w₀ − r, w₀ + r], refused unless r is finite and
-    /// positive.
+    /// This specification searching the box [w₀ − r, w₀ + r], refused unless
+    /// 0 < r ≤ [`MAX_BOX_RADIUS`](crate::optimizers::MAX_BOX_RADIUS).
     pub fn box_radius(self, box_radius: f64) -> Result<Spec> {
-        let box_radius = positive("the search-box radius", box_radius)?;
+        crate::optimizers::SearchBox::around(&[], box_radius)?;
         Ok(Spec { box_radius, ..self })
     }
 
@@ -425,5 +425,17 @@ mod tests {
             assert_eq!(a.evaluations(), 80);
             assert!(a.best().unwrap().1 > 10.0, "seed {seed}: no gain");
         }
+    }
+
+    /// A search box is refused where it is not positive, not finite, or past the bound the
+    /// weights saturate within; the bound itself is taken.
+    #[test]
+    fn a_box_radius_past_its_bound_is_refused() {
+        let spec = Spec::race(Method::Cdbo);
+        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY, 1e308, 1000.5] {
+            let e = spec.box_radius(bad).unwrap_err().to_string();
+            assert!(e.contains("search-box radius"), "{bad}: {e}");
+        }
+        assert!(spec.box_radius(crate::optimizers::MAX_BOX_RADIUS).is_ok());
     }
 }

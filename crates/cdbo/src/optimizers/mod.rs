@@ -134,14 +134,20 @@ pub struct SearchBox {
 /// The default half-width r of the search box around w₀.
 pub const DEFAULT_BOX_RADIUS: f64 = 1.5;
 
+/// The largest half-width r of a search box. A policy's weights act through
+/// clamp(wᵀφ(x), −1, 1) with 0 ≤ φ ≤ 1, so they saturate within a few units, and the test
+/// functions' domains (Ackley's ±32.768) fit well inside; a larger box only dilutes the
+/// search, and far larger ones (1e308) overflow its arithmetic.
+pub const MAX_BOX_RADIUS: f64 = 1000.0;
+
 impl SearchBox {
     /// [w₀ − r, w₀ + r].
     pub fn around(w0: &[f64], radius: f64) -> Result<SearchBox> {
-        if !(radius.is_finite() && radius > 0.0) {
+        if !(radius.is_finite() && radius > 0.0 && radius <= MAX_BOX_RADIUS) {
             return Err(Error::invalid_value(
                 "the search-box radius",
                 radius,
-                "positive",
+                format!("in (0, {MAX_BOX_RADIUS}]"),
             ));
         }
         Ok(SearchBox {
