@@ -1,4 +1,4 @@
-"""Issue 36's benchmark: 6 seeds x 300 laps on four panels, the mean best reward, the mean
+"""The budget benchmark: 6 seeds x 300 laps on four panels, the mean best reward, the mean
 failed laps and the worst seed per panel.
 
     python3 docs/results/budget/bench.py OUT target/release/cdbo safe-pattern-search [--max-failed-laps N]
