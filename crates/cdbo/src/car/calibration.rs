@@ -15,7 +15,7 @@
 //! launch = 0.80            # drive torque in first gear
 //! ```
 //!
-//! Why these six: the demonstrations agree within 0.3 % (docs/results/torcs.md), so what
+//! Why these six: the demonstrations agree within 0.79 % on the 38 installed tracks (docs/results/torcs.md), so what
 //! is left between cdbo's simulator and the game (or a real car) is in what the car file
 //! does not pin down: the tyre's grip and shape, the aerodynamic maps (simuv2's body downforce
 //! depends on ride height), the surface's rolling resistance, and the launch (the robot's

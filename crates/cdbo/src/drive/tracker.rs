@@ -66,7 +66,7 @@ pub const YAW_RATE_GAIN: f64 = 4.0;
 /// Chosen by measurement: the Spirit 300's laps reach at most 1.59 with c = min(c_max, v/v_y)
 /// and do not ring (0.003 rad a step), car1-trb1's reached 1.9–2.8 with c_max = 4 and rang at
 /// 0.09–0.17 rad a step from 20 m/s up, in cdbo's simulator and in the game alike
-/// (docs/results/torcs.md, "Transfer at −1.5 m"); at a flat c = 2.5 (one-step gains up to 1.75)
+/// (docs/results/torcs.md, "The path tracker's one-step bound"); at a flat c = 2.5 (one-step gains up to 1.75)
 /// they rang at 0.0003–0.002 rad.
 pub const YAW_STEP_GAIN: f64 = 1.6;
 /// The driver step T (s) the law acts at, in cdbo's simulator and in the game (TORCS's robots

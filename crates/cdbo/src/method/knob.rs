@@ -85,7 +85,7 @@ impl Method {
     /// The method's one main knob (every peer's is chosen by the same small sweep on
     /// the training panels ridgeway-30, forza-30, e-track-2-30 and forza-50, 300 laps, seeds
     /// from 100, by the mean best reward of the four; docs/results/beyond): random search's σ
-    /// 0.01, CMA-ES's σ₀ 0.03, the pattern search's first step 0.15 (seeds 100–105); TuRBO's
+    /// 0.01, CMA-ES's σ₀ 0.03, the pattern search's first step 0.05 (seeds 100–105); TuRBO's
     /// L_init 0.03 (TuRBO: 0.8), LineBO's step 0.3 (LineBO: the whole line), REMBO-5d's box
     /// 0.1 and REMBO-10d's 0.03 (REMBO: √d) (seeds 100–102). CDBO and BO-CMA-ES keep the
     /// paper's σ₀.
