@@ -15,7 +15,7 @@ import cdbo
 laps = int(sys.argv[1]) if len(sys.argv) > 1 else 300
 seed = int(sys.argv[2]) if len(sys.argv) > 2 else 0
 env = cdbo.RaceEnv("ridgeway", kernels=30)
-low, high = env.action_space.low, env.action_space.high
+low, high = env.low, env.high
 
 # pycma minimises: the lap's reward L/T (m/s) with a minus sign, one lap per evaluation.
 es = cma.CMAEvolutionStrategy(

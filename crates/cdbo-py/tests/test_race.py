@@ -66,11 +66,10 @@ def test_a_python_loop_over_optimizer_and_env_is_the_librarys_race(method, knob)
     for _ in range(laps):
         env.reset()
         w = opt.ask()
-        _, reward, terminated, truncated, info = env.step(w)
-        assert terminated and not truncated
-        assert (info["failure"] is None) == info["completed"]
-        opt.tell(w, reward, failed_at=info["x_fail"], too_slow=info["too_slow"])
-        rewards.append(reward)
+        lap = env.lap(w)
+        assert (lap.failure is None) == lap.completed
+        opt.tell(w, lap)
+        rewards.append(lap.reward)
     assert rewards == [lap["reward"] for lap in result.laps]
     assert opt.best[1] == result.best_reward
     # The best policy drives the best lap again.
@@ -138,14 +137,32 @@ def test_race_refuses_bad_settings():
 def test_the_environment_works_without_gymnasium_and_registers_with_it():
     env = cdbo.RaceEnv(kernels=10)
     assert env.action_space.shape == (10,)
-    assert np.array_equal(env.action_space.low, env.w0 - cdbo.DEFAULT_BOX_RADIUS)
+    assert np.array_equal(env.action_space.low, -np.ones(10))
+    assert np.array_equal(env.action_space.high, np.ones(10))
+    assert np.array_equal(env.low, env.w0 - cdbo.DEFAULT_BOX_RADIUS)
     obs, info = env.reset(seed=0)
-    _, reward, *_ = env.step(env.w0)
+    _, reward, terminated, truncated, info = env.step(np.zeros(10))
+    assert terminated and not truncated and info["completed"]
     assert reward == cdbo.Simulator().lap(cdbo.Policy(env.w0, env.lengthscale)).reward
+    edge = np.full(10, -1.0)
+    assert env.step(edge)[1] == env.lap(env.low).reward
     gymnasium = pytest.importorskip("gymnasium")
     made = gymnasium.make("cdbo/Race-v0", kernels=10)
     made.reset(seed=0)
-    assert made.step(env.w0)[1] == reward
+    assert made.step(np.zeros(10))[1] == reward
+
+
+def test_gymnasiums_check_passes_without_a_warning():
+    """gymnasium's own ``check_env`` finds the action space symmetric and normalised and the
+    environment well formed: every warning it gives fails here."""
+    import warnings
+
+    gymnasium = pytest.importorskip("gymnasium")
+    from gymnasium.utils.env_checker import check_env
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_env(cdbo.RaceEnv(kernels=10), skip_render_check=True)
 
 
 def test_the_gil_is_released_while_laps_run():

@@ -58,8 +58,11 @@ class RaceEnv(_Base):
 
     ``reset()`` returns ``(obs, info)`` and ``step(w)`` returns ``(obs, reward, terminated,
     truncated, info)`` with ``terminated=True``: each episode is one lap. The observation is
-    a constant (there is nothing to observe before a lap). ``action_space`` is the box
-    [w0 - bounds, w0 + bounds] the library's optimisers search; the weights are not clipped.
+    a constant (there is nothing to observe before a lap). ``action_space`` is [-1, 1]^d,
+    symmetric and normalised as gymnasium asks: ``step(u)`` drives the weights
+    ``w = w0 + bounds * u`` (``weights(u)``), which span the box [``low``, ``high``] =
+    [w0 - bounds, w0 + bounds] the library's optimisers search; ``lap(w)`` drives weights
+    directly. Actions are not clipped.
     ``w0``, ``lengthscale`` and ``track_length`` (m) are what ``cdbo.Optimizer`` is told to
     race as ``cdbo race`` does.
 
@@ -122,7 +125,8 @@ class RaceEnv(_Base):
         self.w0 = np.concatenate([self.initial.weights, np.zeros(m)])
         self.track_length = self.simulator.track.length
         self.bounds = bounds
-        self.action_space = _box(self.w0 - bounds, self.w0 + bounds)
+        self.low, self.high = self.w0 - bounds, self.w0 + bounds
+        self.action_space = _box(-np.ones_like(self.w0), np.ones_like(self.w0))
         self.observation_space = _box(np.zeros(1), np.ones(1))
         self.last = None
 
@@ -144,8 +148,18 @@ class RaceEnv(_Base):
             super().reset(seed=seed)
         return np.zeros(1), {}
 
+    def weights(self, action):
+        """The weights an action u in [-1, 1]^d stands for: ``w0 + bounds * u``."""
+        u = np.asarray(action, dtype=np.float64)
+        if u.shape != self.w0.shape:
+            raise ValueError(f"the action has {u.size} weights; this race's have {self.w0.size}")
+        return self.w0 + self.bounds * u
+
     def step(self, action):
-        w = np.asarray(action, dtype=np.float64)
+        return self._drive(self.weights(action))
+
+    def _drive(self, w):
+        w = np.asarray(w, dtype=np.float64)
         if w.shape != self.w0.shape:
             raise ValueError(f"the action has {w.size} weights; this race's have {self.w0.size}")
         policy = Policy(w[: self.kernels], self.lengthscale)
@@ -162,12 +176,12 @@ class RaceEnv(_Base):
         return np.zeros(1), lap.reward, True, False, info
 
     def lap(self, w):
-        """One lap with weights ``w`` (``step`` without the episode): its ``LapResult``.
+        """One lap with weights ``w`` (not an action: the optimiser's weights): its ``LapResult``.
 
         ``opt.tell(w, env.lap(w))`` tells the optimiser the reward and, for a failed lap,
         where and why it failed; ``float(env.lap(w))`` is the reward alone.
         """
-        self.step(w)
+        self._drive(w)
         return self.last
 
 
