@@ -270,12 +270,15 @@ impl ExperimentConfig {
         if let Some(margin) = self.off_track_margin {
             checked_off_track_margin(margin)?;
         }
-        if self.methods.is_empty() || self.tracks.is_empty() {
-            return Err(Error::too_small(
-                "methods and tracks",
-                self.methods.len().min(self.tracks.len()),
-                1,
+        if self.methods.is_empty() {
+            return Err(Error::invalid_value(
+                "the grid's methods",
+                "none",
+                "at least one, as methods = [\"cdbo\"] or preset = \"fast-safe\"",
             ));
+        }
+        if self.tracks.is_empty() {
+            return Err(Error::too_small("the grid's tracks", 0, 1));
         }
         for t in &self.tracks {
             if t.kernels.is_empty() {
@@ -514,7 +517,8 @@ mod tests {
     /// `preset = "fast-safe"` reads as the stack it names: its runs are the safe pattern
     /// search's, on the path tracker and the minimum-curvature line; the grid saved holds those
     /// settings, not the preset, and reads back the same. A key of the stack beside the preset
-    /// is refused naming the file and the key.
+    /// is refused naming the file and the key; a grid with neither methods nor a preset is
+    /// refused naming both.
     #[test]
     fn a_grid_preset_sets_the_method_the_steering_and_the_line() {
         let head = "laps = 3\nrepeats = 1\ntracks = [{track = \"x\", kernels = [5]}]\n";
@@ -565,6 +569,13 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("fastest") && e.contains("fast-safe"), "{e}");
+        let e = ExperimentConfig::from_toml(head, "g.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("g.toml") && e.contains("methods = [") && e.contains("preset = "),
+            "{e}"
+        );
     }
 
     #[test]
