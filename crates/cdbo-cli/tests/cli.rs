@@ -337,6 +337,26 @@ fn transfer_refuses_a_bad_reference_before_any_lap() {
     assert!(!out.exists());
 }
 
+/// `torcs transfer --preset fast-safe` learns with the stack it names (up to the reference,
+/// read before the game is asked for) and refuses a flag of that stack beside it, in one line
+/// naming both.
+#[test]
+fn transfer_takes_the_preset_but_not_beside_its_flags() {
+    let torn = scratch("torn-preset.json", r#"{"transfers": ["#);
+    let transfer = ["torcs", "transfer", "--preset", "fast-safe", "--against"];
+    fails_with(
+        &[&transfer[..], &[torn.to_str().unwrap()]].concat(),
+        &["torn-preset.json"],
+    );
+    for given in [
+        ["--method", "pattern-search"],
+        ["--steering", "pi"],
+        ["--line", "learn"],
+    ] {
+        fails_with(&[&transfer[..4], &given].concat(), &["--preset", given[0]]);
+    }
+}
+
 /// The game's laps kept beside the fidelity report (docs/results/torcs/panel_TRACK.jsonl, 300
 /// policies a track drawn around three learned ones, driven in TORCS 1.3.7): cdbo's simulator
 /// keeps agreeing with them. A change to the model that loses fidelity fails here, without the
@@ -857,7 +877,7 @@ fn a_race_says_by_which_rule_its_laps_failed() {
 }
 
 #[test]
-fn a_cdbo_race_points_to_the_learner_beyond_the_paper() {
+fn a_cdbo_race_points_to_the_recommended_stack() {
     let out = Path::new(env!("CARGO_TARGET_TMPDIR"))
         .join(format!("cdbo-cli-race-hint-{}", std::process::id()));
     let dir = out.to_str().unwrap();
@@ -865,10 +885,80 @@ fn a_cdbo_race_points_to_the_learner_beyond_the_paper() {
         let args = ["race", "--laps", "3", "--method", method, "--out", dir];
         String::from_utf8(succeed(&args).stdout).unwrap()
     };
-    let hint = "--method pattern-search";
+    let hint = "`cdbo race --preset fast-safe`";
     assert!(race("cdbo").contains(hint));
     assert!(!race("pattern-search").contains(hint));
     let _ = std::fs::remove_dir_all(&out);
+}
+
+/// `--preset fast-safe` races as its long form, `--method safe-pattern-search --steering
+/// tracker --line min-curvature`, bit for bit: the same best reward and the same laps, and the
+/// summary names the stack; the preset keeps `--max-failed-laps`; beside a flag it sets, it is
+/// refused in one line naming both.
+#[test]
+fn the_fast_safe_preset_races_as_its_long_form() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("cdbo-cli-preset-{}", std::process::id()));
+    let race = |name: &str, stack: &[&str]| -> (serde_json::Value, String) {
+        let out = dir.join(name);
+        let mut args = vec!["race", "--laps", "30", "--out", out.to_str().unwrap()];
+        args.extend(stack);
+        succeed(&args);
+        let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
+        let laps = std::fs::read_to_string(out.join("laps.csv")).unwrap();
+        // Every column but the two timings.
+        let laps = laps
+            .lines()
+            .map(|l| l.rsplitn(3, ',').nth(2).unwrap().to_owned() + "\n")
+            .collect();
+        (serde_json::from_str(&summary).unwrap(), laps)
+    };
+    let (preset, preset_laps) = race("preset", &["--preset", "fast-safe"]);
+    let long_form = [
+        "--method",
+        "safe-pattern-search",
+        "--steering",
+        "tracker",
+        "--line",
+        "min-curvature",
+    ];
+    let (long, long_laps) = race("long", &long_form);
+    let bits = |v: &serde_json::Value| v["best_reward_mps"].as_f64().unwrap().to_bits();
+    assert_eq!(bits(&preset), bits(&long));
+    assert_eq!(preset_laps, long_laps);
+    assert_eq!(preset_laps.lines().count(), 31, "{preset_laps}");
+    for (key, value) in [
+        ("method", "safe-pattern-search"),
+        ("steering", "tracker"),
+        ("base_line", "min-curvature"),
+    ] {
+        assert_eq!(preset[key], value, "{preset}");
+    }
+    let (paper, paper_laps) = race("paper", &[]);
+    assert_ne!(bits(&paper), bits(&preset));
+    assert_ne!(paper_laps, preset_laps);
+    let (budget, _) = race(
+        "budget",
+        &["--preset", "fast-safe", "--max-failed-laps", "2"],
+    );
+    assert_eq!(budget["max_failed_laps"], 2);
+    assert!(budget["failed_laps"].as_u64().unwrap() <= 2, "{budget}");
+    for given in [
+        ["--method", "cdbo"],
+        ["--steering", "pi"],
+        ["--line", "centre"],
+        ["--line-start", "centre"],
+        ["--line-kernels", "4"],
+    ] {
+        let args = [
+            &["race", "--laps", "3", "--preset", "fast-safe"][..],
+            &given,
+        ]
+        .concat();
+        fails_with(&args, &["--preset", given[0]]);
+    }
+    fails_with(&["race", "--preset", "fastest"], &["fastest", "fast-safe"]);
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]

@@ -498,3 +498,45 @@ fn a_grid_keeps_its_off_track_margin_as_race_does() {
         "{err}"
     );
 }
+
+/// A grid's `preset = "fast-safe"` races every run as `cdbo race --preset fast-safe` does at
+/// the grid's knob (the same best, bit for bit): its runs are the safe pattern search's, their
+/// records name the path tracker and the minimum-curvature line, and the grid kept in the
+/// folder names the stack, not the preset.
+#[test]
+fn a_grid_of_the_preset_races_as_race_does() {
+    let dir = fresh_dir("grid-preset");
+    let grid = "laps = 8\nrepeats = 1\npreset = \"fast-safe\"\n\
+                [[tracks]]\ntrack = \"ridgeway\"\nkernels = [6]\n";
+    std::fs::write(dir.join("grid.toml"), grid).unwrap();
+    ok(&dir, &["experiment", "grid.toml", "--out", "g"]);
+    let run: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.join("g/runs/ridgeway-m6-safe-pattern-search-r0.json"))
+            .unwrap(),
+    )
+    .unwrap();
+    assert_eq!(run["spec"]["method"], "safe-pattern-search");
+    assert_eq!(run["steering"], "tracker");
+    assert_eq!(run["base_line"], "min-curvature");
+    let kept = std::fs::read_to_string(dir.join("g/experiment.toml")).unwrap();
+    assert!(
+        kept.contains("methods = [\"safe-pattern-search\"]") && !kept.contains("preset"),
+        "{kept}"
+    );
+    let args = [
+        "race",
+        "--preset",
+        "fast-safe",
+        "--kernels",
+        "6",
+        "--laps",
+        "8",
+        "--knob",
+        "0.03",
+        "--json",
+        "--out",
+        "r",
+    ];
+    let raced: serde_json::Value = serde_json::from_str(&ok(&dir, &args)).unwrap();
+    assert_eq!(run["best_reward_mps"], raced["best_reward_mps"]);
+}

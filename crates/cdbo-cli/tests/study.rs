@@ -515,3 +515,66 @@ fn a_study_steers_as_its_initial_policy_was_raced() {
     optimize.extend(["--steering", "pi"]);
     common::refused(&dir, &optimize, &["s.db", "--steering tracker", "not pi"]);
 }
+
+/// `--preset fast-safe` on `optimize` and `study create` stores the stack it names, the safe
+/// pattern search on the path tracker and the minimum-curvature line, and drives the laps its
+/// long form drives, reward for reward; a study of another stack resumed with it is refused
+/// naming the stored flags, and beside a flag it sets it is refused naming both.
+#[test]
+fn a_study_of_the_preset_is_its_long_form() {
+    let dir = fresh_dir_with_demo("study-preset");
+    let evaluator = EVALUATOR.replace("{cdbo}", CDBO);
+    let long_form = [
+        "--method",
+        "safe-pattern-search",
+        "--steering",
+        "tracker",
+        "--line",
+        "min-curvature",
+    ];
+    let drive = |db: &str, stack: &[&str]| -> Vec<Option<u64>> {
+        let mut args = common::optimize_args(&evaluator, db, 4);
+        args.extend(stack.iter().map(|s| s.to_string()));
+        ok(&dir, &args);
+        history(&dir, "s", db)
+            .iter()
+            .map(|t| t["reward"].as_f64().map(f64::to_bits))
+            .collect()
+    };
+    let preset = drive("preset.db", &["--preset", "fast-safe"]);
+    assert_eq!(preset.len(), 4);
+    assert_eq!(preset, drive("long.db", &long_form));
+    let status = ok(
+        &dir,
+        &["study", "status", "s", "--storage", "preset.db", "--json"],
+    );
+    let status: serde_json::Value = serde_json::from_str(&status).unwrap();
+    assert_eq!(status["method"], "safe-pattern-search");
+    assert_eq!(status["steering"], "tracker");
+    assert_eq!(status["line"], "min-curvature");
+    let created = common::create_study("c", &["--storage", "c.db", "--preset", "fast-safe"]);
+    ok(&dir, &created);
+    let status = ok(
+        &dir,
+        &["study", "status", "c", "--storage", "c.db", "--json"],
+    );
+    let status: serde_json::Value = serde_json::from_str(&status).unwrap();
+    assert_eq!(status["method"], "safe-pattern-search");
+    drive("paper.db", &[]);
+    let mut resumed = common::optimize_args(&evaluator, "paper.db", 4);
+    resumed.extend(["--preset".into(), "fast-safe".into()]);
+    common::refused(
+        &dir,
+        &resumed,
+        &[
+            "paper.db",
+            "--method cdbo --steering pi --line centre",
+            "--preset fast-safe",
+        ],
+    );
+    common::refused(
+        &dir,
+        &common::create_study("d", &["--preset", "fast-safe", "--steering", "pi"]),
+        &["--preset", "--steering"],
+    );
+}

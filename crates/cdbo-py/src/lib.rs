@@ -10,6 +10,7 @@
 
 mod convert;
 mod optimizer;
+mod preset;
 mod race;
 mod sim;
 mod study;
@@ -23,6 +24,10 @@ fn _cdbo(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add(
         "METHODS",
         cdbo::method::Method::ALL.map(|m| m.name()).to_vec(),
+    )?;
+    m.add(
+        "PRESETS",
+        cdbo::method::Preset::ALL.map(|p| p.name()).to_vec(),
     )?;
     m.add("DEFAULT_BETA", cdbo::acquisition::ucb::DEFAULT_BETA)?;
     m.add("DEFAULT_BOX_RADIUS", cdbo::optimizers::DEFAULT_BOX_RADIUS)?;
@@ -43,5 +48,6 @@ fn _cdbo(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sim::limit, m)?)?;
     m.add_function(wrap_pyfunction!(race::race, m)?)?;
     m.add_function(wrap_pyfunction!(race::resolve_line, m)?)?;
+    m.add_function(wrap_pyfunction!(preset::resolve_stack, m)?)?;
     Ok(())
 }

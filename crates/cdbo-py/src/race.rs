@@ -3,23 +3,23 @@
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
-use cdbo::drive::steering::SteeringLaw;
 use cdbo::experiment::race::{LapRecord, RaceConfig, RaceOutcome};
 use cdbo::line::{BaseLine, LineKind, LineSetting};
 use cdbo::sim::lap::checked_off_track_margin;
 
 use crate::convert::IntoPy;
+use crate::preset::Stack;
 use crate::sim::{PyLapResult, PyLimit, PyPolicy, car_from, track_from};
 
-/// The line a race asks for, from its Python arguments: `line` is `centre`, `min-curvature`
-/// or `learn`, `line_start` `centre` or `min-curvature`.
+/// The line a race asks for, from its Python arguments: `line`, and `line_start` `centre` or
+/// `min-curvature`.
 pub fn line_setting(
-    line: &str,
+    line: LineKind,
     kernels: Option<usize>,
     start: Option<&str>,
 ) -> PyResult<LineSetting> {
     Ok(LineSetting {
-        line: line.parse::<LineKind>().py()?,
+        line,
         kernels,
         start: start.map(str::parse::<BaseLine>).transpose().py()?,
     })
@@ -35,7 +35,7 @@ pub fn resolve_line(
     line_kernels: Option<usize>,
     line_start: Option<&str>,
 ) -> PyResult<(&'static str, Option<usize>)> {
-    let (base, m) = line_setting(line, line_kernels, line_start)?
+    let (base, m) = line_setting(line.parse().py()?, line_kernels, line_start)?
         .resolve(kernels)
         .py()?;
     Ok((base.name(), m))
@@ -141,9 +141,14 @@ impl PyRaceResult {
 }
 
 /// Learns a policy for a track exactly as `cdbo race` does (the same laps, bit for bit, for
-/// the same settings): drive the demonstration, fit w0, then `laps` laps of `method`, on the
-/// line `line` (`centre`, `min-curvature` or `learn`, with `line_kernels` and `line_start` as
-/// `cdbo race --line-kernels` and `--line-start`), steered by `steering` (`pi` or `tracker`),
+/// the same settings): drive the demonstration, fit w0, then `laps` laps of `method` (None:
+/// `cdbo`), on the line `line` (`centre`, the default, `min-curvature` or `learn`, with
+/// `line_kernels` and `line_start` as `cdbo race --line-kernels` and `--line-start`), steered
+/// by `steering` (`pi`, the default, or `tracker`); or with `preset="fast-safe"` (as `cdbo
+/// race --preset fast-safe`) in place of those five, the recommended stack: the safe pattern
+/// search (within its budget of 30 failed laps, or `max_failed`) on the path tracker and the
+/// minimum-curvature line, method="safe-pattern-search", steering="tracker",
+/// line="min-curvature" (one of those beside it raises `ValueError`);
 /// its laps failing `off_track_margin` m past the road's edge (as `--off-track-margin`; by
 /// default, None, keeping the reserve `cdbo race` learns with: the wheels 0.25 m off slippery
 /// ground, the body 1 m off the walls, the car's centre on the road, `LEARNING_OFF_TRACK_MARGIN`
@@ -153,13 +158,13 @@ impl PyRaceResult {
 /// --knob`; None: its tuned value); `progress(record)` is called after every lap with the
 /// lap's record (a dict).
 #[pyfunction]
-#[pyo3(signature = (track = None, car = None, *, method = "cdbo", kernels = 30, laps = 300, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, demo_speed = 15.0, knob = None, max_failed = None, data_dir = None, progress = None, line = "centre", line_kernels = None, line_start = None, steering = "pi", off_track_margin = None, bounds = None))]
+#[pyo3(signature = (track = None, car = None, *, method = None, kernels = 30, laps = 300, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, demo_speed = 15.0, knob = None, max_failed = None, data_dir = None, progress = None, line = None, line_kernels = None, line_start = None, steering = None, off_track_margin = None, bounds = None, preset = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn race(
     py: Python<'_>,
     track: Option<&Bound<'_, PyAny>>,
     car: Option<&Bound<'_, PyAny>>,
-    method: &str,
+    method: Option<&str>,
     kernels: usize,
     laps: usize,
     seed: u64,
@@ -169,25 +174,26 @@ pub fn race(
     max_failed: Option<usize>,
     data_dir: Option<&Bound<'_, PyAny>>,
     progress: Option<Py<PyAny>>,
-    line: &str,
+    line: Option<&str>,
     line_kernels: Option<usize>,
     line_start: Option<&str>,
-    steering: &str,
+    steering: Option<&str>,
     off_track_margin: Option<f64>,
     bounds: Option<f64>,
+    preset: Option<&str>,
 ) -> PyResult<PyRaceResult> {
+    let stack = Stack::of(preset, method, steering, line, line_kernels, line_start)?;
     let track = track_from(py, track, data_dir)?;
     let car = car_from(car, data_dir)?;
-    let steering: SteeringLaw = steering.parse().py()?;
     let off_track_margin = off_track_margin
         .map(checked_off_track_margin)
         .transpose()
         .py()?;
-    let (base_line, line_kernels) = line_setting(line, line_kernels, line_start)?
+    let (base_line, line_kernels) = line_setting(stack.line, line_kernels, line_start)?
         .resolve(kernels)
         .py()?;
     let config = RaceConfig {
-        method: method.parse::<cdbo::method::Method>().py()?,
+        method: stack.method,
         kernels,
         laps,
         seed,
@@ -205,7 +211,7 @@ pub fn race(
     let outcome = py
         .detach(|| {
             let venue = cdbo::venue::Venue::simulator(track.clone(), &car)
-                .steered(steering.steering())
+                .steered(stack.steering.steering())
                 .for_learning(off_track_margin);
             cdbo::experiment::race::race(&venue, &track, &car, &config, |r| {
                 if let (Some(cb), None) = (&progress, &callback_error) {

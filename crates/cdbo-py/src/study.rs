@@ -8,12 +8,12 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyType};
 
-use cdbo::drive::steering::SteeringLaw;
 use cdbo::line::LineKind;
 use cdbo::policy::rkhs::default_lengthscale;
 use cdbo::study::{Outcome, Study, StudyConfig, Trial};
 
 use crate::convert::{IntoPy, array, lock, vector};
+use crate::preset::Stack;
 use crate::race::line_setting;
 
 /// One trial of a study: `id`, the `weights` to drive, and once told its `reward`,
@@ -68,10 +68,12 @@ impl PyTrial {
 ///
 /// `Study.create(path, w0, method="cdbo", lengthscale=None, seed=0, beta=1.0,
 /// track_length=None, knob=None, max_failed=None, line="centre", line_kernels=None,
-/// line_start=None, steering="pi", bounds=None)` (M = len(w0) kernels, length-scale 1/(M − 1) by default;
-/// the lap's length in metres, if known, lets pattern search repair over road; `max_failed`
-/// is `cdbo study create --max-failed-laps`; `line`, `line_kernels`, `line_start` and
-/// `steering` as `cdbo.race`'s, stored with the study: with `line="learn"` w0 is [w_a, w_d]
+/// line_start=None, steering="pi", bounds=None, preset=None)` (M = len(w0) kernels,
+/// length-scale 1/(M − 1) by default; the lap's length in metres, if known, lets pattern
+/// search repair over road; `max_failed` is `cdbo study create --max-failed-laps`; `method`,
+/// `line`, `line_kernels`, `line_start`, `steering` and `preset` as `cdbo.race`'s, stored with
+/// the study: `preset="fast-safe"` stores the safe pattern search, the path tracker and the
+/// minimum-curvature line; with `line="learn"` w0 is [w_a, w_d]
 /// as `RaceEnv(line="learn").w0`, the line's M_d = `line_kernels` weights last, half of w0 by
 /// default; `bounds` the search box's half-width, as `--box-radius`), `Study.open(path)`;
 /// then `ask()` → `Trial`,
@@ -85,29 +87,30 @@ pub struct PyStudy {
 #[pymethods]
 impl PyStudy {
     #[classmethod]
-    #[pyo3(signature = (path, w0, *, method = "cdbo", lengthscale = None, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, track_length = None, knob = None, max_failed = None, line = "centre", line_kernels = None, line_start = None, steering = "pi", bounds = None))]
+    #[pyo3(signature = (path, w0, *, method = None, lengthscale = None, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, track_length = None, knob = None, max_failed = None, line = None, line_kernels = None, line_start = None, steering = None, bounds = None, preset = None))]
     #[allow(clippy::too_many_arguments)]
     fn create(
         _cls: &Bound<'_, PyType>,
         py: Python<'_>,
         path: PathBuf,
         w0: &Bound<'_, PyAny>,
-        method: &str,
+        method: Option<&str>,
         lengthscale: Option<f64>,
         seed: u64,
         beta: f64,
         track_length: Option<f64>,
         knob: Option<f64>,
         max_failed: Option<usize>,
-        line: &str,
+        line: Option<&str>,
         line_kernels: Option<usize>,
         line_start: Option<&str>,
-        steering: &str,
+        steering: Option<&str>,
         bounds: Option<f64>,
+        preset: Option<&str>,
     ) -> PyResult<Self> {
+        let stack = Stack::of(preset, method, steering, line, line_kernels, line_start)?;
         let w0 = vector(w0, "w0")?;
-        let steering: SteeringLaw = steering.parse().py()?;
-        let learned = line.parse::<LineKind>().py()? == LineKind::Learn;
+        let learned = stack.line == LineKind::Learn;
         // A learned line's weights follow the pedal's in w0, half of them by default (as
         // `RaceEnv(line="learn").w0`).
         let line_kernels = match learned {
@@ -124,11 +127,11 @@ impl PyStudy {
             }
             None => w0.len(),
         };
-        let (base_line, line_kernels) = line_setting(line, line_kernels, line_start)?
+        let (base_line, line_kernels) = line_setting(stack.line, line_kernels, line_start)?
             .resolve(kernels)
             .py()?;
         let config = StudyConfig {
-            method: method.parse::<cdbo::method::Method>().py()?,
+            method: stack.method,
             kernels,
             lengthscale: lengthscale.unwrap_or_else(|| default_lengthscale(kernels)),
             seed,
@@ -142,7 +145,7 @@ impl PyStudy {
             warm_start: None,
             line_kernels,
             base_line,
-            steering,
+            steering: stack.steering,
         };
         let study = py.detach(|| Study::create(&path, config)).py()?;
         Ok(PyStudy {

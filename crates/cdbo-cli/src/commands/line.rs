@@ -5,6 +5,7 @@
 use clap::Args;
 
 use cdbo::line::{BaseLine, LineKind, LineSetting};
+use cdbo::method::Preset;
 
 /// The line flags.
 #[derive(Debug, Args, Clone, Copy, Default)]
@@ -25,6 +26,18 @@ pub struct LineArgs {
 }
 
 impl LineArgs {
+    /// The flags with `preset`'s line as `--line` (clap refuses a line flag beside
+    /// `--preset`).
+    pub fn with_preset(self, preset: Option<Preset>) -> LineArgs {
+        match preset {
+            Some(p) => LineArgs {
+                line: Some(Line::of(p.line())),
+                ..self
+            },
+            None => self,
+        }
+    }
+
     /// Whether any line flag was given (a resumed study checks only those given).
     pub fn given(&self) -> bool {
         self.line.is_some() || self.line_start.is_some() || self.line_kernels.is_some()
@@ -87,6 +100,14 @@ enum Line {
 }
 
 impl Line {
+    fn of(kind: LineKind) -> Line {
+        match kind {
+            LineKind::Centre => Line::Centre,
+            LineKind::MinCurvature => Line::MinCurvature,
+            LineKind::Learn => Line::Learn,
+        }
+    }
+
     fn kind(self) -> LineKind {
         match self {
             Line::Centre => LineKind::Centre,

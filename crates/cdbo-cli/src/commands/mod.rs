@@ -28,7 +28,7 @@ use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use cdbo::car::{Car, catalog as cars};
 use cdbo::data_path::DataPath;
 use cdbo::drive::steering::SteeringLaw;
-use cdbo::method::Method;
+use cdbo::method::{Method, Preset};
 use cdbo::track::{Ends, Track, builtin, catalog as tracks};
 use cdbo::venue::Venue;
 
@@ -37,6 +37,16 @@ pub fn method_parser() -> impl clap::builder::TypedValueParser<Value = Method> {
     let names = Method::ALL.map(|m| PossibleValue::new(m.name()).help(m.description()));
     PossibleValuesParser::new(names).try_map(|name| name.parse::<Method>())
 }
+
+/// `--preset`'s parser: the presets by name, each with what it sets in `--help`.
+pub fn preset_parser() -> impl clap::builder::TypedValueParser<Value = Preset> {
+    let names = Preset::ALL.map(|p| PossibleValue::new(p.name()).help(p.description()));
+    PossibleValuesParser::new(names).try_map(|name| name.parse::<Preset>())
+}
+
+/// The flags a preset sets, which clap refuses beside `--preset`: one name never mixes with a
+/// flag of its own stack.
+pub const PRESET_SETS: [&str; 5] = ["method", "steering", "line", "line_start", "line_kernels"];
 
 /// `--steering`: a [`SteeringLaw`] by name, each listed with its description in `--help`.
 pub fn steering_parser() -> impl clap::builder::TypedValueParser<Value = SteeringLaw> {

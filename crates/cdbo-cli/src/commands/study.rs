@@ -9,7 +9,7 @@ use super::policy::{read_demo, read_raced_policy};
 use super::{CliResult, from_flag, print_json};
 use cdbo::drive::steering::SteeringLaw;
 use cdbo::line::LineSetting;
-use cdbo::method::Method;
+use cdbo::method::{Method, Preset};
 use cdbo::policy::RacedPolicy;
 use cdbo::policy::RkhsPolicy;
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
@@ -71,6 +71,11 @@ pub struct InitialPolicy {
     /// over the 275 m of road before the failure (otherwise over two kernel spacings).
     #[arg(long, value_name = "METRES", allow_negative_numbers = true, value_parser = super::value::positive)]
     track_length: Option<f64>,
+    /// A stack by one name, in place of the flags it sets (not with them): fast-safe, the one
+    /// we recommend, is `--method safe-pattern-search --steering tracker --line
+    /// min-curvature` (the safe search's budget: 30 failed laps, or --max-failed-laps).
+    #[arg(long, value_parser = super::preset_parser(), conflicts_with_all = super::PRESET_SETS)]
+    preset: Option<Preset>,
     /// Optimiser (default cdbo).
     #[arg(long, value_parser = super::method_parser())]
     method: Option<Method>,
@@ -105,7 +110,22 @@ pub struct InitialPolicy {
 impl InitialPolicy {
     /// The optimiser given, or CDBO.
     pub fn method(&self) -> Method {
-        self.method.unwrap_or(Method::Cdbo)
+        self.method_given().unwrap_or(Method::Cdbo)
+    }
+
+    /// The optimiser `--method` or `--preset` gives (clap refuses both).
+    fn method_given(&self) -> Option<Method> {
+        self.preset.map(Preset::method).or(self.method)
+    }
+
+    /// The steering `--steering` or `--preset` gives.
+    fn steering_given(&self) -> Option<SteeringLaw> {
+        self.preset.map(Preset::steering).or(self.steering)
+    }
+
+    /// The line flags, with `--preset`'s line.
+    fn line_given(&self) -> LineArgs {
+        self.line.with_preset(self.preset)
     }
 
     /// The study's settings from the demonstration or the weights.
@@ -113,9 +133,9 @@ impl InitialPolicy {
         let lengthscale = self
             .lengthscale
             .unwrap_or_else(|| default_lengthscale(self.kernels));
-        let (base_line, line_kernels) = self.line.resolve(self.kernels)?;
+        let (base_line, line_kernels) = self.line_given().resolve(self.kernels)?;
         let mut line_w0 = None;
-        let mut steering = self.steering;
+        let mut steering = self.steering_given();
         let (policy, file) = match (
             &self.demo,
             self.weights.as_ref().or(self.warm_start.as_ref()),
@@ -221,6 +241,23 @@ impl InitialPolicy {
                 study.display()
             ))
         };
+        if let Some(p) = self.preset {
+            let kept = LineSetting::of(stored.base_line, stored.line_kernels);
+            let line = LineSetting {
+                line: p.line(),
+                ..LineSetting::centre()
+            };
+            if (stored.method, stored.steering, kept) != (p.method(), p.steering(), line) {
+                return Err(format!(
+                    "{}: the study was created with --method {} --steering {} {}, not --preset {p} ({}); resume it without --preset, or start a new study elsewhere",
+                    study.display(),
+                    stored.method,
+                    stored.steering.name(),
+                    super::line::flags(&kept),
+                    p.flags()
+                ));
+            }
+        }
         if self.kernels != stored.kernels {
             return differs(
                 "--kernels",
@@ -228,7 +265,7 @@ impl InitialPolicy {
                 stored.kernels.to_string(),
             );
         }
-        if let Some(m) = self.method.filter(|m| *m != stored.method) {
+        if let Some(m) = self.method_given().filter(|m| *m != stored.method) {
             return differs("--method", m.to_string(), stored.method.to_string());
         }
         if let Some(s) = self.seed.filter(|s| *s != stored.seed) {
@@ -270,7 +307,7 @@ impl InitialPolicy {
         )?;
         optional(
             "--steering",
-            self.steering.map(|s| s.name().to_owned()),
+            self.steering_given().map(|s| s.name().to_owned()),
             Some(stored.steering.name().to_owned()),
         )?;
         optional(
@@ -278,9 +315,9 @@ impl InitialPolicy {
             self.warm_start.as_ref().map(|p| p.display().to_string()),
             stored.warm_start.clone(),
         )?;
-        if self.line.given() {
-            let given = self
-                .line
+        let line = self.line_given();
+        if line.given() {
+            let given = line
                 .resolve(self.kernels)
                 .map(|(base, kernels)| LineSetting::of(base, kernels))?;
             let kept = LineSetting::of(stored.base_line, stored.line_kernels);

@@ -17,7 +17,7 @@ use cdbo::data_path::DataPath;
 use cdbo::drive::steering::SteeringLaw;
 use cdbo::experiment::race::{RaceConfig, race};
 use cdbo::line::BaseLine;
-use cdbo::method::Method;
+use cdbo::method::{Method, Preset};
 use cdbo::policy::RacedPolicy;
 use cdbo::torcs::Game;
 use cdbo::torcs::panel::Outcome;
@@ -36,6 +36,11 @@ pub struct TransferArgs {
     /// (`cdbo torcs calibrate`'s car.toml); the game drives --car.
     #[arg(long, value_name = "CAR")]
     sim_car: Option<String>,
+    /// A stack by one name, in place of the flags it sets (not with them): fast-safe, the one
+    /// we recommend, is `--method safe-pattern-search --steering tracker --line
+    /// min-curvature` (the safe search's budget: 30 failed laps a race).
+    #[arg(long, value_parser = super::preset_parser(), conflicts_with_all = super::PRESET_SETS)]
+    preset: Option<Preset>,
     /// Optimiser.
     #[arg(long, value_parser = super::method_parser(), default_value_t = Method::PatternSearch)]
     method: Method,
@@ -170,9 +175,12 @@ pub fn run(args: &TransferArgs, data: &DataPath) -> CliResult {
             u64::MAX
         )
     })?;
-    let (base_line, line_kernels) = args.line.resolve(args.kernels)?;
+    // The stack: the preset's, or the flags' (clap refuses both).
+    let method = args.preset.map_or(args.method, Preset::method);
+    let steering = args.preset.map_or(args.steering, Preset::steering);
+    let (base_line, line_kernels) = args.line.with_preset(args.preset).resolve(args.kernels)?;
     let config = RaceConfig {
-        method: args.method,
+        method,
         kernels: args.kernels,
         laps: args.laps,
         line_kernels,
@@ -217,11 +225,10 @@ pub fn run(args: &TransferArgs, data: &DataPath) -> CliResult {
                 .cloned()
                 .ok_or("the game's venue has its car")?,
         };
-        let steering = args.steering.steering();
         let learning = Venue::simulator(track.clone(), &car)
-            .steered(steering.clone())
+            .steered(steering.steering())
             .for_learning(args.off_track_margin);
-        let judging = in_game.steered(steering).for_learning(None);
+        let judging = in_game.steered(steering.steering()).for_learning(None);
         venues.push(TrackVenues {
             name: name.clone(),
             track,
@@ -271,7 +278,7 @@ pub fn run(args: &TransferArgs, data: &DataPath) -> CliResult {
                 let kept = RacedPolicy {
                     policy: outcome.best.clone(),
                     base_line,
-                    steering: args.steering,
+                    steering,
                 };
                 let file = policy_file(&policies, name, seed);
                 let text =
@@ -350,10 +357,10 @@ pub fn run(args: &TransferArgs, data: &DataPath) -> CliResult {
     let report = Report {
         car: args.car.clone(),
         sim_car: args.sim_car.clone(),
-        method: args.method,
+        method,
         kernels: args.kernels,
         laps: args.laps,
-        steering: args.steering,
+        steering,
         base_line,
         line_kernels,
         learned_off_track_margin_m: learning.off_track_margin(),

@@ -16,6 +16,7 @@ from ._cdbo import (
     Policy,
     Simulator,
     resolve_line,
+    resolve_stack,
 )
 
 try:
@@ -80,6 +81,10 @@ class RaceEnv(_Base):
     with, kept for the game or car the policy is then driven in: the wheels 0.25 m off
     slippery ground, the body 1 m off the walls, the car's centre on the road
     (``LEARNING_OFF_TRACK_MARGIN``, 1 m inside it, where the road's verges are not known).
+
+    ``preset="fast-safe"``, as ``cdbo race --preset fast-safe``, stands for the recommended
+    stack in place of ``line`` and ``steering`` (which are then refused): the path tracker on
+    the minimum-curvature line, and ``optimizer()``'s method the safe pattern search.
     """
 
     metadata = {"render_modes": []}
@@ -92,12 +97,21 @@ class RaceEnv(_Base):
         demo_speed: float = 15.0,
         bounds: float = DEFAULT_BOX_RADIUS,
         data_dir=None,
-        line: str = "centre",
+        line=None,
         line_kernels=None,
         line_start=None,
-        steering: str = "pi",
+        steering=None,
         off_track_margin=None,
+        preset=None,
     ):
+        self.preset = preset
+        self.method, steering, line = resolve_stack(
+            preset,
+            steering=steering,
+            line=line,
+            line_kernels=line_kernels,
+            line_start=line_start,
+        )
         self.base_line, self.line_kernels = resolve_line(
             kernels, line=line, line_kernels=line_kernels, line_start=line_start
         )
@@ -130,12 +144,15 @@ class RaceEnv(_Base):
         self.observation_space = _box(np.zeros(1), np.ones(1))
         self.last = None
 
-    def optimizer(self, method="cdbo", **options):
+    def optimizer(self, method=None, **options):
         """``cdbo.Optimizer(method, w0, ...)`` told what this race is: its start ``w0``, its
         box, the policy's length-scale, the lap's length and, with a learned line, how many
         weights are the pedal's, as ``cdbo race`` tells it (the
         pattern search pushes the policy's pedal and repairs it over road with them).
-        ``options`` are the Optimizer's own (``seed=``, ``knob=``, ``max_failed=``, ...)."""
+        ``method`` is ``"cdbo"`` by default, the preset's learner with a ``preset`` (which
+        refuses another). ``options`` are the Optimizer's own (``seed=``, ``knob=``,
+        ``max_failed=``, ...)."""
+        method = resolve_stack(self.preset, method=method)[0]
         options.setdefault("bounds", self.bounds)
         options.setdefault("lengthscale", self.lengthscale)
         options.setdefault("track_length", self.track_length)

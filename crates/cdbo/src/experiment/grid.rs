@@ -17,6 +17,9 @@
 //! "min-curvature"` races every run on that line, as `cdbo race --line`; a grid without it
 //! races the centre line, the paper's.
 //! `steering = "tracker"` drives every run with the path tracker (default `"pi"`);
+//! `preset = "fast-safe"` stands for the stack it names ([`Preset`]), `methods =
+//! ["safe-pattern-search"]`, `steering = "tracker"` and `line = "min-curvature"`, which the
+//! grid then does not give;
 //! `off_track_margin = 1.0` fails its laps 1 m past the road's edge, the game's rule (default:
 //! the learning reserve in cdbo's simulator, as `cdbo race`; the game's rule in the game).
 //!
@@ -28,7 +31,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::drive::steering::SteeringLaw;
 use crate::line::{BaseLine, LineKind, LineSetting};
-use crate::method::{Method, Spec};
+use crate::method::{Method, Preset, Spec};
 use crate::sim::lap::{GAME_OFF_TRACK_MARGIN, checked_off_track_margin};
 
 use crate::error::{Error, Result};
@@ -57,7 +60,13 @@ pub struct ExperimentConfig {
     /// UCB β (the paper: within [0.5, 2]).
     #[serde(default = "default_beta")]
     pub beta: f64,
+    /// A stack by name ([`Preset`]) in place of `methods`, `steering` and `line`, which a grid
+    /// with it does not give: [`ExperimentConfig::from_toml`] reads it into them, so that the
+    /// grid holds no preset once read and writes the settings it stood for.
+    #[serde(default, skip_serializing)]
+    preset: Option<Preset>,
     /// Optimisers, by their names.
+    #[serde(default)]
     pub methods: Vec<Method>,
     /// Tracks and their policy sizes.
     pub tracks: Vec<TrackGrid>,
@@ -150,6 +159,7 @@ impl ExperimentConfig {
         };
         Some(match name {
             "paper" => ExperimentConfig {
+                preset: None,
                 laps: 300,
                 repeats: 4,
                 demo_speed: default_demo_speed(),
@@ -178,6 +188,7 @@ impl ExperimentConfig {
                 ..ExperimentConfig::preset("paper")?
             },
             "quick" => ExperimentConfig {
+                preset: None,
                 laps: 25,
                 repeats: 2,
                 demo_speed: default_demo_speed(),
@@ -198,9 +209,10 @@ impl ExperimentConfig {
         })
     }
 
-    /// Reads a grid from TOML text; `origin` names the file in errors.
+    /// Reads a grid from TOML text, its `preset` read into the settings it stands for;
+    /// `origin` names the file in errors.
     pub fn from_toml(text: &str, origin: &str) -> Result<ExperimentConfig> {
-        let config: ExperimentConfig = toml::from_str(text).map_err(|e| {
+        let mut config: ExperimentConfig = toml::from_str(text).map_err(|e| {
             // The line of the offending span, and its key (the text before `=`).
             let start = e.span().map_or(0, |s| s.start.min(text.len()));
             let line_start = text[..start].rfind('\n').map_or(0, |i| i + 1);
@@ -215,6 +227,9 @@ impl ExperimentConfig {
                 message: e.message().trim().to_owned(),
             }
         })?;
+        if let Some(preset) = config.preset.take() {
+            config.set(preset, text, origin)?;
+        }
         config.check().map_err(|e| Error::Parse {
             file: origin.to_owned(),
             line: None,
@@ -224,6 +239,30 @@ impl ExperimentConfig {
         Ok(config)
     }
 
+    /// Sets `preset`'s method, steering and line, refusing a grid `text` that gives any of them
+    /// as well: one name never mixes with a key of its own stack.
+    fn set(&mut self, preset: Preset, text: &str, origin: &str) -> Result<()> {
+        const SETS: [&str; 5] = ["methods", "steering", "line", "line_kernels", "line_start"];
+        let keys: toml::Table = toml::from_str(text)
+            .map_err(|e| Error::parse(origin, "grid", e.message().trim().to_owned()))?;
+        if let Some(key) = SETS.into_iter().find(|k| keys.contains_key(*k)) {
+            return Err(Error::parse(
+                origin,
+                key,
+                format!(
+                    "preset = \"{preset}\" sets methods = [\"{}\"], steering = \"{}\" and line = \"{}\": give the preset or these keys, not both",
+                    preset.method(),
+                    preset.steering(),
+                    preset.line().name()
+                ),
+            ));
+        }
+        self.methods = vec![preset.method()];
+        self.steering = preset.steering();
+        self.line = preset.line();
+        Ok(())
+    }
+
     /// Checks the grid is non-empty, its methods known and its numbers sensible.
     pub fn check(&self) -> Result<()> {
         crate::sizes::LAPS.checked(self.laps)?;
@@ -231,12 +270,15 @@ impl ExperimentConfig {
         if let Some(margin) = self.off_track_margin {
             checked_off_track_margin(margin)?;
         }
-        if self.methods.is_empty() || self.tracks.is_empty() {
-            return Err(Error::too_small(
-                "methods and tracks",
-                self.methods.len().min(self.tracks.len()),
-                1,
+        if self.methods.is_empty() {
+            return Err(Error::invalid_value(
+                "the grid's methods",
+                "none",
+                "at least one, as methods = [\"cdbo\"] or preset = \"fast-safe\"",
             ));
+        }
+        if self.tracks.is_empty() {
+            return Err(Error::too_small("the grid's tracks", 0, 1));
         }
         for t in &self.tracks {
             if t.kernels.is_empty() {
@@ -470,6 +512,70 @@ mod tests {
         .unwrap_err()
         .to_string();
         assert!(e.contains("g.toml") && e.contains("line start"), "{e}");
+    }
+
+    /// `preset = "fast-safe"` reads as the stack it names: its runs are the safe pattern
+    /// search's, on the path tracker and the minimum-curvature line; the grid saved holds those
+    /// settings, not the preset, and reads back the same. A key of the stack beside the preset
+    /// is refused naming the file and the key; a grid with neither methods nor a preset is
+    /// refused naming both.
+    #[test]
+    fn a_grid_preset_sets_the_method_the_steering_and_the_line() {
+        let head = "laps = 3\nrepeats = 1\ntracks = [{track = \"x\", kernels = [5]}]\n";
+        let grid = ExperimentConfig::from_toml(
+            &format!("preset = \"fast-safe\"\n{head}[knob]\nsafe-pattern-search = 0.05\n"),
+            "g",
+        )
+        .unwrap();
+        assert_eq!(grid.methods, [Method::SafePatternSearch]);
+        assert_eq!(grid.steering, SteeringLaw::Tracker);
+        assert_eq!(
+            grid.line(),
+            LineSetting {
+                line: LineKind::MinCurvature,
+                ..LineSetting::centre()
+            }
+        );
+        assert_eq!(grid.runs()[0].method, "safe-pattern-search");
+        let saved = toml::to_string(&grid).unwrap();
+        assert!(!saved.contains("preset"), "{saved}");
+        assert_eq!(ExperimentConfig::from_toml(&saved, "g").unwrap(), grid);
+        let long = "methods = [\"safe-pattern-search\"]\nsteering = \"tracker\"\nline = \"min-curvature\"\n";
+        let long = ExperimentConfig::from_toml(
+            &format!("{long}{head}[knob]\nsafe-pattern-search = 0.05\n"),
+            "g",
+        )
+        .unwrap();
+        assert_eq!(long, grid);
+        for key in [
+            "methods = [\"cdbo\"]",
+            "steering = \"pi\"",
+            "line = \"min-curvature\"",
+            "line_kernels = 4",
+        ] {
+            let e = ExperimentConfig::from_toml(
+                &format!("preset = \"fast-safe\"\n{key}\n{head}"),
+                "g.toml",
+            )
+            .unwrap_err()
+            .to_string();
+            let name = key.split(' ').next().unwrap();
+            assert!(
+                e.contains("g.toml") && e.contains(name) && e.contains("not both"),
+                "{e}"
+            );
+        }
+        let e = ExperimentConfig::from_toml(&format!("preset = \"fastest\"\n{head}"), "g.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("fastest") && e.contains("fast-safe"), "{e}");
+        let e = ExperimentConfig::from_toml(head, "g.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("g.toml") && e.contains("methods = [") && e.contains("preset = "),
+            "{e}"
+        );
     }
 
     #[test]

@@ -1,14 +1,17 @@
 //! The one registry of methods: each method's name (on the command line, in grids, records,
 //! studies and the Python package), its description (the command line's help), its colour in
-//! figures, its main knob ([`knob`]), the specification every run is built from ([`spec`])
-//! and what it costs ([`cost`]). Everything that names a method reads [`Method`]; the generic
-//! optimisers ([`crate::optimizers`]) and the learners ([`crate::learner`]) know nothing of it.
+//! figures, its main knob ([`knob`]), the specification every run is built from ([`spec`]),
+//! what it costs ([`cost`]) and the recommended stack by one name ([`preset`]). Everything
+//! that names a method reads [`Method`]; the generic optimisers ([`crate::optimizers`]) and
+//! the learners ([`crate::learner`]) know nothing of it.
 
 pub mod cost;
 pub mod knob;
+pub mod preset;
 pub mod spec;
 
 pub use knob::{Knob, KnobKind, PAPER_SIGMA0};
+pub use preset::Preset;
 pub use spec::{Spec, resume};
 
 use std::fmt;
