@@ -365,6 +365,7 @@ fn transfer_takes_the_preset_but_not_beside_its_flags() {
 /// and the one before that (no rolling resistance against the yaw, no pitch from the wings' drag,
 /// the launch clutch blended at cdbo's own step) on 287, 279 and 290.
 #[test]
+#[ignore = "slow: 900 simulator laps, the game's kept panels on three tracks"]
 fn the_simulator_still_agrees_with_the_games_kept_laps() {
     let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/results/torcs");
     let panels: Vec<String> = ["forza", "e-track-2", "aalborg"]
@@ -542,6 +543,7 @@ fn bad_race_knobs_are_refused_in_one_line() {
 /// throttle, and with 10 failed laps the search stops at 14.86 m/s, just short of the
 /// demonstration's 14.96; it reached 26.87 on the single-track car.)
 #[test]
+#[ignore = "slow: two 300-lap races of the safe pattern search"]
 fn the_safe_search_keeps_its_budget_in_a_race() {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
         .join(format!("cdbo-cli-safe-{}", std::process::id()));
@@ -620,6 +622,7 @@ fn the_box_radius_bounds_the_search() {
 /// learner, the paper's GP method, a random search), where without it the same races fail
 /// more; the best lap is still a completed one.
 #[test]
+#[ignore = "slow: six 60-lap races, each method with and without the cap"]
 fn a_failed_lap_budget_caps_the_failed_laps() {
     for method in ["pattern-search", "cdbo", "random"] {
         let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))

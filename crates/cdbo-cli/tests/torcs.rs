@@ -97,6 +97,7 @@ fn bests(out: &Path) -> Vec<(String, f64, usize)> {
 }
 
 #[test]
+#[ignore = "slow: a grid of races in the game, twice (one game, then two at once)"]
 fn a_grid_in_the_game_runs_with_jobs_like_any_other() {
     let dir = fresh_dir("grid");
     let Some(cache) = game_cache(&dir) else {
@@ -163,6 +164,7 @@ fn serve_sim_in_the_game_answers_with_game_laps() {
 /// on Aalborg berniw2 drives its standing lap in about 78.15 s (docs/results/torcs.md) without
 /// striking a barrier, and a robot that leaves the road (sparkle, inferno2) is damaged.
 #[test]
+#[ignore = "slow: the shipped robots' laps in the game"]
 fn the_robots_table_gives_each_robots_laps_and_damage() {
     let dir = fresh_dir("robots");
     let Some(cache) = game_cache(&dir) else {
@@ -206,6 +208,7 @@ fn the_robots_table_gives_each_robots_laps_and_damage() {
 /// and it keeps every drawn policy with the game's lap, which `cdbo torcs panel` scores again
 /// to compare's count.
 #[test]
+#[ignore = "slow: a panel of policies driven in the game and in the simulator"]
 fn compare_writes_each_disagreement_as_a_policy_that_drives_again() {
     let dir = fresh_dir("compare");
     let Some(cache) = game_cache(&dir) else {
@@ -289,6 +292,7 @@ fn compare_writes_each_disagreement_as_a_policy_that_drives_again() {
 /// the table's difference is the two laps', and the seed's summary counts them. A track the
 /// game does not have stops it before any lap, with nothing written.
 #[test]
+#[ignore = "slow: a 30-lap race per method, each best policy then driven in the game"]
 fn transfer_drives_each_learned_best_policy_in_the_game() {
     let dir = fresh_dir("transfer");
     let Some(cache) = game_cache(&dir) else {
