@@ -352,6 +352,9 @@ fn race_with(
     if let Some(max) = budget.filter(|_| start_failed > 0) {
         spec = spec.max_failed_laps(max - start_failed);
     }
+    if start.is_some() {
+        spec = spec.start_completed();
+    }
     let optimizer = spec
         .policy(lengthscale)?
         .track_length(limit.track_length)?
