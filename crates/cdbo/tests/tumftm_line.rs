@@ -77,7 +77,10 @@ fn our_minimum_curvature_line_on_monza_agrees_with_tumftms() {
     }
     let mean = sum / published.len() as f64;
     let within = close as f64 / published.len() as f64;
-    let (theirs, mine) = (curvature_integral(&published), curvature_integral(&ours.points));
+    let (theirs, mine) = (
+        curvature_integral(&published),
+        curvature_integral(&ours.points),
+    );
     println!(
         "mean {mean:.3} m, worst {worst:.3} m, {:.1} % within 1.5 m, ∫κ²ds ours {mine:.5} theirs {theirs:.5} ({:+.1} %)",
         100.0 * within,
@@ -85,5 +88,8 @@ fn our_minimum_curvature_line_on_monza_agrees_with_tumftms() {
     );
     assert!(mean < 0.75, "mean lateral distance {mean:.2} m");
     assert!(within >= 0.9, "{:.1} % within 1.5 m", 100.0 * within);
-    assert!((mine / theirs - 1.0).abs() < 0.1, "∫κ² ds {mine} against {theirs}");
+    assert!(
+        (mine / theirs - 1.0).abs() < 0.1,
+        "∫κ² ds {mine} against {theirs}"
+    );
 }

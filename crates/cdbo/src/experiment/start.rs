@@ -11,10 +11,10 @@
 //!
 //! **The first policy.** w₀, the demonstration's fit, is a smoothed copy of the demonstrator's
 //! pedal, and can be faster than the demonstrator where the fit spreads its launch: where its
-//! lap leaves the road it is fitted again to a slower demonstration, where it stalls its
-//! targets are raised before the stall ([`crate::learner::repair`]), until its lap completes
-//! ([`complete_start`]; lowering the targets by the repair's step instead brakes a cruising
-//! pedal to a stall). These laps are the race's first laps and count among its failed ones; the
+//! lap leaves the road its pedal is lowered before the place (to half the demonstrator's
+//! throttle at most), where it
+//! stalls raised, and where that does not help it is fitted again to a slower demonstration,
+//! until its lap completes ([`complete_start`]). These laps are the race's first laps and count among its failed ones; the
 //! method then starts from the policy whose lap completed (its first lap, which it does not
 //! drive again).
 
@@ -23,7 +23,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::{Error, Result};
 use crate::evaluator::{Evaluator, Outcome};
 use crate::learner::pattern_search::push::REPAIR_DISTANCE;
-use crate::learner::repair::{PedalRepair, REPAIR_SPACINGS};
+use crate::learner::repair::REPAIR_SPACINGS;
 use crate::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 use crate::policy::{Policy, RkhsPolicy};
 use crate::sim::{Failure, LapResult};
@@ -34,9 +34,11 @@ pub const SLOWDOWN: f64 = 0.8;
 pub const SLOWEST: f64 = 2.0;
 /// Halvings of the interval between the last failing and the first completing speed.
 pub const BISECTIONS: usize = 3;
-/// After a first policy's lap too fast, it is fitted again to a demonstration this much
-/// slower.
+/// Where lowering its pedal cannot help a first policy's lap too fast, it is fitted again to a
+/// demonstration this much slower.
 pub const START_SLOWDOWN: f64 = 0.9;
+/// How much a first policy's pedal is lowered before where its lap was too fast.
+pub const START_STEP: f64 = 0.1;
 
 /// A demonstration as the race drove it: its lap and the (x, a) pairs of every driver step.
 pub type Demonstration = (LapResult, Vec<(f64, f64)>);
@@ -148,12 +150,16 @@ impl Start {
 }
 
 /// Drives `initial` (its pedal w₀ fitted to the demonstration `targets`, held at `speed` m/s)
-/// with `evaluator` until its lap completes, at most `max_failed` laps failing: after a lap
-/// too fast (off the road, spun, backwards; or failed where the venue did not say), w₀ is
-/// fitted again to a demonstration [`START_SLOWDOWN`] as fast, by `demonstrate`; after a lap
-/// too slow (stalled, time limit), the fit's targets are raised before where it stalled
-/// ([`PedalRepair`], over [`REPAIR_DISTANCE`] m and at least two kernel spacings). Each lap's
-/// outcome and the seconds it took are kept.
+/// with `evaluator` until its lap completes, at most `max_failed` laps failing. After a lap too
+/// fast (off the road, spun, backwards), the fit's targets over the [`REPAIR_DISTANCE`] metres
+/// (at least two kernel spacings) before the failure are lowered by [`START_STEP`], but none
+/// below half the demonstrator's throttle there (a cruising pedal braked, or only coasting,
+/// over that stretch stops the car); after a lap too slow (stalled, time limit), they are
+/// raised by half the step before the stall. Where that cannot help — the lap failed within a
+/// kernel spacing of where one failed since the last fit to a demonstration, or where the
+/// targets are at their floor already, or the venue did not say where — w₀ is fitted again to
+/// a demonstration [`START_SLOWDOWN`] as fast, by `demonstrate`. Each lap's outcome and the
+/// seconds it took are kept.
 pub fn complete_start(
     evaluator: &mut dyn Evaluator,
     initial: Policy,
@@ -165,9 +171,10 @@ pub fn complete_start(
     let kernels = initial.pedal.kernels();
     let lengthscale = default_lengthscale(kernels);
     let window = (REPAIR_DISTANCE / track_length).max(REPAIR_SPACINGS * lengthscale);
-    let mut repair = PedalRepair::new(kernels).over(window);
-    let mut targets = targets.to_vec();
+    let mut demo = targets.to_vec();
+    let mut targets = demo.clone();
     let mut speed = speed;
+    let mut places: Vec<f64> = Vec::new();
     let mut start = Start {
         policy: initial,
         laps: Vec::new(),
@@ -182,26 +189,55 @@ pub fn complete_start(
         if !matches!(outcome, Outcome::Failed { .. }) || start.failed() >= max_failed {
             return Ok(start);
         }
-        match outcome.failed_lap() {
-            Some(failed) if failed.too_slow => {
-                repair.repair(&mut targets, failed.at, true);
+        let failed = outcome.failed_lap();
+        let again = failed.is_some_and(|f| places.iter().any(|x| (f.at - x).abs() < lengthscale));
+        places.extend(failed.map(|f| f.at));
+        let repaired = match failed {
+            Some(_) if again => false,
+            Some(f) if f.too_slow => {
+                shift(&mut targets, &demo, f.at - window, f.at, 0.5 * START_STEP)
             }
-            _ => loop {
+            Some(f) => shift(&mut targets, &demo, f.at - window, f.at, -START_STEP),
+            None => false,
+        };
+        if !repaired {
+            loop {
                 speed *= START_SLOWDOWN;
                 if speed < SLOWEST {
                     return Ok(start);
                 }
                 let (lap, pairs) = demonstrate(speed)?;
                 if lap.completed {
-                    targets = pairs;
+                    (demo, targets) = (pairs.clone(), pairs);
+                    places.clear();
                     start.speed_mps = speed;
                     break;
                 }
-            },
+            }
         }
         start.policy.pedal = RkhsPolicy::fit(&targets, kernels, lengthscale, DEFAULT_RIDGE)
             .map_err(|e| Error::Numerical(format!("refitting the first policy: {e}")))?;
     }
+}
+
+/// Moves the targets (x, a) with x in [from, to] by `step`, a lowered one no further than half
+/// its demonstration's value a₀ where that presses the throttle, a₀ itself where it brakes
+/// (`demo`: the targets and the demonstration are the same pairs, moved); whether any moved.
+fn shift(targets: &mut [(f64, f64)], demo: &[(f64, f64)], from: f64, to: f64, step: f64) -> bool {
+    let mut moved = false;
+    for ((x, a), (_, a0)) in targets.iter_mut().zip(demo) {
+        if (from..=to).contains(x) {
+            let floor = if *a0 > 0.0 { 0.5 * a0 } else { *a0 };
+            let next = if step < 0.0 {
+                (*a + step).max(floor)
+            } else {
+                *a + step
+            };
+            moved |= next != *a;
+            *a = next;
+        }
+    }
+    moved
 }
 
 /// An evaluator that has already driven one lap: the first evaluation of those weights is
