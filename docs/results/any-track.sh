@@ -3,7 +3,8 @@
 # run at a time at low priority, each run's summary kept as OUT/CONFIG/TRACK-sSEED.json (a run
 # already there is skipped, so the script resumes). Usage:
 #   docs/results/any-track.sh OUT "SEEDS" "CONFIGS" [TRACKS_DIR]
-# CONFIGS from: recommended cdbo pattern-search budget10-METHOD (any method of `cdbo race`).
+# CONFIGS from: recommended cdbo pattern-search budget10-METHOD (any method of `cdbo race`);
+# NICE sets the niceness (default 19), CDBO the binary (default target/release/cdbo).
 set -u
 out=$1; seeds=$2; configs=$3; dir=${4:-../shared/tracks/csv}
 cdbo=${CDBO:-target/release/cdbo}
@@ -19,7 +20,7 @@ for config in $configs; do
       track=$(basename "$file" .csv)
       json="$out/$config/$track-s$seed.json"
       [ -s "$json" ] && continue
-      nice -n 19 "$cdbo" race --track "$file" $args --seed "$seed" --laps 300 --kernels 30 \
+      nice -n "${NICE:-19}" "$cdbo" race --track "$file" $args --seed "$seed" --laps 300 --kernels 30 \
         --json --out "$out/runs/$config-$track-s$seed" > "$json.tmp" 2> "$json.err" \
         && mv "$json.tmp" "$json"
     done
