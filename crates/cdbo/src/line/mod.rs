@@ -62,12 +62,18 @@ impl LineOptions {
     ///
     /// [`LEARNING_OFF_TRACK_MARGIN`]: crate::sim::lap::LEARNING_OFF_TRACK_MARGIN
     pub fn for_race(car: &Car, track: &Track) -> LineOptions {
+        LineOptions::for_track(car, track, SAFETY_MARGIN)
+    }
+
+    /// For `car` on `track`: half its width plus `safety_margin_m` inside the edge laps are
+    /// learned by, as [`for_race`](Self::for_race) with another safety margin.
+    pub fn for_track(car: &Car, track: &Track, safety_margin_m: f64) -> LineOptions {
         let inside = if track.has_verges() {
             0.0
         } else {
             NO_VERGES_RESERVE
         };
-        LineOptions::for_car(car, SAFETY_MARGIN + inside)
+        LineOptions::for_car(car, safety_margin_m + inside)
     }
 }
 
