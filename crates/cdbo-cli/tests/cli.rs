@@ -1483,3 +1483,56 @@ fn calibrate_from_a_log_writes_a_car_and_refuses_bad_logs() {
     ]);
     assert_eq!(lap["completed"], true, "{lap}");
 }
+
+/// A `.csv` circuit with a road of width 0, a centre line that crosses itself, or fewer than
+/// 10 points is refused by `race` in one line naming the file, and no run folder is made.
+#[test]
+fn a_bad_csv_circuit_gets_one_line_and_no_run_folder() {
+    let point = |i: usize, n: usize, widths: &str, eight: bool| {
+        let a = i as f64 / n as f64 * std::f64::consts::TAU;
+        let (x, y) = if eight {
+            (300.0 * a.sin(), 150.0 * (2.0 * a).sin())
+        } else {
+            (200.0 * a.cos(), 200.0 * a.sin())
+        };
+        format!("{x},{y},{widths}\n")
+    };
+    let circuit = |n: usize, widths: &str, eight: bool| {
+        (0..n).fold(
+            String::from("# x_m,y_m,w_tr_right_m,w_tr_left_m\n"),
+            |s, i| s + &point(i, n, widths, eight),
+        )
+    };
+    let bad = [
+        (
+            "width0.csv",
+            circuit(60, "0,0", false),
+            "track widths must be positive",
+        ),
+        (
+            "crossing.csv",
+            circuit(60, "5,5", true),
+            "the centre line crosses itself",
+        ),
+        (
+            "few.csv",
+            circuit(8, "5,5", false),
+            "at least 10 points, found 8",
+        ),
+    ];
+    for (name, content, needle) in bad {
+        let file = scratch(name, &content);
+        let out = file.with_extension("run");
+        let args = [
+            "race",
+            "--track",
+            file.to_str().unwrap(),
+            "--laps",
+            "2",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        fails_with(&args, &[file.to_str().unwrap(), needle]);
+        assert!(!out.exists(), "{name}: made {}", out.display());
+    }
+}

@@ -199,6 +199,7 @@ pub fn race(
         seed,
         beta,
         demo_speed,
+        fixed_demo_speed: false,
         knob,
         max_failed_laps: max_failed,
         line_kernels,

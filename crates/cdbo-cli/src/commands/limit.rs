@@ -15,7 +15,8 @@ use cdbo::line::{LineOptions, RacingLine, SAFETY_MARGIN};
 pub struct LimitArgs {
     #[command(flatten)]
     setup: Setup,
-    /// Clearance (m) the racing line keeps between the car's side and the road's edge.
+    /// Clearance (m) the racing line keeps between the car's side and the road's edge (a
+    /// metre more where the track gives no verges: laps learned there fail a metre inside it).
     #[arg(long, default_value_t = SAFETY_MARGIN, value_parser = value::non_negative)]
     safety_margin: f64,
     /// Print JSON.
@@ -38,8 +39,10 @@ pub fn run(args: &LimitArgs, data: &DataPath) -> CliResult {
     let (track, car) = args.setup.load(data)?;
     let centre = limit_lap(&track, &car);
     let start = Instant::now();
-    let line =
-        RacingLine::minimum_curvature(&track, &LineOptions::for_car(&car, args.safety_margin))?;
+    let line = RacingLine::minimum_curvature(
+        &track,
+        &LineOptions::for_track(&car, &track, args.safety_margin),
+    )?;
     let on_line = line_limit(&track, &line, &car);
     let ms = start.elapsed().as_secs_f64() * 1e3;
     if args.json {

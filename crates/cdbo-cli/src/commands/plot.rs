@@ -39,7 +39,8 @@ pub enum PlotCommand {
         /// road's edges.
         #[arg(long, default_value = cars::DEFAULT)]
         car: String,
-        /// Clearance (m) the racing line keeps between the car's side and the road's edge.
+        /// Clearance (m) the racing line keeps between the car's side and the road's edge (a
+        /// metre more where the track gives no verges: laps learned there fail a metre inside it).
         #[arg(long, default_value_t = SAFETY_MARGIN, value_parser = value::non_negative)]
         safety_margin: f64,
     },
@@ -70,7 +71,7 @@ pub fn run(cmd: &PlotCommand, data: &DataPath) -> CliResult {
     let racing_line = match (line, policy) {
         (Some(Line::MinCurvature), _) => {
             let car = cars::find(car, data)?;
-            let options = LineOptions::for_car(&car, *safety_margin);
+            let options = LineOptions::for_track(&car, &t, *safety_margin);
             let line = RacingLine::minimum_curvature(&t, &options)?;
             Some(("minimum-curvature line".to_owned(), line.points))
         }

@@ -50,9 +50,11 @@ pub struct RaceArgs {
     /// UCB exploration weight β (the paper: 0.5 to 2).
     #[arg(long, default_value_t = cdbo::acquisition::ucb::DEFAULT_BETA, allow_negative_numbers = true, value_parser = super::value::non_negative)]
     beta: f64,
-    /// Speed of the demonstrator (m/s).
-    #[arg(long, default_value_t = 15.0, allow_negative_numbers = true, value_parser = super::value::positive)]
-    demo_speed: f64,
+    /// Speed of the demonstrator (m/s), held exactly. Default: the paper's 15 m/s, or where
+    /// that lap leaves the road, the fastest constant speed that completes (a short search,
+    /// said in one line).
+    #[arg(long, allow_negative_numbers = true, value_parser = super::value::positive)]
+    demo_speed: Option<f64>,
     /// The method's main knob: σ₀ (CDBO's initial samples, CMA-ES's and random search's σ, the
     /// pattern search's first step), TuRBO's initial trust-region side L_init, LineBO's step
     /// (each line's half-length), REMBO's box half-width b; default: its race value, tuned on
@@ -121,6 +123,14 @@ struct Summary {
     /// Its lap time, if it completed.
     first_lap_time_s: Option<f64>,
     demo_reward_mps: f64,
+    /// The speed the demonstrator held (m/s).
+    demo_speed_mps: f64,
+    /// Where the asked speed's demonstration failed: what was chosen instead, and why.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    demo_choice: Option<cdbo::experiment::start::DemoChoice>,
+    /// Laps of the first policy π(w₀) that failed before its repaired lap completed (the
+    /// race's first laps, among the failed ones).
+    start_failed_laps: usize,
     best_reward_mps: f64,
     best_lap_time_s: Option<f64>,
     limit_reward_mps: f64,
@@ -168,7 +178,10 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         laps: args.laps,
         seed: args.seed,
         beta: args.beta,
-        demo_speed: args.demo_speed,
+        demo_speed: args
+            .demo_speed
+            .unwrap_or(cdbo::drive::demo::DEFAULT_TARGET_SPEED),
+        fixed_demo_speed: args.demo_speed.is_some(),
         knob: args.knob.or(args.sigma0),
         max_failed_laps: args.max_failed_laps,
         line_kernels,
@@ -281,6 +294,12 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         first_lap_reward_mps: outcome.laps.first().map_or(0.0, |l| l.reward_mps),
         first_lap_time_s: outcome.laps.first().and_then(|l| l.lap_time_s),
         demo_reward_mps: outcome.demo.reward_mps,
+        demo_speed_mps: outcome
+            .demo_choice
+            .as_ref()
+            .map_or(config.demo_speed, |c| c.chosen_mps),
+        demo_choice: outcome.demo_choice.clone(),
+        start_failed_laps: outcome.start_failed_laps,
         best_reward_mps: outcome.best_reward_mps,
         best_lap_time_s: best_lap,
         limit_reward_mps: outcome.limit.reward_mps,
@@ -300,6 +319,20 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     )?;
     if args.json {
         return print_json(&summary);
+    }
+    if let Some(choice) = &summary.demo_choice {
+        println!("{}", capitalised(&choice.sentence(&summary.track)));
+    }
+    if summary.start_failed_laps > 0 {
+        println!(
+            "The first policy π(w₀) was repaired where it failed: {} laps failed before {}",
+            summary.start_failed_laps,
+            if outcome.best_reward_mps > 0.0 {
+                "one completed"
+            } else {
+                "the failed laps allowed ran out; the race stopped"
+            }
+        );
     }
     println!(
         "{} on {}, {} kernels, {} laps: best lap {} at {:.2} m/s, {:.1} % of the centre-line limit ({:.2} m/s), {:.1} % of the ceiling ({:.2} m/s), {:.2}x the demonstration ({:.2} m/s); {} laps failed {}",
@@ -348,6 +381,14 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         );
     }
     Ok(())
+}
+
+/// `text` with its first letter in capitals.
+fn capitalised(text: &str) -> String {
+    let mut chars = text.chars();
+    chars
+        .next()
+        .map_or(String::new(), |c| c.to_uppercase().chain(chars).collect())
 }
 
 fn slug(name: &str) -> String {

@@ -9,4 +9,5 @@ pub mod grid;
 pub mod race;
 pub mod record;
 pub mod shared;
+pub mod start;
 pub mod summary;

@@ -18,6 +18,8 @@ use crate::study::run::{Event, InMemory, run};
 use crate::track::Track;
 use crate::venue::Venue;
 
+use super::start::{DemoChoice, Demonstration, DrivenOnce, Start, complete_start, demonstration};
+
 pub use crate::line::BaseLine;
 
 /// Settings of a race.
@@ -35,6 +37,11 @@ pub struct RaceConfig {
     pub beta: f64,
     /// Demonstration speed (m/s).
     pub demo_speed: f64,
+    /// Whether the demonstration holds exactly [`demo_speed`](Self::demo_speed) (a speed the
+    /// user asked for); otherwise, where its lap fails, the fastest constant speed that
+    /// completes ([`super::start::demonstration`]).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub fixed_demo_speed: bool,
     /// The method's main knob ([`Method::knob`]: σ₀, TuRBO's L_init, LineBO's step, REMBO's
     /// box); `None`: its race value. Older configs name it `sigma0`.
     #[serde(default, alias = "sigma0", skip_serializing_if = "Option::is_none")]
@@ -102,6 +109,7 @@ impl Default for RaceConfig {
             seed: 0,
             beta: crate::acquisition::ucb::DEFAULT_BETA,
             demo_speed: 15.0,
+            fixed_demo_speed: false,
             knob: None,
             max_failed_laps: None,
             line_kernels: None,
@@ -165,9 +173,15 @@ pub struct LapRecord {
 pub struct RaceOutcome {
     /// The demonstration lap.
     pub demo: LapResult,
+    /// What the demonstration search chose where the asked speed's lap failed.
+    pub demo_choice: Option<DemoChoice>,
+    /// Laps of the first policy that failed before one completed
+    /// ([`super::start::complete_start`]): the race's first laps, among its failed ones.
+    pub start_failed_laps: usize,
     /// The demonstration's (x, a) pairs.
     pub demo_pairs: Vec<(f64, f64)>,
-    /// The policy the race started from: the demonstration's fit, or the warm start.
+    /// The policy the race started from: the demonstration's fit (repaired where its laps
+    /// failed, [`super::start::complete_start`]), or the warm start.
     pub initial: Policy,
     /// The best policy found.
     pub best: Policy,
@@ -202,30 +216,38 @@ pub fn race(
         }
         None => venue,
     };
-    let demo = venue.demonstrate(config.demo_speed)?;
+    let (demo, choice) = demonstration(config.demo_speed, config.fixed_demo_speed, |v| {
+        venue.demonstrate(v)
+    })?;
     let mut evaluator = venue.evaluator(config.shape()?)?;
+    let speed = choice.as_ref().map_or(config.demo_speed, |c| c.chosen_mps);
     let mut outcome = race_with(
         &track.name,
-        demo,
+        (demo, speed),
         limit,
         config,
-        evaluator.as_mut(),
+        (evaluator.as_mut(), &mut |v| venue.demonstrate(v)),
         progress,
     )?;
     outcome.line = line;
+    outcome.demo_choice = choice;
     Ok(outcome)
 }
 
 /// Runs a race whose laps `evaluator` drives with policies of length-scale
 /// [`default_lengthscale`]`(config.kernels)`, from a demonstration already driven there (its
-/// lap and (x, a) pairs); `progress` is called after every lap. The laps go through the one
+/// lap and (x, a) pairs, and the speed it held), slower ones by `demonstrate` where the first
+/// policy needs one ([`complete_start`]); `progress` is called after every lap. The laps go through the one
 /// lap loop ([`crate::study::run`]) with an in-memory trial source.
 fn race_with(
     track_name: &str,
-    (demo, demo_pairs): (LapResult, Vec<(f64, f64)>),
+    ((demo, demo_pairs), demo_speed): (Demonstration, f64),
     limit: Limit,
     config: &RaceConfig,
-    evaluator: &mut dyn Evaluator,
+    (evaluator, demonstrate): (
+        &mut dyn Evaluator,
+        &mut dyn FnMut(f64) -> Result<Demonstration>,
+    ),
     mut progress: impl FnMut(&LapRecord),
 ) -> Result<RaceOutcome> {
     crate::sizes::KERNELS.checked(config.kernels)?;
@@ -251,7 +273,7 @@ fn race_with(
     // w₀: the warm start, or the pedal fitted to the demonstration and a line at the base line
     // (d = 0).
     let shape = config.shape()?;
-    let initial = match &config.warm_start {
+    let mut initial = match &config.warm_start {
         Some(_) if shape.line.is_some() => {
             return Err(Error::invalid_value(
                 "a warm start with a learned line",
@@ -271,15 +293,76 @@ fn race_with(
             },
         },
     };
-    let optimizer = config
-        .spec()?
-        .policy(lengthscale)?
-        .track_length(limit.track_length)?
-        .optimizer(initial.weights())?;
+    // The first policy driven, and repaired where it fails, until its lap completes; a warm
+    // start is the method's to repair.
+    let budget = match config.max_failed_laps {
+        Some(max) => Some(max),
+        None if config.method == Method::SafePatternSearch => {
+            Some(crate::learner::safe_search::BUDGET)
+        }
+        None => None,
+    };
+    let start_cap = budget.unwrap_or(config.laps).min(config.laps);
+    let start = if config.warm_start.is_some() {
+        None
+    } else {
+        Some(complete_start(
+            evaluator,
+            initial.clone(),
+            (&demo_pairs, demo_speed),
+            demonstrate,
+            limit.track_length,
+            start_cap,
+        )?)
+    };
+    let start_failed = start.as_ref().map_or(0, Start::failed);
     let mut laps = Vec::with_capacity(config.laps);
     let mut best = (initial.weights(), 0.0);
-    let mut source = InMemory::new(optimizer, config.laps);
-    run(&mut source, evaluator, &mut |event| {
+    for (i, (outcome, seconds)) in start.iter().flat_map(|s| &s.laps).enumerate() {
+        if matches!(outcome, Outcome::Failed { .. }) {
+            let record = start_record(i + 1, outcome, *seconds);
+            progress(&record);
+            laps.push(record);
+        }
+    }
+    let (first, remembered) = match &start {
+        Some(s) if !s.completed() => {
+            return Ok(RaceOutcome {
+                demo,
+                demo_pairs,
+                demo_choice: None,
+                start_failed_laps: start_failed,
+                best: s.policy.clone(),
+                initial,
+                best_reward_mps: 0.0,
+                laps,
+                limit,
+                line: None,
+            });
+        }
+        Some(s) => {
+            initial = s.policy.clone();
+            let (outcome, seconds) = s.laps.last().cloned().unzip();
+            let lap = outcome.map(|o| (s.policy.weights(), o));
+            (s.policy.weights(), (lap, seconds.unwrap_or(0.0)))
+        }
+        None => (initial.weights(), (None, 0.0)),
+    };
+    let mut spec = config.spec()?;
+    if let Some(max) = budget.filter(|_| start_failed > 0) {
+        spec = spec.max_failed_laps(max - start_failed);
+    }
+    if start.is_some() {
+        spec = spec.start_completed();
+    }
+    let optimizer = spec
+        .policy(lengthscale)?
+        .track_length(limit.track_length)?
+        .optimizer(first)?;
+    let mut source = InMemory::new(optimizer, config.laps - start_failed);
+    let (lap, mut start_s) = remembered;
+    let mut evaluator = DrivenOnce::new(evaluator, lap);
+    run(&mut source, &mut evaluator, &mut |event| {
         let Event::Told {
             trial,
             outcome,
@@ -293,7 +376,7 @@ fn race_with(
             best = (trial.weights.clone(), reward);
         }
         let record = LapRecord {
-            lap: trial.id as usize,
+            lap: start_failed + trial.id as usize,
             reward_mps: reward,
             best_mps: best.1,
             lap_time_s: match outcome {
@@ -306,7 +389,7 @@ fn race_with(
             },
             x_fail: outcome.failed_at(),
             optimizer_s: timing.ask_s + timing.tell_s,
-            simulator_s: timing.evaluate_s,
+            simulator_s: timing.evaluate_s + std::mem::take(&mut start_s),
         };
         progress(&record);
         laps.push(record);
@@ -314,6 +397,8 @@ fn race_with(
     Ok(RaceOutcome {
         demo,
         demo_pairs,
+        demo_choice: None,
+        start_failed_laps: start_failed,
         initial,
         best: shape.policy(&best.0)?,
         best_reward_mps: best.1,
@@ -321,6 +406,24 @@ fn race_with(
         limit,
         line: None,
     })
+}
+
+/// The record of the `lap`-th lap of the first policy, failed as `outcome` says, driven in
+/// `seconds`.
+fn start_record(lap: usize, outcome: &Outcome, seconds: f64) -> LapRecord {
+    LapRecord {
+        lap,
+        reward_mps: 0.0,
+        best_mps: 0.0,
+        lap_time_s: None,
+        failure: match outcome {
+            Outcome::Failed { reason, .. } => Some(failure_reason(reason.as_deref())),
+            _ => None,
+        },
+        x_fail: outcome.failed_at(),
+        optimizer_s: 0.0,
+        simulator_s: seconds,
+    }
 }
 
 /// A failed lap's reason as the race records it: the simulator's (and the game robot's)

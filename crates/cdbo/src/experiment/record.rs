@@ -207,6 +207,7 @@ pub fn run_at(
         seed: spec.seed(),
         beta: grid.beta,
         demo_speed: grid.demo_speed,
+        fixed_demo_speed: false,
         knob: Some(grid.knob_of(method)),
         max_failed_laps: None,
         line_kernels,

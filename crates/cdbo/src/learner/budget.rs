@@ -4,8 +4,10 @@
 //! `max_failed` laps; on a real car it is the lap the learner is most certain of.
 //!
 //! A lap failed when its reward is 0 or its failure was told ([`FailedLap`]). A lap can be
-//! driven again only once one has completed: until then the method goes on proposing (where
-//! w₀'s own lap fails, the cap holds from the first completed lap on).
+//! driven again only once one has completed, or where the start is known to complete
+//! ([`FailureBudget::falling_back_to`]: a race drives its start until it does,
+//! [`crate::experiment::start`]): then the cap holds from the first lap. Otherwise the method
+//! goes on proposing until a lap completes.
 
 use serde::{Deserialize, Serialize};
 
@@ -26,6 +28,10 @@ pub struct BudgetState {
     pub failed: usize,
     /// Laps driven again after the budget was spent (not told to the method).
     pub repeats: usize,
+    /// A start known to complete, driven again once the budget is spent while no lap of the
+    /// method has completed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fallback: Option<Vec<f64>>,
 }
 
 /// A method that fails at most `max_failed` laps.
@@ -34,6 +40,7 @@ pub struct FailureBudget {
     max_failed: usize,
     failed: usize,
     repeats: usize,
+    fallback: Option<Vec<f64>>,
 }
 
 impl FailureBudget {
@@ -44,6 +51,16 @@ impl FailureBudget {
             max_failed,
             failed: 0,
             repeats: 0,
+            fallback: None,
+        }
+    }
+
+    /// This budget with `start` known to complete: once the budget is spent, `start` is driven
+    /// again while no lap of the method has completed.
+    pub fn falling_back_to(self, start: Vec<f64>) -> FailureBudget {
+        FailureBudget {
+            fallback: Some(start),
+            ..self
         }
     }
 
@@ -57,6 +74,7 @@ impl FailureBudget {
             max_failed: state.max_failed,
             failed: state.failed,
             repeats: state.repeats,
+            fallback: state.fallback,
         })
     }
 
@@ -65,12 +83,14 @@ impl FailureBudget {
         self.failed >= self.max_failed
     }
 
-    /// The lap driven again once the budget is spent: the best completed one.
+    /// The lap driven again once the budget is spent: the best completed one, else the start
+    /// known to complete.
     fn safest(&self) -> Option<Vec<f64>> {
         self.inner
             .best()
             .filter(|(_, reward)| *reward > 0.0)
             .map(|(w, _)| w.to_vec())
+            .or_else(|| self.fallback.clone())
     }
 }
 
@@ -128,6 +148,7 @@ impl Optimizer for FailureBudget {
                 max_failed: self.max_failed,
                 failed: self.failed,
                 repeats: self.repeats,
+                fallback: self.fallback.clone(),
             },
         )
     }

@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
-use super::{LineOptions, RacingLine, SAFETY_MARGIN};
+use super::{LineOptions, RacingLine};
 use crate::car::Car;
 use crate::error::{Error, Result};
 use crate::track::Track;
@@ -19,7 +19,9 @@ pub enum BaseLine {
     #[default]
     Centre,
     /// The minimum-curvature racing line ([`RacingLine::minimum_curvature`]) at half the car's
-    /// width plus [`SAFETY_MARGIN`] from the road's edges: |d₀(s)| ≤ w(s)/2 − w_car/2 − 0.5 m.
+    /// width plus [`SAFETY_MARGIN`](crate::line::SAFETY_MARGIN) inside the edge laps are
+    /// learned by ([`LineOptions::for_race`]): |d₀(s)| ≤ w(s)/2 − w_car/2 − 0.5 m, a metre less
+    /// where the track gives no verges.
     MinCurvature,
 }
 
@@ -43,7 +45,7 @@ impl BaseLine {
             BaseLine::Centre => None,
             BaseLine::MinCurvature => Some(Arc::new(RacingLine::minimum_curvature(
                 track,
-                &LineOptions::for_car(car, SAFETY_MARGIN),
+                &LineOptions::for_race(car, track),
             )?)),
         })
     }

@@ -32,6 +32,7 @@ pub struct Spec {
     pedal_kernels: Option<usize>,
     max_failed_laps: Option<usize>,
     warm: bool,
+    start_completes: bool,
 }
 
 impl Spec {
@@ -54,6 +55,7 @@ impl Spec {
             pedal_kernels: None,
             max_failed_laps: None,
             warm: false,
+            start_completes: false,
         }
         .with_checked_knob(method.knob().value)
     }
@@ -172,6 +174,17 @@ impl Spec {
         Spec { warm: true, ..self }
     }
 
+    /// This specification for a start w₀ whose lap is known to complete (a race drives it until
+    /// it does, [`crate::experiment::start`]): a budget of failed laps spent before any lap of
+    /// the method has completed drives the start again ([`FailureBudget::falling_back_to`]), so
+    /// that the budget is a cap from the first lap.
+    pub fn start_completed(self) -> Spec {
+        Spec {
+            start_completes: true,
+            ..self
+        }
+    }
+
     /// The method.
     pub fn method(&self) -> Method {
         self.method
@@ -196,10 +209,15 @@ impl Spec {
     /// The method's optimiser, from w₀ (within its failed-lap budget, if it has one; the safe
     /// pattern search spends its budget itself, [`safe_search::BUDGET`] unless told).
     pub fn optimizer(&self, w0: Vec<f64>) -> Result<Box<dyn Optimizer + Send>> {
-        let method = self.method_optimizer(w0)?;
+        let method = self.method_optimizer(w0.clone())?;
         Ok(match self.max_failed_laps {
             Some(max) if self.method != Method::SafePatternSearch => {
-                Box::new(FailureBudget::new(method, max))
+                let budget = FailureBudget::new(method, max);
+                Box::new(if self.start_completes {
+                    budget.falling_back_to(w0)
+                } else {
+                    budget
+                })
             }
             _ => method,
         })
@@ -218,6 +236,7 @@ impl Spec {
             pedal_kernels,
             max_failed_laps,
             warm,
+            start_completes: _,
         } = *self;
         let pattern_search = pattern_search::PatternSearchConfig {
             seed,
@@ -437,5 +456,36 @@ mod tests {
             assert!(e.contains("search-box radius"), "{bad}: {e}");
         }
         assert!(spec.box_radius(crate::optimizers::MAX_BOX_RADIUS).is_ok());
+    }
+
+    /// Every method's first lap is its start w₀ (CMA-ES's excepted: it samples around it), as
+    /// a race relies on: the race drives the start until it completes and hands the completed
+    /// lap to the method as its first. Told that the start completes, a budget spent before any
+    /// lap of the method's completed drives the start again, CMA-ES's included.
+    #[test]
+    fn every_methods_first_lap_is_its_start() {
+        let w0: Vec<f64> = (0..12).map(|i| 0.1 * i as f64 - 0.3).collect();
+        for method in Method::ALL {
+            let spec = Spec::race(method)
+                .policy(1.0 / 11.0)
+                .unwrap()
+                .track_length(3000.0)
+                .unwrap();
+            let first = spec.optimizer(w0.clone()).unwrap().ask().unwrap();
+            assert_eq!(first == w0, method != Method::Cmaes, "{method}");
+            if method == Method::SafePatternSearch {
+                continue;
+            }
+            let mut spent = spec
+                .max_failed_laps(0)
+                .start_completed()
+                .optimizer(w0.clone())
+                .unwrap();
+            for _ in 0..3 {
+                let w = spent.ask().unwrap();
+                assert_eq!(w, w0, "{method}");
+                spent.tell(&w, 0.0).unwrap();
+            }
+        }
     }
 }

@@ -161,6 +161,21 @@ fn build(rows: &[[f64; 4]], name: &str, file: &str) -> Result<Track> {
             )
         })
         .collect();
+    if let Some((i, j)) = first_crossing(&centre) {
+        return Err(Error::parse(
+            file,
+            "rows",
+            format!(
+                "the centre line crosses itself: its segment from point {} to {} crosses the one from point {} to {} (near ({:.1}, {:.1}) m); a circuit's centre line must not cross",
+                i + 1,
+                (i + 1) % n + 1,
+                j + 1,
+                (j + 1) % n + 1,
+                centre[j].0,
+                centre[j].1
+            ),
+        ));
+    }
     let mut t = vec![0.0; n];
     for i in 1..n {
         t[i] = t[i - 1] + (centre[i].0 - centre[i - 1].0).hypot(centre[i].1 - centre[i - 1].1);
@@ -259,6 +274,42 @@ fn build(rows: &[[f64; 4]], name: &str, file: &str) -> Result<Track> {
     ))
 }
 
+/// The first pair (i, j), i < j, of segments pᵢpᵢ₊₁ and pⱼpⱼ₊₁ of the closed polygon `p` that
+/// are not neighbours and cross: each segment's ends lie on opposite sides of the other's
+/// line (the signs of the cross products differ). Segments are compared only where their
+/// bounding boxes overlap, after sorting by their least x.
+fn first_crossing(p: &[(f64, f64, f64)]) -> Option<(usize, usize)> {
+    let n = p.len();
+    let seg = |i: usize| ((p[i].0, p[i].1), (p[(i + 1) % n].0, p[(i + 1) % n].1));
+    let side = |a: (f64, f64), b: (f64, f64), c: (f64, f64)| {
+        (b.0 - a.0) * (c.1 - a.1) - (b.1 - a.1) * (c.0 - a.0)
+    };
+    let mut order: Vec<usize> = (0..n).collect();
+    let min_x = |i: usize| seg(i).0.0.min(seg(i).1.0);
+    order.sort_by(|&a, &b| min_x(a).total_cmp(&min_x(b)));
+    let mut found: Option<(usize, usize)> = None;
+    for (k, &i) in order.iter().enumerate() {
+        let (a, b) = seg(i);
+        let max_x = a.0.max(b.0);
+        for &j in &order[k + 1..] {
+            if min_x(j) > max_x {
+                break;
+            }
+            if (i + 1) % n == j || (j + 1) % n == i {
+                continue;
+            }
+            let (c, d) = seg(j);
+            let crosses =
+                side(a, b, c) * side(a, b, d) < 0.0 && side(c, d, a) * side(c, d, b) < 0.0;
+            if crosses {
+                let pair = (i.min(j), i.max(j));
+                found = Some(found.map_or(pair, |f| f.min(pair)));
+            }
+        }
+    }
+    found
+}
+
 /// Replaces each curvature by its mean over samples i−half..=i+half (periodic).
 /// The window is cut to the lap on a lap shorter than it.
 fn smooth_curvature(samples: &mut [Sample], half: usize) {
@@ -317,6 +368,24 @@ mod tests {
         assert!(e.contains("at least 10 points"), "{e}");
         let e = parse("1,2,3\n", "c", "c.csv").unwrap_err().to_string();
         assert!(e.contains("expected 4 columns"), "{e}");
+    }
+
+    /// A figure of eight crosses itself at its waist: refused, naming the two segments.
+    #[test]
+    fn a_centre_line_that_crosses_itself_is_refused() {
+        let n = 60;
+        let mut s = String::new();
+        for i in 0..n {
+            let a = i as f64 / n as f64 * std::f64::consts::TAU;
+            s += &format!("{},{},5,5\n", 300.0 * a.sin(), 150.0 * (2.0 * a).sin());
+        }
+        let e = parse(&s, "c", "c.csv").unwrap_err().to_string();
+        assert!(e.contains("the centre line crosses itself"), "{e}");
+        assert!(
+            e.contains("segment from point 31 to 32 crosses the one from point 60 to 1"),
+            "{e}"
+        );
+        assert!(parse(&circle_csv(72, 200.0), "c", "c.csv").is_ok());
     }
 
     #[test]

@@ -1,0 +1,319 @@
+//! The start of a race on any circuit: a demonstration that completes under the rule the laps
+//! are learned by, and a first policy π(w₀) that completes before any method learns from it.
+//!
+//! **The demonstration.** The paper's PI holds 15 m/s ([`crate::drive::demo`]); where that lap
+//! leaves the road (a tight chicane on a circuit whose laps keep a reserve of the road), and
+//! the speed was not asked for, a short search finds the fastest constant speed that completes:
+//! the speed falls by [`SLOWDOWN`] until a lap completes (no slower than [`SLOWEST`]), then
+//! [`BISECTIONS`] halvings of the interval between the slowest failing and the fastest
+//! completing speed. Each is one lap of the demonstrator, not counted among the race's laps
+//! (as the paper's demonstration is not). Where 15 m/s completes nothing changes.
+//!
+//! **The first policy.** w₀, the demonstration's fit, is a smoothed copy of the demonstrator's
+//! pedal, and can be faster than the demonstrator where the fit spreads its launch: where its
+//! lap leaves the road its pedal is lowered before the place (to half the demonstrator's
+//! throttle at most), where it
+//! stalls raised, and where that does not help it is fitted again to a slower demonstration,
+//! until its lap completes ([`complete_start`]). These laps are the race's first laps and count among its failed ones; the
+//! method then starts from the policy whose lap completed (its first lap, which it does not
+//! drive again).
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+use crate::evaluator::{Evaluator, Outcome};
+use crate::learner::pattern_search::push::REPAIR_DISTANCE;
+use crate::learner::repair::REPAIR_SPACINGS;
+use crate::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
+use crate::policy::{Policy, RkhsPolicy};
+use crate::sim::{Failure, LapResult};
+
+/// Each speed the demonstration search tries is this share of the last that failed.
+pub const SLOWDOWN: f64 = 0.8;
+/// The slowest demonstration the search tries (m/s).
+pub const SLOWEST: f64 = 2.0;
+/// Halvings of the interval between the last failing and the first completing speed.
+pub const BISECTIONS: usize = 3;
+/// Where lowering its pedal cannot help a first policy's lap too fast, it is fitted again to a
+/// demonstration this much slower.
+pub const START_SLOWDOWN: f64 = 0.9;
+/// How much a first policy's pedal is lowered before where its lap was too fast.
+pub const START_STEP: f64 = 0.1;
+
+/// A demonstration as the race drove it: its lap and the (x, a) pairs of every driver step.
+pub type Demonstration = (LapResult, Vec<(f64, f64)>);
+
+/// What the demonstration search chose where the asked speed's lap failed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DemoChoice {
+    /// The speed asked for (m/s).
+    pub asked_mps: f64,
+    /// How its lap failed.
+    pub failure: Failure,
+    /// The fastest speed found to complete (m/s).
+    pub chosen_mps: f64,
+    /// Demonstration laps the search drove, the asked speed's included.
+    pub laps: usize,
+}
+
+impl DemoChoice {
+    /// One line saying what was chosen and why.
+    pub fn sentence(&self, track: &str) -> String {
+        format!(
+            "the {} m/s demonstration does not complete {track} ({} at {:.0} % of the lap); \
+             demonstrating at {:.2} m/s instead, the fastest constant speed that completed in a \
+             search of {} laps",
+            self.asked_mps,
+            self.failure.reason.name(),
+            100.0 * self.failure.x,
+            self.chosen_mps,
+            self.laps
+        )
+    }
+}
+
+/// The demonstration at `speed` (m/s) by `demonstrate`; where its lap fails and the speed is
+/// not `fixed`, the fastest constant speed whose lap completes (see the [module](self)), and
+/// what was chosen. A fixed speed's failed lap is returned as it is (the race refuses it).
+pub fn demonstration(
+    speed: f64,
+    fixed: bool,
+    mut demonstrate: impl FnMut(f64) -> Result<Demonstration>,
+) -> Result<(Demonstration, Option<DemoChoice>)> {
+    let first = demonstrate(speed)?;
+    let Some(failure) = first.0.failure.filter(|_| !first.0.completed && !fixed) else {
+        return Ok((first, None));
+    };
+    let mut laps = 1;
+    let (mut failing, mut completing) = (speed, None);
+    while completing.is_none() {
+        let v = SLOWDOWN * failing;
+        if v < SLOWEST {
+            return Ok((first, None));
+        }
+        let demo = demonstrate(v)?;
+        laps += 1;
+        if demo.0.completed {
+            completing = Some((v, demo));
+        } else {
+            failing = v;
+        }
+    }
+    let Some((mut v, mut best)) = completing else {
+        return Ok((first, None));
+    };
+    for _ in 0..BISECTIONS {
+        let mid = 0.5 * (v + failing);
+        let demo = demonstrate(mid)?;
+        laps += 1;
+        if demo.0.completed {
+            (v, best) = (mid, demo);
+        } else {
+            failing = mid;
+        }
+    }
+    let choice = DemoChoice {
+        asked_mps: speed,
+        failure,
+        chosen_mps: v,
+        laps,
+    };
+    Ok((best, Some(choice)))
+}
+
+/// The first policy of a race, driven until its lap completes.
+#[derive(Debug, Clone)]
+pub struct Start {
+    /// The policy the method starts from: w₀, repaired where its laps failed.
+    pub policy: Policy,
+    /// The outcome of each lap driven, in order: failed ones, then the completed one, if any.
+    pub laps: Vec<(Outcome, f64)>,
+    /// The speed (m/s) of the demonstration the policy was last fitted to.
+    pub speed_mps: f64,
+}
+
+impl Start {
+    /// Laps that failed.
+    pub fn failed(&self) -> usize {
+        self.laps
+            .iter()
+            .filter(|(o, _)| matches!(o, Outcome::Failed { .. }))
+            .count()
+    }
+
+    /// Whether the last lap completed.
+    pub fn completed(&self) -> bool {
+        self.laps
+            .last()
+            .is_some_and(|(o, _)| !matches!(o, Outcome::Failed { .. }))
+    }
+}
+
+/// Drives `initial` (its pedal w₀ fitted to the demonstration `targets`, held at `speed` m/s)
+/// with `evaluator` until its lap completes, at most `max_failed` laps failing. After a lap too
+/// fast (off the road, spun, backwards), the fit's targets over the [`REPAIR_DISTANCE`] metres
+/// (at least two kernel spacings) before the failure are lowered by [`START_STEP`], but none
+/// below half the demonstrator's throttle there (a cruising pedal braked, or only coasting,
+/// over that stretch stops the car); after a lap too slow (stalled, time limit), they are
+/// raised by half the step before the stall. Where that cannot help — the lap failed within a
+/// kernel spacing of where one failed since the last fit to a demonstration, or where the
+/// targets are at their floor already, or the venue did not say where — w₀ is fitted again to
+/// a demonstration [`START_SLOWDOWN`] as fast, by `demonstrate`. Each lap's outcome and the
+/// seconds it took are kept.
+pub fn complete_start(
+    evaluator: &mut dyn Evaluator,
+    initial: Policy,
+    (targets, speed): (&[(f64, f64)], f64),
+    demonstrate: &mut dyn FnMut(f64) -> Result<Demonstration>,
+    track_length: f64,
+    max_failed: usize,
+) -> Result<Start> {
+    let kernels = initial.pedal.kernels();
+    let lengthscale = default_lengthscale(kernels);
+    let window = (REPAIR_DISTANCE / track_length).max(REPAIR_SPACINGS * lengthscale);
+    let mut demo = targets.to_vec();
+    let mut targets = demo.clone();
+    let mut speed = speed;
+    let mut places: Vec<f64> = Vec::new();
+    let mut start = Start {
+        policy: initial,
+        laps: Vec::new(),
+        speed_mps: speed,
+    };
+    loop {
+        let t0 = std::time::Instant::now();
+        let outcome = evaluator.evaluate(start.laps.len() as i64 + 1, &start.policy.weights())?;
+        start
+            .laps
+            .push((outcome.clone(), t0.elapsed().as_secs_f64()));
+        if !matches!(outcome, Outcome::Failed { .. }) || start.failed() >= max_failed {
+            return Ok(start);
+        }
+        let failed = outcome.failed_lap();
+        let again = failed.is_some_and(|f| places.iter().any(|x| (f.at - x).abs() < lengthscale));
+        places.extend(failed.map(|f| f.at));
+        let repaired = match failed {
+            Some(_) if again => false,
+            Some(f) if f.too_slow => {
+                shift(&mut targets, &demo, f.at - window, f.at, 0.5 * START_STEP)
+            }
+            Some(f) => shift(&mut targets, &demo, f.at - window, f.at, -START_STEP),
+            None => false,
+        };
+        if !repaired {
+            loop {
+                speed *= START_SLOWDOWN;
+                if speed < SLOWEST {
+                    return Ok(start);
+                }
+                let (lap, pairs) = demonstrate(speed)?;
+                if lap.completed {
+                    (demo, targets) = (pairs.clone(), pairs);
+                    places.clear();
+                    start.speed_mps = speed;
+                    break;
+                }
+            }
+        }
+        start.policy.pedal = RkhsPolicy::fit(&targets, kernels, lengthscale, DEFAULT_RIDGE)
+            .map_err(|e| Error::Numerical(format!("refitting the first policy: {e}")))?;
+    }
+}
+
+/// Moves the targets (x, a) with x in [from, to] by `step`, a lowered one no further than half
+/// its demonstration's value a₀ where that presses the throttle, a₀ itself where it brakes
+/// (`demo`: the targets and the demonstration are the same pairs, moved); whether any moved.
+fn shift(targets: &mut [(f64, f64)], demo: &[(f64, f64)], from: f64, to: f64, step: f64) -> bool {
+    let mut moved = false;
+    for ((x, a), (_, a0)) in targets.iter_mut().zip(demo) {
+        if (from..=to).contains(x) {
+            let floor = if *a0 > 0.0 { 0.5 * a0 } else { *a0 };
+            let next = if step < 0.0 {
+                (*a + step).max(floor)
+            } else {
+                *a + step
+            };
+            moved |= next != *a;
+            *a = next;
+        }
+    }
+    moved
+}
+
+/// An evaluator that has already driven one lap: the first evaluation of those weights is
+/// that lap's outcome, not driven again; every other lap is `inner`'s.
+pub struct DrivenOnce<'a> {
+    inner: &'a mut dyn Evaluator,
+    lap: Option<(Vec<f64>, Outcome)>,
+}
+
+impl<'a> DrivenOnce<'a> {
+    /// `inner`, with the lap of `weights` already driven to `outcome`.
+    pub fn new(inner: &'a mut dyn Evaluator, lap: Option<(Vec<f64>, Outcome)>) -> DrivenOnce<'a> {
+        DrivenOnce { inner, lap }
+    }
+}
+
+impl Evaluator for DrivenOnce<'_> {
+    fn evaluate(&mut self, trial: i64, weights: &[f64]) -> Result<Outcome> {
+        match self.lap.take() {
+            Some((w, outcome)) if w == weights => Ok(outcome),
+            _ => self.inner.evaluate(trial, weights),
+        }
+    }
+
+    fn remove_leftovers(&mut self) -> Vec<(std::path::PathBuf, u32)> {
+        self.inner.remove_leftovers()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sim::FailureReason;
+
+    /// A demonstrator that completes at `limit` m/s or slower.
+    fn demonstrator(limit: f64, speeds: &mut Vec<f64>) -> impl FnMut(f64) -> Result<Demonstration> {
+        move |v| {
+            speeds.push(v);
+            let completed = v <= limit;
+            let lap = LapResult {
+                completed,
+                lap_time_s: completed.then_some(100.0 / v),
+                reward_mps: if completed { v } else { 0.0 },
+                failure: (!completed).then_some(Failure {
+                    reason: FailureReason::OffTrack,
+                    x: 0.17,
+                    distance_m: 10.0,
+                    time_s: 1.0,
+                }),
+                simulated_s: 1.0,
+                trace: Vec::new(),
+            };
+            Ok((lap, vec![(0.0, v)]))
+        }
+    }
+
+    /// Where the asked speed completes, it is the only lap; where it fails, the search slows
+    /// by a fifth until a lap completes, then halves the gap three times, and keeps the
+    /// fastest that completed; a fixed speed is never searched.
+    #[test]
+    fn the_search_finds_the_fastest_speed_that_completes() {
+        let mut speeds = Vec::new();
+        let (demo, choice) = demonstration(15.0, false, demonstrator(20.0, &mut speeds)).unwrap();
+        assert!(demo.0.completed && choice.is_none());
+        assert_eq!(speeds, vec![15.0]);
+        let mut speeds = Vec::new();
+        let (demo, choice) = demonstration(15.0, false, demonstrator(10.0, &mut speeds)).unwrap();
+        let choice = choice.unwrap();
+        // 15 and 12 fail, 9.6 completes; 10.8 fails, 10.2 fails, 9.9 completes.
+        assert_eq!(speeds.len(), 6, "{speeds:?}");
+        assert!((choice.chosen_mps - 9.9).abs() < 1e-9, "{choice:?}");
+        assert_eq!(demo.0.reward_mps, choice.chosen_mps);
+        assert_eq!(choice.laps, 6);
+        assert!(choice.sentence("Monza").contains("off_track at 17 %"));
+        let mut speeds = Vec::new();
+        let (demo, choice) = demonstration(15.0, true, demonstrator(10.0, &mut speeds)).unwrap();
+        assert!(!demo.0.completed && choice.is_none() && speeds == vec![15.0]);
+    }
+}

@@ -1,0 +1,116 @@
+//! A circuit never seen: a tight chicane that the paper's 15 m/s demonstration leaves (under
+//! the rule laps are learned by) still races, every method starts from a lap that completes,
+//! and a budget of failed laps is a cap from the first lap, where π(w₀) itself fails.
+
+use cdbo::car::Car;
+use cdbo::experiment::race::{RaceConfig, RaceOutcome, race};
+use cdbo::method::Method;
+use cdbo::track::Track;
+use cdbo::venue::Venue;
+
+/// A 1.6 km circuit in the TUMFTM CSV form: two 600 m straights joined by 60 m hairpins,
+/// 8 m wide, the first straight with a chicane that moves the road 12 m aside and back over
+/// 40 m.
+fn chicane() -> Track {
+    let bump = |x: f64| {
+        let u = (x - 250.0) / 40.0;
+        if (0.0..=1.0).contains(&u) {
+            12.0 * (std::f64::consts::PI * u).sin().powi(2)
+        } else {
+            0.0
+        }
+    };
+    let r = 60.0;
+    let turn = |a: f64, cx: f64| (cx + r * a.cos(), r + r * a.sin());
+    let half = std::f64::consts::PI;
+    let mut points: Vec<(f64, f64)> = (0..300)
+        .map(|i| (2.0 * i as f64, bump(2.0 * i as f64)))
+        .collect();
+    points.extend((0..60).map(|k| turn(-0.5 * half + half * k as f64 / 60.0, 600.0)));
+    points.extend((0..300).map(|i| (600.0 - 2.0 * i as f64, 2.0 * r)));
+    points.extend((0..60).map(|k| turn(0.5 * half + half * k as f64 / 60.0, 0.0)));
+    let text: String = points
+        .iter()
+        .map(|(x, y)| format!("{x:.3},{y:.3},4,4\n"))
+        .collect();
+    cdbo::track::csv::parse(&text, "chicane", "chicane.csv").unwrap()
+}
+
+/// A race of `laps` laps on the chicane as a policy learns there (the car's centre a metre
+/// inside the road's edge).
+fn race_chicane(method: Method, laps: usize, max_failed_laps: Option<usize>) -> RaceOutcome {
+    let car = Car::spirit_300();
+    let track = chicane();
+    let venue = Venue::simulator(track.clone(), &car).for_learning(None);
+    let config = RaceConfig {
+        method,
+        laps,
+        max_failed_laps,
+        ..RaceConfig::default()
+    };
+    race(&venue, &track, &car, &config, |_| {}).unwrap()
+}
+
+/// The 15 m/s demonstration leaves the road in the chicane; the race demonstrates at the
+/// fastest constant speed that completes instead, repairs π(w₀) until its lap completes, and
+/// learns from there. With the speed held as asked, the race is refused, as before.
+#[test]
+fn a_chicane_the_papers_demonstration_leaves_still_races() {
+    let outcome = race_chicane(Method::Cdbo, 30, None);
+    let choice = outcome.demo_choice.clone().expect("a slower demonstration");
+    assert_eq!(choice.asked_mps, 15.0);
+    assert!((10.0..15.0).contains(&choice.chosen_mps), "{choice:?}");
+    assert!(outcome.demo.completed);
+    assert!(
+        outcome.best_reward_mps > outcome.demo.reward_mps,
+        "{}",
+        outcome.best_reward_mps
+    );
+    let first = outcome
+        .laps
+        .iter()
+        .position(|l| l.reward_mps > 0.0)
+        .unwrap();
+    assert_eq!(
+        first, outcome.start_failed_laps,
+        "the first completed lap is the start's"
+    );
+    assert_eq!(outcome.laps.len(), 30);
+    let car = Car::spirit_300();
+    let track = chicane();
+    let venue = Venue::simulator(track.clone(), &car).for_learning(None);
+    let fixed = RaceConfig {
+        fixed_demo_speed: true,
+        ..RaceConfig::default()
+    };
+    let e = race(&venue, &track, &car, &fixed, |_| {}).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("the 15 m/s demonstration does not complete chicane"),
+        "{e}"
+    );
+}
+
+/// Where π(w₀) fails, a budget of failed laps caps them from the first lap for every kind of
+/// method: the start's failed laps are counted, and each run still completes laps.
+#[test]
+fn the_budget_is_a_cap_where_the_first_policy_fails() {
+    for method in [
+        Method::Cdbo,
+        Method::Cmaes,
+        Method::Random,
+        Method::PatternSearch,
+        Method::SafePatternSearch,
+    ] {
+        let outcome = race_chicane(method, 40, Some(5));
+        assert!(outcome.start_failed_laps > 0, "{method}: π(w₀) completed");
+        let failed = outcome.laps.iter().filter(|l| l.failure.is_some()).count();
+        assert!(failed <= 5, "{method}: {failed} laps failed");
+        assert!(outcome.best_reward_mps > 0.0, "{method}: no lap completed");
+        assert_eq!(outcome.laps.len(), 40, "{method}");
+    }
+    // A budget the start spends: the race stops there, never past it.
+    let outcome = race_chicane(Method::Cdbo, 40, Some(2));
+    assert_eq!(outcome.laps.len(), 2);
+    assert!(outcome.laps.iter().all(|l| l.failure.is_some()));
+}
