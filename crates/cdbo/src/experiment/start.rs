@@ -23,7 +23,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::{Error, Result};
 use crate::evaluator::{Evaluator, Outcome};
 use crate::learner::pattern_search::push::REPAIR_DISTANCE;
-use crate::learner::repair::REPAIR_SPACINGS;
+use crate::policy::repair::REPAIR_SPACINGS;
 use crate::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 use crate::policy::{Policy, RkhsPolicy};
 use crate::sim::{Failure, LapResult};
