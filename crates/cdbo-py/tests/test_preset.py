@@ -89,9 +89,9 @@ def test_an_environment_of_the_preset_is_the_races_preset():
     told = []
     for _ in range(laps):
         w = opt.ask()
-        _, reward, _, _, info = env.step(w)
-        opt.tell(w, reward, failed_at=info["x_fail"], too_slow=info["too_slow"])
-        told.append(reward)
+        lap = env.lap(w)
+        opt.tell(w, lap)
+        told.append(lap.reward)
     assert told == rewards(result)
     with pytest.raises(ValueError, match="not both.*method="):
         env.optimizer("cdbo")
