@@ -1,5 +1,5 @@
 //! Racing lines: a closed path within the road, given as lateral offsets dⱼ from the centre
-//! line at stations sⱼ, and the same path as a [`Track`](crate::track::Track) whose own curvature and arc length
+//! line at stations sⱼ, and the same path as a [`Track`] whose own curvature and arc length
 //! the quasi-steady-state limit ([`crate::limit`]) can drive.
 //!
 //! [`RacingLine::minimum_curvature`] computes the minimum-curvature line of Heilmeier et al.,
