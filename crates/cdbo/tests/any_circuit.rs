@@ -53,7 +53,7 @@ fn race_chicane(method: Method, laps: usize, max_failed_laps: Option<usize>) -> 
 
 /// The 15 m/s demonstration leaves the road in the chicane; the race demonstrates at the
 /// fastest constant speed that completes instead, repairs π(w₀) until its lap completes, and
-/// learns from there. With the speed held as asked, the race is refused, as before.
+/// learns from there. With the speed held as asked, the race is refused.
 #[test]
 fn a_chicane_the_papers_demonstration_leaves_still_races() {
     let outcome = race_chicane(Method::Cdbo, 30, None);
