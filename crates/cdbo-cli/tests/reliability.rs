@@ -318,7 +318,7 @@ fn three_workers_one_killed_drive_each_trial_once() {
     );
 }
 
-/// One worker alone gives the same trials as before claims existed: the sequence of a single
+/// One worker alone gives the same trials as a run without claims: the sequence of a single
 /// uninterrupted run, whatever the lease.
 #[test]
 fn a_single_worker_is_unchanged_by_claims() {

@@ -21,8 +21,8 @@ def test_the_builtin_track_and_car_load_by_name_and_by_default():
 
 def test_a_lap_with_trace_is_consistent_and_the_limit_bounds_it():
     sim = cdbo.Simulator(cdbo.Track.load("ridgeway"), cdbo.Car.load("spirit-300"))
-    # Since the engine brake, the fit of the 15 m/s demonstration spins on Ridgeway (x = 0.57);
-    # that of a 10 m/s one completes.
+    # With the engine brake modelled, the fit of the 15 m/s demonstration spins on Ridgeway
+    # (x = 0.57); that of a 10 m/s one completes.
     demo, x, a = sim.demonstrate(10.0)
     assert demo.completed and x.shape == a.shape and np.all(np.diff(x) >= 0)
     policy = cdbo.Policy.fit(x, a, 30)

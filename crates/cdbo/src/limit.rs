@@ -35,7 +35,7 @@
 //!
 //! The crest-aware limit is the profile [the ceiling](crate::ceiling) tracks (a profile the
 //! car cannot hold over a crest says nothing about the drive stack); the crest-blind
-//! [`limit_lap`] stays the yardstick, compared across sessions.
+//! [`limit_lap`] stays the yardstick, the same for every run and every commit.
 
 use serde::Serialize;
 

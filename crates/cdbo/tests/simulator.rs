@@ -1,4 +1,5 @@
-//! The lap evaluator against the acceptance lines and against closed forms.
+//! The lap evaluator against the behaviour a lap must show (stalls, walls, verges, crests,
+//! convergence) and against closed forms.
 
 mod common;
 

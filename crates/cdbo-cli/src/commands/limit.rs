@@ -24,8 +24,7 @@ pub struct LimitArgs {
     json: bool,
 }
 
-/// `--json`: the centre line's limit at the top (as before the racing line), the line's
-/// beside it.
+/// `--json`: the centre line's limit at the top level, the racing line's beside it.
 #[derive(Serialize)]
 struct Report {
     #[serde(flatten)]

@@ -133,8 +133,8 @@ pub fn tradeoffs(records: &[RunRecord]) -> BTreeMap<Cell, Tradeoff> {
 
 /// The method with the highest mean best reward among those failing at most `share` of their
 /// laps a run on average (mean failed laps ≤ share × laps), with its trade-off; `None` if
-/// every method fails more. Ties go to the method listed first. A cap on the mean, as the
-/// issue's acceptance ("≤ 30 failed laps per run on average") states it.
+/// every method fails more. Ties go to the method listed first. A cap on the mean, as a
+/// budget of failed laps is stated ("≤ 30 failed laps per run on average").
 pub fn best_within<'a>(
     methods: impl IntoIterator<Item = (&'a str, &'a Tradeoff)>,
     share: f64,

@@ -253,8 +253,8 @@ mod tests {
         );
     }
 
-    /// A one-action policy is the paper's: its file reads and writes as before, its driver
-    /// gives the paper's pedal and the centre line.
+    /// A one-action policy is the paper's: its file reads and writes in the paper's form, its
+    /// driver gives the paper's pedal and the centre line.
     #[test]
     fn the_pedal_only_policy_is_the_papers() {
         let text = r#"{"lengthscale": 0.5, "weights": [0.25, -1.5, 0.75]}"#;

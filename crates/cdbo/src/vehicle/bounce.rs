@@ -42,7 +42,7 @@
 //! pitch and roll), and the bumps are met at the car's speed along the centre line from the
 //! lap's start rather than from each segment's (the same wavelengths, other phases). On smooth
 //! ground with the wheel settled (e = b = ḃ = 0) the load is F_qs to the last bit and nothing
-//! is computed: a track without a rough road drives as before.
+//! is computed: a track without a rough road drives on the quasi-static loads alone.
 
 use super::tyre::TyreModel;
 use crate::car::{Damper, G, Ride};

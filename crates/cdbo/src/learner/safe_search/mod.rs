@@ -29,8 +29,7 @@
 //! learner is then the pattern search itself, its push, repairs and laps exactly
 //! ([`SafeSearchConfig::within`]).
 //!
-//! Measured on the issue's four panels (6 seeds × 300 laps): README, "A learner within a
-//! budget".
+//! Measured on four panels (6 seeds × 300 laps each): README, "A learner within a budget".
 //!
 //! [`FailureBudget`]: crate::learner::budget::FailureBudget
 
@@ -49,7 +48,7 @@ use memory::{FailureMemory, Pedals};
 
 /// The method's name, and the kind of its saved state.
 pub const NAME: &str = "safe-pattern-search";
-/// Failed laps allowed by default, B: the issue's 10 % of a 300-lap race (README).
+/// Failed laps allowed by default, B: 10 % of the paper's 300-lap race (README).
 pub const BUDGET: usize = 30;
 /// The laps the budget is spent over, H (the paper's race).
 pub const HORIZON: usize = 300;
