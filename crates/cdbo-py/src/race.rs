@@ -154,11 +154,13 @@ impl PyRaceResult {
 /// ground, the body 1 m off the walls, the car's centre on the road, `LEARNING_OFF_TRACK_MARGIN`
 /// where the road's verges are not known),
 /// searching w₀ ± `bounds` (as `--box-radius`; None: 1.5).
+/// `demo_speed` (m/s) is held exactly, as `--demo-speed`; None: the paper's 15 m/s, or where its
+/// lap fails the fastest constant speed that completes (the race says which).
 /// `track` and `car` are objects or names; `knob` is the method's main knob (`cdbo race
 /// --knob`; None: its tuned value); `progress(record)` is called after every lap with the
 /// lap's record (a dict).
 #[pyfunction]
-#[pyo3(signature = (track = None, car = None, *, method = None, kernels = 30, laps = 300, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, demo_speed = 15.0, knob = None, max_failed = None, data_dir = None, progress = None, line = None, line_kernels = None, line_start = None, steering = None, off_track_margin = None, bounds = None, preset = None))]
+#[pyo3(signature = (track = None, car = None, *, method = None, kernels = 30, laps = 300, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, demo_speed = None, knob = None, max_failed = None, data_dir = None, progress = None, line = None, line_kernels = None, line_start = None, steering = None, off_track_margin = None, bounds = None, preset = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn race(
     py: Python<'_>,
@@ -169,7 +171,7 @@ pub fn race(
     laps: usize,
     seed: u64,
     beta: f64,
-    demo_speed: f64,
+    demo_speed: Option<f64>,
     knob: Option<f64>,
     max_failed: Option<usize>,
     data_dir: Option<&Bound<'_, PyAny>>,
@@ -198,8 +200,8 @@ pub fn race(
         laps,
         seed,
         beta,
-        demo_speed,
-        fixed_demo_speed: false,
+        demo_speed: demo_speed.unwrap_or(RaceConfig::default().demo_speed),
+        fixed_demo_speed: demo_speed.is_some(),
         knob,
         max_failed_laps: max_failed,
         line_kernels,
