@@ -70,7 +70,7 @@ pub struct RaceArgs {
     #[arg(long, value_name = "N")]
     max_failed_laps: Option<usize>,
     /// Half-width r of the box [w₀ − r, w₀ + r] the method searches (default 1.5). A wider box
-    /// lets the pedal brake sharper where corners come close (README, "The line everywhere").
+    /// lets the pedal brake sharper where corners come close (docs/methods.md).
     #[arg(long, value_name = "R", allow_negative_numbers = true, value_parser = super::value::box_radius)]
     box_radius: Option<f64>,
     /// How the car steers.

@@ -77,7 +77,7 @@ pub fn race_bytes(method: Method, kernels: usize, laps: usize) -> f64 {
 /// proportion (`optimizer_seconds`). Calibrated on `cdbo bench suggest` (both
 /// cores busy): 300 observations in 30, 300 and 1000 dimensions, a median 2.9, 28.7 and 110 ms
 /// per CDBO suggestion; this gives 3.7 s for CDBO's optimiser over a 300-lap, 100-kernel
-/// race, where the README's Forza-100 races measured 4.1–5.0 s under load (the estimate was
+/// race, where Forza-100 races measured 4.1–5.0 s under load (the estimate was
 /// 15.7 s with the 3 µs of an older build).
 pub fn study_seconds(method: Method, kernels: usize, laps: usize) -> f64 {
     let n = laps as f64;

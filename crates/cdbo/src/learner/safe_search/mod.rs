@@ -29,7 +29,7 @@
 //! learner is then the pattern search itself, its push, repairs and laps exactly
 //! ([`SafeSearchConfig::within`]).
 //!
-//! Measured on four panels (6 seeds × 300 laps each): README, "A learner within a budget".
+//! Measured on four panels (6 seeds × 300 laps each): docs/budgets.md.
 //!
 //! [`FailureBudget`]: crate::learner::budget::FailureBudget
 
@@ -48,12 +48,12 @@ use memory::{FailureMemory, Pedals};
 
 /// The method's name, and the kind of its saved state.
 pub const NAME: &str = "safe-pattern-search";
-/// Failed laps allowed by default, B: 10 % of the paper's 300-lap race (README).
+/// Failed laps allowed by default, B: 10 % of the paper's 300-lap race (docs/budgets.md).
 pub const BUDGET: usize = 30;
 /// The laps the budget is spent over, H (the paper's race).
 pub const HORIZON: usize = 300;
 /// The pace p: B·(t/H)^p laps may have failed after t laps (measured: 0, ¼, ½ on 3 seeds of
-/// the four benchmark panels, ½ best; README).
+/// the four benchmark panels, ½ best; docs/budgets.md).
 pub const PACE: f64 = 0.5;
 /// The reach κ of a bracket while the failed laps keep to the pace (measured: ¼ and ½).
 pub const REACH: f64 = 0.25;
