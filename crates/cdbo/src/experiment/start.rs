@@ -13,8 +13,8 @@
 //! pedal, and can be faster than the demonstrator where the fit spreads its launch: where its
 //! lap leaves the road its pedal is lowered before the place (to half the demonstrator's
 //! throttle at most), where it
-//! stalls raised, and where that does not help it is fitted again to a slower demonstration,
-//! until its lap completes ([`complete_start`]). These laps are the race's first laps and count among its failed ones; the
+//! stalls raised (up to full throttle), and where lowering does not help it is fitted again
+//! to a slower demonstration, until its lap completes ([`complete_start`]). These laps are the race's first laps and count among its failed ones; the
 //! method then starts from the policy whose lap completed (its first lap, which it does not
 //! drive again).
 
@@ -155,10 +155,12 @@ impl Start {
 /// (at least two kernel spacings) before the failure are lowered by [`START_STEP`], but none
 /// below half the demonstrator's throttle there (a cruising pedal braked, or only coasting,
 /// over that stretch stops the car); after a lap too slow (stalled, time limit), they are
-/// raised by half the step before the stall. Where that cannot help — the lap failed within a
-/// kernel spacing of where one failed since the last fit to a demonstration, or where the
-/// targets are at their floor already, or the venue did not say where — w₀ is fitted again to
-/// a demonstration [`START_SLOWDOWN`] as fast, by `demonstrate`. Each lap's outcome and the
+/// raised by the step before the stall, up to full throttle, however often it stalls there
+/// (a slower demonstration cannot help a car that stops). Where lowering cannot help — a lap
+/// too fast failed within a kernel spacing of where one failed since the last fit to a
+/// demonstration, or the targets are at their floor already — or where raising cannot (full
+/// throttle already), or the venue did not say where, w₀ is fitted again to a demonstration
+/// [`START_SLOWDOWN`] as fast, by `demonstrate`. Each lap's outcome and the
 /// seconds it took are kept.
 pub fn complete_start(
     evaluator: &mut dyn Evaluator,
@@ -193,10 +195,8 @@ pub fn complete_start(
         let again = failed.is_some_and(|f| places.iter().any(|x| (f.at - x).abs() < lengthscale));
         places.extend(failed.map(|f| f.at));
         let repaired = match failed {
+            Some(f) if f.too_slow => shift(&mut targets, &demo, f.at - window, f.at, START_STEP),
             Some(_) if again => false,
-            Some(f) if f.too_slow => {
-                shift(&mut targets, &demo, f.at - window, f.at, 0.5 * START_STEP)
-            }
             Some(f) => shift(&mut targets, &demo, f.at - window, f.at, -START_STEP),
             None => false,
         };
@@ -231,7 +231,7 @@ fn shift(targets: &mut [(f64, f64)], demo: &[(f64, f64)], from: f64, to: f64, st
             let next = if step < 0.0 {
                 (*a + step).max(floor)
             } else {
-                *a + step
+                (*a + step).min(1.0).max(*a)
             };
             moved |= next != *a;
             *a = next;
@@ -292,6 +292,63 @@ mod tests {
             };
             Ok((lap, vec![(0.0, v)]))
         }
+    }
+
+    /// A venue whose lap stalls at x = 0.3 while the pedal at x = 0.25 is below `needed`.
+    struct Hill {
+        needed: f64,
+    }
+
+    impl Evaluator for Hill {
+        fn evaluate(&mut self, _trial: i64, weights: &[f64]) -> Result<Outcome> {
+            let lengthscale = default_lengthscale(weights.len());
+            let pedal = RkhsPolicy::new(weights.to_vec(), lengthscale)?;
+            Ok(if pedal.action(0.25) < self.needed {
+                Outcome::Failed {
+                    at: Some(0.3),
+                    reason: Some("stalled".into()),
+                }
+            } else {
+                Outcome::Lap {
+                    time_s: 100.0,
+                    length_m: 1000.0,
+                }
+            })
+        }
+    }
+
+    /// A first policy that stalls again and again at one place is raised there until its lap
+    /// completes: a slower demonstration cannot help a car that stops, so none is asked for.
+    #[test]
+    fn a_stalling_first_policy_is_raised_not_slowed() {
+        let targets: Vec<(f64, f64)> = (0..100).map(|i| (i as f64 / 100.0, 0.2)).collect();
+        let kernels = 30;
+        let lengthscale = default_lengthscale(kernels);
+        let pedal = RkhsPolicy::fit(&targets, kernels, lengthscale, DEFAULT_RIDGE).unwrap();
+        let mut asked = Vec::new();
+        let mut demonstrate = |v: f64| {
+            asked.push(v);
+            demonstrator(f64::INFINITY, &mut Vec::new())(v)
+        };
+        let mut hill = Hill { needed: 0.55 };
+        let start = complete_start(
+            &mut hill,
+            pedal.into(),
+            (&targets, 15.0),
+            &mut demonstrate,
+            1000.0,
+            30,
+        )
+        .unwrap();
+        assert!(start.completed(), "{:?}", start.laps);
+        // 0.2 raised by 0.1 a lap: 0.3, 0.4, 0.5 stall (the fit sits a little below its
+        // targets), 0.6 completes.
+        assert!((3..=5).contains(&start.failed()), "{:?}", start.laps);
+        assert!(
+            asked.is_empty(),
+            "slower demonstrations asked for: {asked:?}"
+        );
+        assert_eq!(start.speed_mps, 15.0);
     }
 
     /// Where the asked speed completes, it is the only lap; where it fails, the search slows
