@@ -1,4 +1,5 @@
-//! `cdbo bench sim`: simulator throughput on one core.
+//! `cdbo bench`: simulator throughput on one core, an optimiser's suggestion, every method on
+//! a test problem, and every circuit of a folder ([`super::bench_circuits`]).
 
 use clap::{Args, Subcommand};
 use serde::Serialize;
@@ -18,6 +19,9 @@ pub enum BenchCommand {
     Suggest(SuggestArgs),
     /// Every method on a test problem: mean ± standard error of the best value, and time.
     Optimizers(OptimizersArgs),
+    /// Every circuit of a folder raced with each stack the README recommends: started or
+    /// not, first completed lap, best as % of the centre-line limit, failed laps, wall time.
+    Circuits(super::bench_circuits::CircuitsArgs),
 }
 
 #[derive(Debug, Args)]
@@ -121,6 +125,7 @@ pub fn run(cmd: &BenchCommand, data: &DataPath) -> CliResult {
         BenchCommand::Sim(args) => sim(args, data),
         BenchCommand::Suggest(args) => suggest(args),
         BenchCommand::Optimizers(args) => optimizers(args),
+        BenchCommand::Circuits(args) => super::bench_circuits::circuits(args, data),
     }
 }
 

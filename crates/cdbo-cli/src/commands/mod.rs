@@ -1,6 +1,7 @@
 //! One module per sub-command; shared argument groups here.
 
 pub mod bench;
+pub mod bench_circuits;
 pub mod ceiling;
 pub mod dashboard;
 pub mod experiment;

@@ -1,0 +1,126 @@
+//! `cdbo bench circuits`: a folder of circuits raced with each stack, one row each, the same
+//! races `cdbo race` runs.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn cdbo(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_cdbo"))
+        .args(args)
+        .output()
+        .expect("runs")
+}
+
+fn json(args: &[&str]) -> serde_json::Value {
+    let out = cdbo(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("JSON")
+}
+
+/// A folder of this test's own, emptied.
+fn folder(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("cdbo-bench-test-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// An ellipse of half-axes `a` and `b` metres, 12 m wide, as a TUMFTM `.csv` centre line.
+fn ellipse(a: f64, b: f64) -> String {
+    (0..120).fold(
+        String::from("# x_m,y_m,w_tr_right_m,w_tr_left_m\n"),
+        |s, i| {
+            let t = i as f64 / 120.0 * std::f64::consts::TAU;
+            s + &format!("{},{},6,6\n", a * t.cos(), b * t.sin())
+        },
+    )
+}
+
+#[test]
+fn every_circuit_of_a_folder_is_raced_with_each_stack_as_race_races_it() {
+    let dir = folder("two");
+    std::fs::write(dir.join("Round.csv"), ellipse(150.0, 150.0)).unwrap();
+    std::fs::write(dir.join("Long.csv"), ellipse(300.0, 120.0)).unwrap();
+    std::fs::write(dir.join("notes.txt"), "not a track").unwrap();
+    let report = json(&[
+        "bench",
+        "circuits",
+        dir.to_str().unwrap(),
+        "--stacks",
+        "fast-safe,pattern-search",
+        "--laps",
+        "12",
+        "--jobs",
+        "2",
+        "--json",
+    ]);
+    let rows = report["rows"].as_array().unwrap();
+    let names: Vec<(&str, &str)> = rows
+        .iter()
+        .map(|r| (r["circuit"].as_str().unwrap(), r["stack"].as_str().unwrap()))
+        .collect();
+    assert_eq!(
+        names,
+        [
+            ("Long", "fast-safe"),
+            ("Long", "pattern-search"),
+            ("Round", "fast-safe"),
+            ("Round", "pattern-search"),
+        ]
+    );
+    for row in rows {
+        assert_eq!(row["started"], 1, "{row}");
+        assert!(row["first_completed_lap"].as_u64().is_some(), "{row}");
+        let share = row["best_of_limit"].as_f64().unwrap();
+        assert!(share > 0.2 && share < 1.5, "{row}");
+    }
+    // Each run is the race `cdbo race` runs with the same stack, bit for bit.
+    for run in report["runs"].as_array().unwrap() {
+        let file = dir.join(format!("{}.csv", run["circuit"].as_str().unwrap()));
+        let stack = run["stack"].as_str().unwrap();
+        let flag = if stack == "fast-safe" {
+            "--preset"
+        } else {
+            "--method"
+        };
+        let out = folder(&format!(
+            "race-{}-{stack}",
+            run["circuit"].as_str().unwrap()
+        ));
+        let summary = json(&[
+            "race",
+            "--track",
+            file.to_str().unwrap(),
+            flag,
+            stack,
+            "--laps",
+            "12",
+            "--json",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(run["best_mps"], summary["best_reward_mps"], "{run}");
+        assert_eq!(run["failed_laps"], summary["failed_laps"], "{run}");
+    }
+}
+
+#[test]
+fn a_folder_without_circuits_and_an_unknown_stack_get_one_clear_line() {
+    let dir = folder("empty");
+    let out = cdbo(&["bench", "circuits", dir.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(err.contains("no track in this folder"), "{err}");
+    let out = cdbo(&["bench", "circuits", "ridgeway", "--stacks", "fastest"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("\"fastest\" is neither a preset (fast-safe) nor a method"),
+        "{err}"
+    );
+}
