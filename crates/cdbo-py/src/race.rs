@@ -153,14 +153,15 @@ impl PyRaceResult {
 /// default, None, keeping the reserve `cdbo race` learns with: the wheels 0.25 m off slippery
 /// ground, the body 1 m off the walls, the car's centre on the road, `LEARNING_OFF_TRACK_MARGIN`
 /// where the road's verges are not known),
-/// searching w₀ ± `bounds` (as `--box-radius`; None: 1.5).
+/// searching w₀ ± `bounds` (as `--box-radius`; None: 1.5), on the flying lap if `flying` (as
+/// `--flying`: the second of two laps from the standing start, timed line to line).
 /// `demo_speed` (m/s) is held exactly, as `--demo-speed`; None: the paper's 15 m/s, or where its
 /// lap fails the fastest constant speed that completes (the race says which).
 /// `track` and `car` are objects or names; `knob` is the method's main knob (`cdbo race
 /// --knob`; None: its tuned value); `progress(record)` is called after every lap with the
 /// lap's record (a dict).
 #[pyfunction]
-#[pyo3(signature = (track = None, car = None, *, method = None, kernels = 30, laps = 300, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, demo_speed = None, knob = None, max_failed = None, data_dir = None, progress = None, line = None, line_kernels = None, line_start = None, steering = None, off_track_margin = None, bounds = None, preset = None))]
+#[pyo3(signature = (track = None, car = None, *, method = None, kernels = 30, laps = 300, seed = 0, beta = cdbo::acquisition::ucb::DEFAULT_BETA, demo_speed = None, knob = None, max_failed = None, data_dir = None, progress = None, line = None, line_kernels = None, line_start = None, steering = None, off_track_margin = None, bounds = None, preset = None, flying = false))]
 #[allow(clippy::too_many_arguments)]
 pub fn race(
     py: Python<'_>,
@@ -183,6 +184,7 @@ pub fn race(
     off_track_margin: Option<f64>,
     bounds: Option<f64>,
     preset: Option<&str>,
+    flying: bool,
 ) -> PyResult<PyRaceResult> {
     let stack = Stack::of(preset, method, steering, line, line_kernels, line_start)?;
     let track = track_from(py, track, data_dir)?;
@@ -208,6 +210,7 @@ pub fn race(
         warm_start: None,
         base_line,
         box_radius: bounds,
+        flying,
     };
     config.spec().py()?;
     let mut callback_error: Option<PyErr> = None;

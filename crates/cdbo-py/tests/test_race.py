@@ -192,3 +192,15 @@ def test_the_gil_is_released_while_laps_run():
         sys.setswitchinterval(old)
     assert seen == list(range(1, laps + 1))
     assert ran_after[0] < laps, f"the main thread ran only after {ran_after[0]} laps"
+
+
+def test_flying_is_the_clis_flying_lap(cli, tmp_path):
+    """`flying=True` is `cdbo race --flying`: the same laps, bit for bit, and not the standing
+    laps' race."""
+    args = ("race", "--json", "--laps", 30, "--preset", "fast-safe")
+    summary = json.loads(cli(*args, "--flying", "--out", tmp_path))
+    result = cdbo.race("ridgeway", laps=30, preset="fast-safe", flying=True)
+    assert result.best_reward == summary["best_reward_mps"]
+    assert summary["best_lap_time_s"] == summary["best_flying_lap_s"]
+    standing = cdbo.race("ridgeway", laps=30, preset="fast-safe")
+    assert standing.best_reward != result.best_reward

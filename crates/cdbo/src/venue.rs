@@ -85,6 +85,19 @@ impl Venue {
         }
     }
 
+    /// This venue timing flying laps ([`LapConfig::flying`]): the second of two laps from the
+    /// standing start. cdbo's simulator only; the game's robot times the standing lap.
+    pub fn flying(self) -> Result<Venue> {
+        match &self {
+            Venue::Simulator(_) => Ok(self.configured(|config| config.flying = true)),
+            Venue::Game { .. } => Err(crate::error::Error::invalid_value(
+                "a flying lap's venue",
+                "the game TORCS",
+                "cdbo's simulator (in the game cdbo's robot times the standing lap)",
+            )),
+        }
+    }
+
     /// The settings every lap here is driven with (its steering, line and failure rules).
     pub fn config(&self) -> &LapConfig {
         match self {

@@ -526,3 +526,71 @@ fn the_robot_pulls_away_on_the_slipping_clutch() {
         "{mean} m/s² vs {without}..{with}"
     );
 }
+
+/// A flying lap starts with the car at speed on the line and is timed line to line: the
+/// 15 m/s demonstrator's flying lap on Ridgeway is its length at 15 m/s within 1 %, faster
+/// than its standing lap, which is, bit for bit, the lap it drives alone; and the car crosses
+/// the line into it at the held speed.
+#[test]
+fn a_flying_lap_starts_at_speed_and_is_timed_line_to_line() {
+    let track = builtin("ridgeway");
+    let length = track.length;
+    let mut sim = Simulator::new(track, &Car::spirit_300());
+    let standing = sim.lap(&mut SpeedHold::new(15.0));
+    sim.config.flying = true;
+    sim.config.trace = true;
+    let flying = sim.lap(&mut SpeedHold::new(15.0));
+    assert!(flying.completed, "{:?}", flying.failure);
+    assert_eq!(flying.standing_lap_s, standing.lap_time_s);
+    let t = flying.lap_time_s.unwrap();
+    assert!(t < standing.lap_time_s.unwrap(), "{t} s");
+    assert!(
+        (t / (length / 15.0) - 1.0).abs() < 0.01,
+        "{t} s against {} s",
+        length / 15.0
+    );
+    // The first driver step of the flying lap, its lap fraction read from 0 again.
+    let start = standing.lap_time_s.unwrap();
+    let first = flying.trace.iter().find(|p| p.t >= start).unwrap();
+    assert!(first.x < 0.01, "{first:?}");
+    assert!((first.speed - 15.0).abs() < 0.5, "{first:?}");
+}
+
+/// A flying lap that fails on its second lap says where on that lap: held at 15 m/s over the
+/// standing lap, then full throttle, the car leaves the road in the flying lap.
+#[test]
+fn a_flying_lap_failing_on_its_second_lap_fails_at_that_laps_fraction() {
+    struct ThenFlat {
+        hold: SpeedHold,
+        from_s: f64,
+    }
+    impl Pedal for ThenFlat {
+        fn pedal(&mut self, obs: &Observation) -> f64 {
+            if obs.time < self.from_s {
+                self.hold.pedal(obs)
+            } else {
+                1.0
+            }
+        }
+    }
+    let track = builtin("ridgeway");
+    let length = track.length;
+    let mut sim = Simulator::new(track, &Car::spirit_300());
+    let standing = sim.lap(&mut SpeedHold::new(15.0)).lap_time_s.unwrap();
+    sim.config.flying = true;
+    let lap = sim.lap(&mut ThenFlat {
+        hold: SpeedHold::new(15.0),
+        from_s: standing,
+    });
+    let failure = lap.failure.expect("full throttle leaves the road");
+    assert_eq!(lap.standing_lap_s, Some(standing));
+    assert!(failure.time_s > standing, "{failure:?}");
+    assert!(
+        failure.x < 1.0 && failure.distance_m < length,
+        "{failure:?}"
+    );
+    assert!(
+        (failure.x - failure.distance_m / length).abs() < 1e-12,
+        "{failure:?}"
+    );
+}

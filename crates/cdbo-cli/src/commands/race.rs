@@ -83,6 +83,11 @@ pub struct RaceArgs {
     /// Output folder (default: runs/race-TRACK-METHOD-mM-sSEED).
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
+    /// Learn on the flying lap: the second of two laps from the standing start, timed line
+    /// to line, as the game times a robot's best lap (cdbo's simulator only). Either way the
+    /// summary gives the best policy's standing and flying laps.
+    #[arg(long)]
+    flying: bool,
     /// Print the summary as JSON (no progress bar).
     #[arg(long)]
     json: bool,
@@ -131,8 +136,17 @@ struct Summary {
     /// Laps of the first policy π(w₀) that failed before its repaired lap completed (the
     /// race's first laps, among the failed ones).
     start_failed_laps: usize,
+    /// Whether the race learned on flying laps (`--flying`).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    flying: bool,
     best_reward_mps: f64,
+    /// The best lap learned on (flying with `--flying`, else standing).
     best_lap_time_s: Option<f64>,
+    /// The best policy's standing lap and flying lap, driven again (in cdbo's simulator).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    best_standing_lap_s: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    best_flying_lap_s: Option<f64>,
     limit_reward_mps: f64,
     limit_lap_time_s: f64,
     best_fraction_of_limit: f64,
@@ -159,6 +173,13 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
             knob.meaning
         )
         .into());
+    }
+    if args.flying && simulator == Simulator::Torcs {
+        return Err(
+            "--flying: in the game cdbo's robot times the standing lap; learn flying laps in \
+             cdbo's simulator"
+                .into(),
+        );
     }
     let warm_start = match &args.warm_start {
         Some(path) => Some(read_policy(path)?),
@@ -188,6 +209,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         warm_start,
         base_line,
         box_radius: args.box_radius,
+        flying: args.flying,
     };
     // A knob the method cannot take is refused before any lap is driven.
     config.spec()?;
@@ -250,6 +272,11 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     let profile = cdbo::ceiling::profile(&track, &car, None);
     let (_, ceiling_mps) = cdbo::ceiling::tracked_profile(&ceiling_sim, &profile)?;
     write_outputs(&out, &outcome, config.base_line, steering)?;
+    let best_lap = outcome
+        .laps
+        .iter()
+        .filter(|l| l.reward_mps == outcome.best_reward_mps)
+        .find_map(|l| l.lap_time_s);
     // The speed plots re-drive the initial and best policies where the race was driven, on
     // its base line.
     let venue = match &outcome.line {
@@ -257,6 +284,14 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         None => venue,
     };
     let drive = |p: &Policy| venue.drive(p);
+    // The best policy's standing and flying laps, where the laps are cdbo's to time.
+    let (best_standing_lap_s, best_flying_lap_s) = match simulator {
+        Simulator::Cdbo => (
+            venue.drive(&outcome.best)?.lap_time_s,
+            venue.clone().flying()?.drive(&outcome.best)?.lap_time_s,
+        ),
+        Simulator::Torcs => (best_lap, None),
+    };
     // The map draws the line the best policy holds, where it is not the centre line.
     let held = (outcome.line.is_some() || outcome.best.line.is_some()).then(|| {
         let raced = RacedPolicy {
@@ -268,11 +303,6 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     });
     let held = held.as_ref().map(|(n, p)| (n.as_str(), p.as_slice()));
     write_plots(&out, &track, &outcome, &drive, held)?;
-    let best_lap = outcome
-        .laps
-        .iter()
-        .filter(|l| l.reward_mps == outcome.best_reward_mps)
-        .find_map(|l| l.lap_time_s);
     let summary = Summary {
         method,
         track: track_name,
@@ -300,8 +330,11 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
             .map_or(config.demo_speed, |c| c.chosen_mps),
         demo_choice: outcome.demo_choice.clone(),
         start_failed_laps: outcome.start_failed_laps,
+        flying: args.flying,
         best_reward_mps: outcome.best_reward_mps,
         best_lap_time_s: best_lap,
+        best_standing_lap_s,
+        best_flying_lap_s,
         limit_reward_mps: outcome.limit.reward_mps,
         limit_lap_time_s: outcome.limit.lap_time_s,
         best_fraction_of_limit: outcome.best_reward_mps / outcome.limit.reward_mps,
@@ -335,14 +368,12 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         );
     }
     println!(
-        "{} on {}, {} kernels, {} laps: best lap {} at {:.2} m/s, {:.1} % of the centre-line limit ({:.2} m/s), {:.1} % of the ceiling ({:.2} m/s), {:.2}x the demonstration ({:.2} m/s); {} laps failed {}",
+        "{} on {}, {} kernels, {} laps: best {} at {:.2} m/s, {:.1} % of the centre-line limit ({:.2} m/s), {:.1} % of the ceiling ({:.2} m/s), {:.2}x the demonstration ({:.2} m/s); {} laps failed {}",
         summary.method,
         summary.track,
         summary.kernels,
         summary.laps,
-        summary
-            .best_lap_time_s
-            .map_or("-".into(), |t| format!("{t:.2} s")),
+        lap_words(&summary),
         summary.best_reward_mps,
         100.0 * summary.best_fraction_of_limit,
         summary.limit_reward_mps,
@@ -381,6 +412,26 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         );
     }
     Ok(())
+}
+
+/// The best lap as the race learned it, and the other kind beside it: "lap 104.02 s (flying
+/// 98.31 s)", "flying lap 98.31 s (standing 104.02 s)".
+fn lap_words(summary: &Summary) -> String {
+    let time = |t: Option<f64>| t.map_or("-".into(), |t| format!("{t:.2} s"));
+    let (kind, other, other_time) = if summary.flying {
+        ("flying lap", "standing", summary.best_standing_lap_s)
+    } else {
+        ("lap", "flying", summary.best_flying_lap_s)
+    };
+    let best = time(summary.best_lap_time_s);
+    match other_time {
+        Some(t) => format!("{kind} {best} ({other} {})", time(Some(t))),
+        // Only cdbo's simulator times both; there a missing one failed.
+        None if summary.simulator == Simulator::Cdbo.name() => {
+            format!("{kind} {best} ({other}: fails)")
+        }
+        None => format!("{kind} {best}"),
+    }
 }
 
 /// `text` with its first letter in capitals.

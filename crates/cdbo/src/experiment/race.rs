@@ -68,6 +68,11 @@ pub struct RaceConfig {
     /// [`DEFAULT_BOX_RADIUS`](crate::optimizers::DEFAULT_BOX_RADIUS).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub box_radius: Option<f64>,
+    /// Learn on the flying lap ([`crate::sim::LapConfig::flying`]: the second of two laps
+    /// from the standing start, timed line to line), the lap a race is made of; the
+    /// demonstration stays a standing lap. cdbo's simulator only.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub flying: bool,
 }
 
 impl RaceConfig {
@@ -116,6 +121,7 @@ impl Default for RaceConfig {
             warm_start: None,
             base_line: BaseLine::Centre,
             box_radius: None,
+            flying: false,
         }
     }
 }
@@ -219,7 +225,11 @@ pub fn race(
     let (demo, choice) = demonstration(config.demo_speed, config.fixed_demo_speed, |v| {
         venue.demonstrate(v)
     })?;
-    let mut evaluator = venue.evaluator(config.shape()?)?;
+    let mut evaluator = if config.flying {
+        venue.clone().flying()?.evaluator(config.shape()?)?
+    } else {
+        venue.evaluator(config.shape()?)?
+    };
     let speed = choice.as_ref().map_or(config.demo_speed, |c| c.chosen_mps);
     let mut outcome = race_with(
         &track.name,

@@ -214,6 +214,7 @@ pub fn run_at(
         warm_start: None,
         base_line,
         box_radius: None,
+        flying: false,
     };
     let (track_name, length_m) = (track.name.clone(), track.length);
     let venue = match grounds {

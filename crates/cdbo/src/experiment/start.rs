@@ -288,6 +288,7 @@ mod tests {
                     time_s: 1.0,
                 }),
                 simulated_s: 1.0,
+                standing_lap_s: None,
                 trace: Vec::new(),
             };
             Ok((lap, vec![(0.0, v)]))

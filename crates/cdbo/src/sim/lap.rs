@@ -18,6 +18,12 @@
 //! - **time limit**: the lap takes longer than its limit.
 //!
 //! Nothing else ends a lap: whether these happen follows from speed, grip and steering.
+//!
+//! **A flying lap** ([`LapConfig::flying`]) is the lap a race is made of, the way the game
+//! times a robot's best lap: the car drives two laps from the standing start with the same
+//! policy (the pedal and line read at the lap fraction of the lap it is on), and the second,
+//! which starts as the car crosses the line at speed, is timed line to line. Either lap can
+//! fail, at its own lap fraction; the time limit is the two laps'.
 
 use std::sync::Arc;
 
@@ -146,6 +152,10 @@ pub struct LapResult {
     pub failure: Option<Failure>,
     /// Simulated time (s).
     pub simulated_s: f64,
+    /// Of a flying lap ([`LapConfig::flying`]), the standing lap before it (s), once the car
+    /// completed it; `lap_time_s` is then the flying lap's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub standing_lap_s: Option<f64>,
     /// The driver steps, when asked for.
     #[serde(skip)]
     pub trace: Vec<TracePoint>,
@@ -179,6 +189,9 @@ pub struct LapConfig {
     /// ([`Reserve`]); `None`: the lap fails only at [`LapConfig::off_track_margin`] and the
     /// barriers.
     pub reserve: Option<Reserve>,
+    /// Time the flying lap, the second of two from the standing start (the [module](self)),
+    /// rather than the standing lap.
+    pub flying: bool,
 }
 
 /// What a policy learning in cdbo's simulator keeps in reserve of the road, so that the world it
@@ -263,6 +276,7 @@ impl Default for LapConfig {
             steering: Steering::default(),
             line: None,
             reserve: None,
+            flying: false,
         }
     }
 }
@@ -416,12 +430,17 @@ impl Simulator {
         let mut proj = track.project(state.x, state.y, 0);
         let (mut distance, mut farthest, mut slow_for) = (0.0, 0.0, 0.0);
         let mut trace = Vec::new();
-        let limit = self.time_limit();
+        // The flying lap's laps: the standing one, then the timed one.
+        let laps = if cfg.flying { 2.0 } else { 1.0 };
+        let limit = laps * self.time_limit();
+        // Where the timed lap starts: its distance (m) and time (s) at the line.
+        let (mut lap_start, mut standing) = (0.0, None);
         let driver_dt = cfg.dt * cfg.driver_every as f64;
         let mut step = 0usize;
         let mut until_driver = 0usize;
         let half_length = 0.5 * track.length;
-        let fail = |reason, distance: f64, t: f64| LapResult {
+        // `distance` into the lap it failed on.
+        let fail = |reason, distance: f64, t: f64, standing: Option<f64>| LapResult {
             completed: false,
             lap_time_s: None,
             reward_mps: 0.0,
@@ -432,13 +451,14 @@ impl Simulator {
                 time_s: t,
             }),
             simulated_s: t,
+            standing_lap_s: standing,
             trace: Vec::new(),
         };
         loop {
             if until_driver == 0 {
                 until_driver = cfg.driver_every;
                 let t = step as f64 * cfg.dt;
-                let x = (distance / track.length).clamp(0.0, 1.0);
+                let x = ((distance - lap_start) / track.length).clamp(0.0, 1.0);
                 let a = pedal_command(pedal.pedal(&Observation {
                     x,
                     speed: state.speed(),
@@ -494,16 +514,23 @@ impl Simulator {
             }
             let before = distance;
             distance += ds;
-            if distance >= track.length {
-                let lap_time = t - cfg.dt + cfg.dt * (track.length - before) / ds;
-                return LapResult {
-                    completed: true,
-                    lap_time_s: Some(lap_time),
-                    reward_mps: track.length / lap_time,
-                    failure: None,
-                    simulated_s: t,
-                    trace,
-                };
+            if distance >= lap_start + track.length {
+                // The time the car crossed the line, linear within the step.
+                let crossed = t - cfg.dt + cfg.dt * (lap_start + track.length - before) / ds;
+                if cfg.flying && standing.is_none() {
+                    (lap_start, standing) = (track.length, Some(crossed));
+                } else {
+                    let lap_time = crossed - standing.unwrap_or(0.0);
+                    return LapResult {
+                        completed: true,
+                        lap_time_s: Some(lap_time),
+                        reward_mps: track.length / lap_time,
+                        failure: None,
+                        simulated_s: t,
+                        standing_lap_s: standing,
+                        trace,
+                    };
+                }
             }
             farthest = f64::max(farthest, distance);
             let road = track.frame(proj.index);
@@ -538,7 +565,7 @@ impl Simulator {
                 (slow_for > STALL_TIME).then_some(super::FailureReason::Stalled)
             };
             if let Some(reason) = failure {
-                let mut r = fail(reason, distance.max(0.0), t);
+                let mut r = fail(reason, (distance - lap_start).max(0.0), t, standing);
                 r.trace = trace;
                 return r;
             }

@@ -69,6 +69,7 @@ fn failed_lap(reason: &str) -> LapResult {
             time_s: 0.0,
         }),
         simulated_s: 0.0,
+        standing_lap_s: None,
         trace: Vec::new(),
     }
 }

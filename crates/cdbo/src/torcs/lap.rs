@@ -429,6 +429,7 @@ impl Game {
             reward_mps: robot.reward_mps,
             failure: robot.failure,
             simulated_s: robot.simulated_s,
+            standing_lap_s: None,
             trace,
         }))
     }
