@@ -60,6 +60,9 @@
  *   aid_slip F R                 slip at which ABS starts easing, per axle
  *   off_track_margin M           (m) beyond half the width
  *   time_limit S                 (s)
+ *   flying F                     1: time the flying lap, the second of two from the standing
+ *                                start, line to line (the pedal and line read at the fraction
+ *                                of the lap the car is on); 0 (default): the standing lap
  */
 
 #include <cmath>
@@ -111,6 +114,7 @@ struct Settings {
     double aid_slip[2] = {0.0, 0.0};
     double off_track_margin = 1.0;
     double time_limit = 0.0;
+    bool flying = false;
 };
 
 struct Lap {
@@ -120,6 +124,8 @@ struct Lap {
     FILE *trace = nullptr;
     double start_time = -1.0, last_time = 0.0;
     double distance = 0.0, farthest = 0.0, last_station = 0.0, slow_for = 0.0;
+    double lap_start = 0.0;  // the timed lap's start: 0, or one length into a flying lap
+    double standing = -1.0;  // a flying lap's standing lap (s), once completed
     double steer_integral = 0.0, demo_integral = 0.0;
     drive::Gearbox gearbox = {};  // points into cfg, set once the settings are read
     size_t gear = 0;              // 0-based, as in cdbo
@@ -185,6 +191,7 @@ bool read_settings(const std::string &path, Settings *s, std::string *error) {
         else if (k == "trace") s->trace = word;
         else if (k == "pedal") { s->pedal = word; s->pedal_args = nums; }
         else if (k == "wheelbase") { if ((ok = need(1))) s->wheelbase = nums[0]; }
+        else if (k == "flying") { if ((ok = need(1))) s->flying = nums[0] != 0.0; }
         else if (k == "line") {
             if ((ok = need(3) && nums[0] > 0.0)) { s->line_length = nums[0]; s->line.assign(nums.begin() + 1, nums.end()); }
             else *error = path + ":" + std::to_string(number) + ": line needs a positive length and at least 2 offsets";
@@ -424,7 +431,7 @@ void json_string(FILE *f, const std::string &s) {
         fprintf(f, ",\"completed\":false,\"error\":");
         json_string(f, lap.error);
     } else if (reason) {
-        double d = std::fmax(lap.distance, 0.0);
+        double d = std::fmax(lap.distance - lap.lap_start, 0.0);
         fprintf(f,
                 ",\"completed\":false,\"lap_time_s\":null,\"reward_mps\":0,\"failure\":{\"reason\":\"%s\","
                 "\"x\":%.6f,\"distance_m\":%.3f,\"time_s\":%.4f}",
@@ -433,6 +440,7 @@ void json_string(FILE *f, const std::string &s) {
         fprintf(f, ",\"completed\":true,\"lap_time_s\":%.4f,\"reward_mps\":%.6f,\"failure\":null",
                 lap_time, len / lap_time);
     }
+    if (lap.standing >= 0.0) fprintf(f, ",\"standing_lap_s\":%.4f", lap.standing);
     fprintf(f, ",\"simulated_s\":%.4f,\"game_time_s\":%.4f}\n", t, game_time);
     fflush(f);
     if (lap.trace) fflush(lap.trace);
@@ -512,9 +520,15 @@ void drive(int, tCarElt *car, tSituation *s) {
     double before = lap.distance;
     lap.distance += ds;
     lap.last_station = station;
-    if (lap.distance >= len && ds > 0.0) {
-        // Completed between the last driver step and this one: interpolate the crossing.
-        finish(t, now, nullptr, t - dt + dt * (len - before) / ds);
+    if (lap.distance >= lap.lap_start + len && ds > 0.0) {
+        // Crossed the line between the last driver step and this one: interpolate the time.
+        double crossed = t - dt + dt * (lap.lap_start + len - before) / ds;
+        if (lap.cfg.flying && lap.standing < 0.0) {
+            lap.standing = crossed;
+            lap.lap_start = len;
+        } else {
+            finish(t, now, nullptr, crossed - std::fmax(lap.standing, 0.0));
+        }
     }
     lap.farthest = std::fmax(lap.farthest, lap.distance);
 
@@ -545,7 +559,7 @@ void drive(int, tCarElt *car, tSituation *s) {
     }
     if (failure) finish(t, now, failure, 0.0);
 
-    double x = clamp(lap.distance / len, 0.0, 1.0);
+    double x = clamp((lap.distance - lap.lap_start) / len, 0.0, 1.0);
     double a = pedal(x, speed, dt);
     double delta = lap.cfg.tracker ? tracker_steer(car, speed) : steer(car, speed, dt);
     choose_gear(car, std::fmax(a, 0.0), dt);

@@ -86,16 +86,9 @@ impl Venue {
     }
 
     /// This venue timing flying laps ([`LapConfig::flying`]): the second of two laps from the
-    /// standing start. cdbo's simulator only; the game's robot times the standing lap.
-    pub fn flying(self) -> Result<Venue> {
-        match &self {
-            Venue::Simulator(_) => Ok(self.configured(|config| config.flying = true)),
-            Venue::Game { .. } => Err(crate::error::Error::invalid_value(
-                "a flying lap's venue",
-                "the game TORCS",
-                "cdbo's simulator (in the game cdbo's robot times the standing lap)",
-            )),
-        }
+    /// standing start, in the simulator and in the game alike (there cdbo's robot times it).
+    pub fn flying(self) -> Venue {
+        self.configured(|config| config.flying = true)
     }
 
     /// The settings every lap here is driven with (its steering, line and failure rules).

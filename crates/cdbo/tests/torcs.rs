@@ -95,6 +95,37 @@ fn a_demonstration_lap_in_the_game_agrees_with_the_simulator() {
 /// path tracker, in the game and in cdbo's simulator (`Venue::on_line`): the game's lap within
 /// 1 % of the simulator's, and the game's car on the line (RMS of its offset from d₀(s) under
 /// 0.3 m, as the simulator's), metres off the centre line.
+/// A flying lap in the game, as in cdbo's simulator, starts with the car crossing the line at
+/// speed and is timed line to line: the 15 m/s demonstrator's on G-Track 1 in car1-trb1 is
+/// faster than its standing lap, within 1 % of cdbo's flying lap, and starts at the held speed
+/// with the lap fraction read from 0 again.
+#[test]
+fn a_flying_lap_in_the_game_is_timed_line_to_line_as_in_the_simulator() {
+    let _one = one_at_a_time();
+    let Some(game) = game() else { return };
+    let data = cdbo::data_path::DataPath::new(std::slice::from_ref(&game.install.data_dir));
+    let track = cdbo::track::catalog::find("g-track-1", &data).unwrap();
+    let mut req = game
+        .request("g-track-1", "car1-trb1", GamePedal::Demo(15.0))
+        .unwrap();
+    req.config.flying = true;
+    req.record = true;
+    let lap = game.lap(&req).unwrap().unwrap();
+    assert!(lap.completed, "{lap:?}");
+    let (t, standing) = (lap.lap_time_s.unwrap(), lap.standing_lap_s.unwrap());
+    assert!(t < standing, "flying {t} s, standing {standing} s");
+    let mut sim = Simulator::new(track, &req.car);
+    sim.config.flying = true;
+    let ours = sim.lap(&mut SpeedHold::new(15.0)).lap_time_s.unwrap();
+    assert!(
+        (t - ours).abs() < 0.01 * ours,
+        "game {t:.2} s, cdbo {ours:.2} s"
+    );
+    let first = lap.trace.iter().find(|p| p.t >= standing).unwrap();
+    assert!(first.x < 0.01, "{first:?}");
+    assert!((first.speed - 15.0).abs() < 0.5, "{first:?}");
+}
+
 #[test]
 #[ignore = "slow: the minimum-curvature line of Forza, and a game lap"]
 fn the_game_holds_the_racing_line_as_the_simulator_does() {

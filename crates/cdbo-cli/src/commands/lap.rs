@@ -38,6 +38,10 @@ pub struct LapArgs {
     steering: Option<SteeringLaw>,
     #[command(flatten)]
     off_track: super::OffTrackArgs,
+    /// Time the flying lap: the second of two from the standing start, line to line, as the
+    /// game times a robot's best lap (the standing lap before it is reported beside it).
+    #[arg(long)]
+    flying: bool,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -57,6 +61,9 @@ struct LapReport {
     lap_time_s: Option<f64>,
     reward_mps: f64,
     failure: Option<Failure>,
+    /// Of a flying lap (`--flying`), the standing lap before it, if completed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    standing_lap_s: Option<f64>,
     limit_lap_time_s: f64,
     limit_reward_mps: f64,
     fraction_of_limit: f64,
@@ -82,6 +89,7 @@ impl LapReport {
             lap_time_s: lap.lap_time_s,
             reward_mps: lap.reward_mps,
             failure: lap.failure,
+            standing_lap_s: lap.standing_lap_s,
             limit_lap_time_s: limit.lap_time_s,
             limit_reward_mps: limit.reward_mps,
             fraction_of_limit: lap.reward_mps / limit.reward_mps,
@@ -130,6 +138,7 @@ pub fn run(args: &LapArgs, data: &DataPath, simulator: Simulator) -> CliResult {
     sim.config.off_track_margin = args.off_track.judging();
     sim.config.line = line;
     sim.config.trace = args.trace.is_some() || args.plot.is_some();
+    sim.config.flying = args.flying;
     let lap = sim.lap(pedal.as_mut());
     if let Some(path) = &args.trace {
         write_trace(path, &lap.trace)?;
@@ -138,6 +147,7 @@ pub fn run(args: &LapArgs, data: &DataPath, simulator: Simulator) -> CliResult {
         crate::figures::lap_speed(path, &sim.track, &lap, &limit)?;
     }
     sim.config.trace = false;
+    sim.config.flying = false;
     // The ceiling is the centre line's, as `cdbo race` reports it.
     sim.config.line = None;
     let profile = cdbo::ceiling::profile(&sim.track, &car, None);
@@ -200,6 +210,7 @@ fn run_torcs(args: &LapArgs, data: &DataPath) -> CliResult {
         .unwrap_or_default();
     req.config.steering = steering.steering();
     req.config.off_track_margin = args.off_track.judging();
+    req.config.flying = args.flying;
     let track = super::game_track(&args.setup.track, &game, data)?;
     // The policy's line on the base line it was raced on (none: the centre line, no table).
     if let Some(raced) = policy {
@@ -245,9 +256,13 @@ fn print_report(report: LapReport, json: bool) -> CliResult {
     }
     match (report.lap_time_s, report.failure) {
         (Some(t), _) => println!(
-            "{} on {}: lap {:.2} s, reward {:.2} m/s ({:.1} % of the centre-line limit {:.2} s, {:.2} m/s; {:.1} % of the ceiling {:.2} m/s)",
+            "{} on {}: {} {:.2} s, reward {:.2} m/s ({:.1} % of the centre-line limit {:.2} s, {:.2} m/s; {:.1} % of the ceiling {:.2} m/s)",
             report.car,
             report.track,
+            match report.standing_lap_s {
+                Some(standing) => format!("standing lap {standing:.2} s, flying lap"),
+                None => "lap".into(),
+            },
             t,
             report.reward_mps,
             100.0 * report.fraction_of_limit,

@@ -84,8 +84,8 @@ pub struct RaceArgs {
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
     /// Learn on the flying lap: the second of two laps from the standing start, timed line
-    /// to line, as the game times a robot's best lap (cdbo's simulator only). Either way the
-    /// summary gives the best policy's standing and flying laps.
+    /// to line, as the game times a robot's best lap. Either way the summary gives the best
+    /// policy's standing and flying laps.
     #[arg(long)]
     flying: bool,
     /// Print the summary as JSON (no progress bar).
@@ -142,7 +142,7 @@ struct Summary {
     best_reward_mps: f64,
     /// The best lap learned on (flying with `--flying`, else standing).
     best_lap_time_s: Option<f64>,
-    /// The best policy's standing lap and flying lap, driven again (in cdbo's simulator).
+    /// The best policy's standing lap and flying lap, driven again where the race was.
     #[serde(skip_serializing_if = "Option::is_none")]
     best_standing_lap_s: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -173,13 +173,6 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
             knob.meaning
         )
         .into());
-    }
-    if args.flying && simulator == Simulator::Torcs {
-        return Err(
-            "--flying: in the game cdbo's robot times the standing lap; learn flying laps in \
-             cdbo's simulator"
-                .into(),
-        );
     }
     let warm_start = match &args.warm_start {
         Some(path) => Some(read_policy(path)?),
@@ -284,14 +277,9 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         None => venue,
     };
     let drive = |p: &Policy| venue.drive(p);
-    // The best policy's standing and flying laps, where the laps are cdbo's to time.
-    let (best_standing_lap_s, best_flying_lap_s) = match simulator {
-        Simulator::Cdbo => (
-            venue.drive(&outcome.best)?.lap_time_s,
-            venue.clone().flying()?.drive(&outcome.best)?.lap_time_s,
-        ),
-        Simulator::Torcs => (best_lap, None),
-    };
+    // The best policy's standing and flying laps, driven again where the race was.
+    let best_standing_lap_s = venue.drive(&outcome.best)?.lap_time_s;
+    let best_flying_lap_s = venue.clone().flying().drive(&outcome.best)?.lap_time_s;
     // The map draws the line the best policy holds, where it is not the centre line.
     let held = (outcome.line.is_some() || outcome.best.line.is_some()).then(|| {
         let raced = RacedPolicy {
@@ -426,11 +414,7 @@ fn lap_words(summary: &Summary) -> String {
     let best = time(summary.best_lap_time_s);
     match other_time {
         Some(t) => format!("{kind} {best} ({other} {})", time(Some(t))),
-        // Only cdbo's simulator times both; there a missing one failed.
-        None if summary.simulator == Simulator::Cdbo.name() => {
-            format!("{kind} {best} ({other}: fails)")
-        }
-        None => format!("{kind} {best}"),
+        None => format!("{kind} {best} ({other}: fails)"),
     }
 }
 

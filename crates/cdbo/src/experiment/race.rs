@@ -70,7 +70,7 @@ pub struct RaceConfig {
     pub box_radius: Option<f64>,
     /// Learn on the flying lap ([`crate::sim::LapConfig::flying`]: the second of two laps
     /// from the standing start, timed line to line), the lap a race is made of; the
-    /// demonstration stays a standing lap. cdbo's simulator only.
+    /// demonstration stays a standing lap.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub flying: bool,
 }
@@ -226,7 +226,7 @@ pub fn race(
         venue.demonstrate(v)
     })?;
     let mut evaluator = if config.flying {
-        venue.clone().flying()?.evaluator(config.shape()?)?
+        venue.clone().flying().evaluator(config.shape()?)?
     } else {
         venue.evaluator(config.shape()?)?
     };

@@ -96,6 +96,8 @@ struct RobotLine {
     #[serde(default)]
     simulated_s: f64,
     #[serde(default)]
+    standing_lap_s: Option<f64>,
+    #[serde(default)]
     error: Option<String>,
 }
 
@@ -314,7 +316,12 @@ fn settings(
     let [f, r] = vehicle.aid_threshold();
     let _ = writeln!(s, "aid_slip {f:e} {r:e}");
     let _ = writeln!(s, "off_track_margin {:e}", req.config.off_track_margin);
-    let _ = writeln!(s, "time_limit {time_limit:e}");
+    // A flying lap's limit is the two laps'.
+    let laps = if req.config.flying { 2.0 } else { 1.0 };
+    let _ = writeln!(s, "time_limit {:e}", laps * time_limit);
+    if req.config.flying {
+        let _ = writeln!(s, "flying 1");
+    }
     Ok(s)
 }
 
@@ -429,7 +436,7 @@ impl Game {
             reward_mps: robot.reward_mps,
             failure: robot.failure,
             simulated_s: robot.simulated_s,
-            standing_lap_s: None,
+            standing_lap_s: robot.standing_lap_s,
             trace,
         }))
     }
