@@ -32,6 +32,11 @@ pub struct OptimizeArgs {
     /// With `--simulator torcs`: the TORCS car.
     #[arg(long, default_value = cdbo::torcs::DEFAULT_CAR, requires = "track")]
     car: String,
+    /// With `--simulator torcs`: time and learn the flying lap, the second of two from the
+    /// standing start, line to line (with an --evaluator, its command times the lap it
+    /// drives: `cdbo lap --policy {policy} --flying --json`).
+    #[arg(long, requires = "track")]
+    flying: bool,
     /// Trials the study should have told when this run ends: a total, counting those already
     /// told (a study with 31 told trials and --laps 40 drives 9 more; with --laps 5, none).
     #[arg(long, value_parser = super::value::total_laps)]
@@ -117,6 +122,7 @@ pub fn run(args: &OptimizeArgs, simulator: Simulator, data: &DataPath) -> CliRes
             // The study's line on its base line, held as cdbo's simulator holds it.
             request.config.line = study.config().base_line.line(&track, &request.car)?;
             request.config.steering = study.config().steering.steering();
+            request.config.flying = args.flying;
             Box::new(TorcsEvaluator {
                 game,
                 request,
