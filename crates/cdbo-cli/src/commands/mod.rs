@@ -19,6 +19,7 @@ pub mod study;
 pub mod torcs;
 pub mod torcs_calibrate;
 pub mod torcs_compare;
+pub mod torcs_learn;
 pub mod torcs_panel;
 pub mod torcs_transfer;
 pub mod track;

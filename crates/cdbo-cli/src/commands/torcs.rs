@@ -47,6 +47,10 @@ pub enum TorcsCommand {
     /// installed) a policy learned as `cdbo race` learns it, its best driven once in the game,
     /// beside its simulated lap.
     Transfer(super::torcs_transfer::TransferArgs),
+    /// From a track to a race-ready policy: cdbo's simulator (the ceiling's policy, or the
+    /// recommended learner's), then a bounded number of the recommended learner's laps in the
+    /// game, the best policy's standing and flying laps beside the fastest shipped robot's.
+    Learn(super::torcs_learn::LearnArgs),
     /// Time every shipped TORCS robot that can drive the car: its standing first lap and its
     /// best (flying) lap of two, alone, from a clean start, headless — the table cdbo's
     /// learned laps are judged against — beside cdbo's QSS limit on the centre line.
@@ -89,6 +93,7 @@ pub fn run(cmd: &TorcsCommand, data: &cdbo::data_path::DataPath) -> CliResult {
         TorcsCommand::Panel(args) => super::torcs_panel::run(args, data),
         TorcsCommand::Calibrate(args) => super::torcs_calibrate::run(args, data),
         TorcsCommand::Transfer(args) => super::torcs_transfer::run(args, data),
+        TorcsCommand::Learn(args) => super::torcs_learn::run(args, data),
         TorcsCommand::Robots { track, car, json } => robots(track, car, *json),
         TorcsCommand::Setup { json } => {
             let install = Install::find()?;
@@ -177,7 +182,7 @@ type RobotLap<'a> = Option<(&'a str, f64)>;
 
 /// The robots table of one track ([`robots_on`]).
 #[derive(Debug, Serialize)]
-struct RobotsTable {
+pub(super) struct RobotsTable {
     track: String,
     car: String,
     limit_lap_time_s: f64,
@@ -186,7 +191,7 @@ struct RobotsTable {
 
 impl RobotsTable {
     /// The fastest robot's standing first lap and best (flying) lap, each with its robot.
-    fn fastest(&self) -> (RobotLap<'_>, RobotLap<'_>) {
+    pub(super) fn fastest(&self) -> (RobotLap<'_>, RobotLap<'_>) {
         let best = |lap: fn(&RobotRow) -> Option<f64>| {
             self.robots
                 .iter()
@@ -276,7 +281,7 @@ fn robots(tracks: &[String], car: &str, json: bool) -> CliResult {
 
 /// Every robot of the installed game but the human driver and cdbo's own (those with a
 /// `drivers/NAME/NAME.xml`) on one track, one at a time, fastest standing first lap first.
-fn robots_on(
+pub(super) fn robots_on(
     game: &Game,
     track: &str,
     car: &str,

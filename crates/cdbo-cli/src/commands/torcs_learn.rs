@@ -1,0 +1,264 @@
+//! `cdbo torcs learn`: from a track to a race-ready policy in one command. cdbo's simulator
+//! first (the ceiling's policy: the limit's speed profile tracked on the minimum-curvature line
+//! and fitted; where no fit completes, the recommended learner's best), then a bounded number
+//! of laps of the recommended learner in the game from it, the result beside the fastest
+//! shipped robot's laps on that track.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use serde::Serialize;
+
+use super::torcs::robots_on;
+use super::{CliResult, game_track, print_json};
+use cdbo::data_path::DataPath;
+use cdbo::experiment::race::{BaseLine, RaceConfig, RaceOutcome, race};
+use cdbo::method::Preset;
+use cdbo::policy::{Policy, RacedPolicy};
+use cdbo::torcs::{self, Game, GamePedal};
+use cdbo::venue::Venue;
+
+#[derive(Debug, Args)]
+pub struct LearnArgs {
+    /// TORCS track names, comma-separated, or `road` for every road track installed.
+    #[arg(long, default_value = "forza", value_delimiter = ',')]
+    track: Vec<String>,
+    /// TORCS car name.
+    #[arg(long, default_value = torcs::DEFAULT_CAR)]
+    car: String,
+    /// Policy kernels M.
+    #[arg(long, default_value_t = 50, value_parser = super::value::kernels)]
+    kernels: usize,
+    /// Laps of the recommended learner in the game, after cdbo's simulator (the game also
+    /// drives one demonstration lap first, and the best policy's standing and flying laps at
+    /// the end).
+    #[arg(long, default_value_t = 30, value_parser = super::value::laps)]
+    game_laps: usize,
+    /// Learn the flying lap (the second of two from the standing start, line to line)
+    /// rather than the standing lap, in both simulators.
+    #[arg(long)]
+    flying: bool,
+    /// Seed of every random choice.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Folder for each track's race-ready policy, TRACK.json (default: runs/torcs-learn).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+/// One track's way from cdbo's simulator to the game, and the robots beside it.
+#[derive(Debug, Serialize)]
+struct TrackResult {
+    track: String,
+    /// Where the game's laps started from: `ceiling` or `recommended learner`.
+    start: &'static str,
+    /// The starting policy's lap in cdbo's simulator (s).
+    sim_lap_s: Option<f64>,
+    /// The game's laps of the learner (the demonstration not counted), and how many failed.
+    game_laps: usize,
+    game_failed_laps: usize,
+    /// The best policy's standing and flying laps in the game, driven again (s).
+    standing_lap_s: Option<f64>,
+    flying_lap_s: Option<f64>,
+    /// The fastest shipped robot's standing lap and best (flying) lap, with its name.
+    robot_standing: Option<(String, f64)>,
+    robot_flying: Option<(String, f64)>,
+    /// The race-ready policy's file.
+    policy: String,
+}
+
+pub fn run(args: &LearnArgs, data: &DataPath) -> CliResult {
+    let game = Game::ready()?;
+    let tracks: Vec<String> = if args.track.iter().any(|t| t == "road") {
+        game.install.tracks("road")
+    } else {
+        args.track.clone()
+    };
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("runs/torcs-learn"));
+    std::fs::create_dir_all(&out).map_err(|e| format!("{}: {e}", out.display()))?;
+    let mut results = Vec::new();
+    for track in &tracks {
+        let result = learn_on(&game, track, args, data, &out)?;
+        if !args.json {
+            eprintln!(
+                "{track}: game's best standing lap {}, flying {}",
+                cell(result.standing_lap_s),
+                cell(result.flying_lap_s)
+            );
+        }
+        results.push(result);
+    }
+    if args.json {
+        return print_json(&results);
+    }
+    print!("{}", markdown(&results, args));
+    Ok(())
+}
+
+/// A lap time in a cell: `83.85 s`, or `fails`.
+fn cell(lap: Option<f64>) -> String {
+    lap.map_or("fails".into(), |t| format!("{t:.2} s"))
+}
+
+fn learn_on(
+    game: &Game,
+    track: &str,
+    args: &LearnArgs,
+    data: &DataPath,
+    out: &std::path::Path,
+) -> Result<TrackResult, Box<dyn std::error::Error>> {
+    let car = game.request(track, &args.car, GamePedal::Demo(15.0))?.car;
+    let ours = game_track(track, game, data)?;
+    let stack = Preset::FastSafe;
+    let base_line = BaseLine::MinCurvature;
+    let line = base_line.line(&ours, &car)?;
+    // 1. cdbo's simulator: the ceiling's policy on the race's line and steering.
+    let mut sim = cdbo::sim::Simulator::new(ours.clone(), &car);
+    sim.config.steering = stack.steering().steering();
+    sim.config.line = line.clone();
+    sim.config.flying = args.flying;
+    let limit = match &line {
+        Some(line) => cdbo::limit::line_limit_on_centre(&ours, line, &car),
+        None => cdbo::limit::limit_lap(&ours, &car),
+    };
+    let profile = cdbo::ceiling::profile(&ours, &car, line.as_deref());
+    let ceiling = cdbo::ceiling::ceiling_with(&sim, &limit, &profile, args.kernels)?;
+    let config = RaceConfig {
+        method: stack.method(),
+        kernels: args.kernels,
+        seed: args.seed,
+        base_line,
+        flying: args.flying,
+        ..RaceConfig::default()
+    };
+    let (start, start_name, sim_lap_s): (Policy, _, _) = match ceiling.policy {
+        Some(policy) => (
+            policy.into(),
+            "ceiling",
+            Some(ours.length / ceiling.policy_mps),
+        ),
+        // No fit completes: the recommended learner's best in cdbo's simulator.
+        None => {
+            let venue = Venue::simulator(ours.clone(), &car)
+                .steered(stack.steering().steering())
+                .for_learning(None);
+            let learned = race(&venue, &ours, &car, &config, |_| {})?;
+            let lap = best_lap(&learned);
+            (learned.best, "recommended learner", lap)
+        }
+    };
+    // 2. The game: the recommended learner from that policy, its laps bounded.
+    let venue = Venue::game(game, track, &args.car, ours.clone())?
+        .steered(stack.steering().steering())
+        .for_learning(None);
+    let in_game = RaceConfig {
+        laps: args.game_laps,
+        warm_start: Some(start),
+        ..config
+    };
+    let outcome = race(&venue, &ours, &car, &in_game, |_| {})?;
+    // 3. Its best policy, driven again standing and flying in the game (on the race's line).
+    let venue = match &outcome.line {
+        Some(line) => venue.on_line(line.clone()),
+        None => venue,
+    };
+    let standing = venue.drive(&outcome.best)?.lap_time_s;
+    let flying = venue.clone().flying().drive(&outcome.best)?.lap_time_s;
+    let file = out.join(format!("{track}.json"));
+    let raced = RacedPolicy {
+        policy: outcome.best.clone(),
+        base_line,
+        steering: stack.steering(),
+    };
+    std::fs::write(&file, serde_json::to_string_pretty(&raced)?)
+        .map_err(|e| format!("{}: {e}", file.display()))?;
+    // 4. The robots on the same track and car.
+    let robots = robots_on(game, track, &args.car, true)?;
+    let (robot_standing, robot_flying) = robots.fastest();
+    let owned = |lap: Option<(&str, f64)>| lap.map(|(r, t)| (r.to_owned(), t));
+    Ok(TrackResult {
+        track: track.to_owned(),
+        start: start_name,
+        sim_lap_s,
+        game_laps: outcome.laps.len(),
+        game_failed_laps: outcome.laps.iter().filter(|l| l.failure.is_some()).count(),
+        standing_lap_s: standing,
+        flying_lap_s: flying,
+        robot_standing: owned(robot_standing),
+        robot_flying: owned(robot_flying),
+        policy: file.display().to_string(),
+    })
+}
+
+/// The race's best lap time (s).
+fn best_lap(outcome: &RaceOutcome) -> Option<f64> {
+    outcome
+        .laps
+        .iter()
+        .filter(|l| l.reward_mps == outcome.best_reward_mps)
+        .find_map(|l| l.lap_time_s)
+}
+
+/// The table: each track's game laps beside the fastest robot's, and how many tracks ours
+/// beats.
+fn markdown(results: &[TrackResult], args: &LearnArgs) -> String {
+    let mut out = format!(
+        "{}, {} kernels, seed {}: cdbo's simulator, then {} laps of the recommended learner in \
+         the game{}; the best policy's laps in the game beside the fastest shipped robot's\n\n",
+        args.car,
+        args.kernels,
+        args.seed,
+        args.game_laps,
+        if args.flying {
+            ", learning the flying lap"
+        } else {
+            ""
+        }
+    );
+    out += "| track | start | in cdbo | game laps (failed) | our standing lap | fastest robot's standing lap | our flying lap | fastest robot's flying lap |\n";
+    out += "| --- | --- | --- | --- | --- | --- | --- | --- |\n";
+    let against = |ours: Option<f64>, robot: &Option<(String, f64)>| match (ours, robot) {
+        (Some(t), Some((name, r))) => (
+            format!("{t:.2} s ({:+.1} %)", 100.0 * (t / r - 1.0)),
+            format!("{r:.2} s ({name})"),
+        ),
+        (ours, robot) => (
+            cell(ours),
+            robot
+                .as_ref()
+                .map_or("–".into(), |(name, r)| format!("{r:.2} s ({name})")),
+        ),
+    };
+    let beats = |ours: Option<f64>, robot: &Option<(String, f64)>| matches!((ours, robot), (Some(t), Some((_, r))) if t < *r);
+    for r in results {
+        let (ours_s, robot_s) = against(r.standing_lap_s, &r.robot_standing);
+        let (ours_f, robot_f) = against(r.flying_lap_s, &r.robot_flying);
+        out += &format!(
+            "| {} | {} | {} | {} ({}) | {ours_s} | {robot_s} | {ours_f} | {robot_f} |\n",
+            r.track,
+            r.start,
+            cell(r.sim_lap_s),
+            r.game_laps,
+            r.game_failed_laps
+        );
+    }
+    out += &format!(
+        "\nOurs beat the fastest robot's standing lap on {} of {} tracks, its flying lap on {}.\n",
+        results
+            .iter()
+            .filter(|r| beats(r.standing_lap_s, &r.robot_standing))
+            .count(),
+        results.len(),
+        results
+            .iter()
+            .filter(|r| beats(r.flying_lap_s, &r.robot_flying))
+            .count()
+    );
+    out
+}
