@@ -12,11 +12,11 @@
 //! **The first policy.** w₀, the demonstration's fit, is a smoothed copy of the demonstrator's
 //! pedal, and can be faster than the demonstrator where the fit spreads its launch: where its
 //! lap leaves the road its pedal is lowered before the place (to half the demonstrator's
-//! throttle at most), where it
-//! stalls raised (up to full throttle), and where lowering does not help it is fitted again
-//! to a slower demonstration, until its lap completes ([`complete_start`]). These laps are the race's first laps and count among its failed ones; the
-//! method then starts from the policy whose lap completed (its first lap, which it does not
-//! drive again).
+//! throttle at most), where it stalls raised just before it (up to full throttle), by a step
+//! that halves where a repair overshot, and where lowering does not help it is fitted again to
+//! a slower demonstration, until its lap completes ([`complete_start`]). These laps are the
+//! race's first laps and count among its failed ones; the method then starts from the policy
+//! whose lap completed (its first lap, which it does not drive again).
 
 use serde::{Deserialize, Serialize};
 
@@ -152,11 +152,15 @@ impl Start {
 /// Drives `initial` (its pedal w₀ fitted to the demonstration `targets`, held at `speed` m/s)
 /// with `evaluator` until its lap completes, at most `max_failed` laps failing. After a lap too
 /// fast (off the road, spun, backwards), the fit's targets over the [`REPAIR_DISTANCE`] metres
-/// (at least two kernel spacings) before the failure are lowered by [`START_STEP`], but none
+/// (at least two kernel spacings) before the failure are lowered by a step δ, but none
 /// below half the demonstrator's throttle there (a cruising pedal braked, or only coasting,
 /// over that stretch stops the car); after a lap too slow (stalled, time limit), they are
-/// raised by the step before the stall, up to full throttle, however often it stalls there
-/// (a slower demonstration cannot help a car that stops). Where lowering cannot help — a lap
+/// raised by δ over the kernel spacing before the stall, up to full throttle, however often it
+/// stalls there (a slower demonstration cannot help a car that stops; raised over more road,
+/// a 30-kernel pedal on Spring's 22 km, 760 m a spacing, reached the corner before the hill
+/// too fast). δ starts at [`START_STEP`], halves where a lap fails where the last repair
+/// moved the pedal the other way (it overshot), and is [`START_STEP`] again once a failure
+/// lies further on. Where lowering cannot help — a lap
 /// too fast failed within a kernel spacing of where one failed since the last fit to a
 /// demonstration, or the targets are at their floor already — or where raising cannot (full
 /// throttle already), or the venue did not say where, w₀ is fitted again to a demonstration
@@ -176,7 +180,11 @@ pub fn complete_start(
     let mut demo = targets.to_vec();
     let mut targets = demo.clone();
     let mut speed = speed;
+    // Where laps too fast failed since the last fit to a demonstration.
     let mut places: Vec<f64> = Vec::new();
+    // The repair's step, and the last repair's place and whether it raised the pedal.
+    let mut step = START_STEP;
+    let mut last: Option<(f64, bool)> = None;
     let mut start = Start {
         policy: initial,
         laps: Vec::new(),
@@ -192,12 +200,26 @@ pub fn complete_start(
             return Ok(start);
         }
         let failed = outcome.failed_lap();
-        let again = failed.is_some_and(|f| places.iter().any(|x| (f.at - x).abs() < lengthscale));
-        places.extend(failed.map(|f| f.at));
+        if let Some(f) = failed {
+            step = match last {
+                // The last repair moved the pedal here the other way: it overshot; halve.
+                Some((x, raised))
+                    if raised != f.too_slow && (x - window..=x + lengthscale).contains(&f.at) =>
+                {
+                    0.5 * step
+                }
+                Some((x, _)) if f.at <= x + lengthscale => step,
+                _ => START_STEP,
+            };
+            last = Some((f.at, f.too_slow));
+        }
+        let again = failed
+            .is_some_and(|f| !f.too_slow && places.iter().any(|x| (f.at - x).abs() < lengthscale));
+        places.extend(failed.filter(|f| !f.too_slow).map(|f| f.at));
         let repaired = match failed {
-            Some(f) if f.too_slow => shift(&mut targets, &demo, f.at - window, f.at, START_STEP),
+            Some(f) if f.too_slow => shift(&mut targets, &demo, f.at - lengthscale, f.at, step),
             Some(_) if again => false,
-            Some(f) => shift(&mut targets, &demo, f.at - window, f.at, -START_STEP),
+            Some(f) => shift(&mut targets, &demo, f.at - window, f.at, -step),
             None => false,
         };
         if !repaired {
@@ -210,6 +232,7 @@ pub fn complete_start(
                 if lap.completed {
                     (demo, targets) = (pairs.clone(), pairs);
                     places.clear();
+                    (step, last) = (START_STEP, None);
                     start.speed_mps = speed;
                     break;
                 }
@@ -295,7 +318,7 @@ mod tests {
         }
     }
 
-    /// A venue whose lap stalls at x = 0.3 while the pedal at x = 0.25 is below `needed`.
+    /// A venue whose lap stalls at x = 0.3 while the pedal at x = 0.29 is below `needed`.
     struct Hill {
         needed: f64,
     }
@@ -304,7 +327,7 @@ mod tests {
         fn evaluate(&mut self, _trial: i64, weights: &[f64]) -> Result<Outcome> {
             let lengthscale = default_lengthscale(weights.len());
             let pedal = RkhsPolicy::new(weights.to_vec(), lengthscale)?;
-            Ok(if pedal.action(0.25) < self.needed {
+            Ok(if pedal.action(0.29) < self.needed {
                 Outcome::Failed {
                     at: Some(0.3),
                     reason: Some("stalled".into()),
