@@ -1,5 +1,6 @@
-//! Helpers shared by the command-line tests: the binary run in a folder, fresh folders, a
-//! recorded demonstration, the study and optimize commands of the tests, a study's history,
+//! Helpers shared by the command-line tests: the binary run in a folder or where the tests run
+//! (with ../shared on its data path), fresh folders and scratch files, a recorded
+//! demonstration and its fit, the study and optimize commands of the tests, a study's history,
 //! workers started and waited for.
 #![allow(dead_code)]
 
@@ -12,6 +13,64 @@ use std::time::{Duration, Instant};
 
 /// The `cdbo` binary under test.
 pub const CDBO: &str = env!("CARGO_BIN_EXE_cdbo");
+
+/// The test data beside the repository, through the one helper of the library's tests.
+#[path = "../../../cdbo/tests/common/shared.rs"]
+mod shared_data;
+
+/// `../shared` beside the repository: the TORCS and Speed Dreams data the tests read.
+pub fn shared() -> PathBuf {
+    shared_data::shared("")
+}
+
+/// Runs `cdbo ARGS` where the tests run, with `../shared` on its data path.
+pub fn run(args: &[&str]) -> Output {
+    Command::new(CDBO)
+        .args(args)
+        .env("CDBO_DATA_PATH", shared())
+        .output()
+        .expect("runs")
+}
+
+/// Runs `cdbo ARGS` ([`run`]) and expects success.
+pub fn succeed(args: &[&str]) -> Output {
+    let out = run(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// Runs `cdbo ARGS` ([`succeed`]) and reads its standard output as JSON.
+pub fn json(args: &[&str]) -> serde_json::Value {
+    serde_json::from_slice(&succeed(args).stdout).expect("JSON")
+}
+
+/// A scratch file with `content`, in a folder of this test binary's own.
+pub fn scratch(name: &str, content: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("cdbo-cli-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join(name);
+    std::fs::write(&p, content).unwrap();
+    p
+}
+
+/// Runs `cdbo ARGS` ([`run`]), expects failure with exactly one `error:` line containing every
+/// `needle`, and no panic.
+pub fn fails_with(args: &[&str], needles: &[&str]) {
+    let out = run(args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{args:?} succeeded");
+    let errors: Vec<&str> = err.lines().filter(|l| l.starts_with("error:")).collect();
+    assert_eq!(errors.len(), 1, "{err}");
+    for n in needles {
+        assert!(errors[0].contains(n), "{:?} lacks {n:?}", errors[0]);
+    }
+    assert!(!err.contains("panicked"), "{err}");
+}
 
 /// Runs `cdbo ARGS` in `dir`.
 pub fn cdbo<S: AsRef<OsStr>>(dir: &Path, args: &[S]) -> Output {
@@ -65,6 +124,26 @@ pub fn demo(dir: &Path) {
         dir,
         &["lap", "--demo", "15", "--trace", "demo.csv", "--json"],
     );
+}
+
+/// Ridgeway's 15 m/s demonstration traced (`cdbo lap --trace`, `TAG-demo.csv`) and w0 of 20
+/// kernels fitted to it (`cdbo policy fit`, `TAG-w0.json`).
+pub fn fitted_to_the_demonstration(tag: &str) -> (PathBuf, PathBuf) {
+    let trace = scratch(&format!("{tag}-demo.csv"), "");
+    succeed(&["lap", "--trace", trace.to_str().unwrap()]);
+    let w0 = scratch(&format!("{tag}-w0.json"), "");
+    let (demo, out) = (trace.to_str().unwrap(), w0.to_str().unwrap());
+    succeed(&[
+        "policy",
+        "fit",
+        "--demo",
+        demo,
+        "--kernels",
+        "20",
+        "-o",
+        out,
+    ]);
+    (trace, w0)
 }
 
 /// A fresh scratch folder ([`fresh_dir`]) holding a demonstration, `demo.csv` ([`demo`]).
