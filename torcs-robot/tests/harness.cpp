@@ -16,7 +16,6 @@
 #include <cstring>
 #include <functional>
 #include <map>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -220,18 +219,35 @@ const std::map<std::string, Case> kCases = {
 }  // namespace
 
 int main() {
+    // One call a line, read whole (a call's numbers run to thousands: a table, a policy);
+    // each number parsed where it stands.
     std::string line;
-    for (int ch; (ch = std::getchar()) != EOF;) {
+    for (int ch; (ch = getchar_unlocked()) != EOF;) {
         if (ch != '\n') {
             line.push_back(char(ch));
             continue;
         }
-        std::istringstream in(line);
-        line.clear();
-        std::string name, word;
-        in >> name;
+        const char *p = line.c_str();
+        while (*p == ' ') p++;
+        const char *end_of_name = std::strchr(p, ' ');
+        if (end_of_name == nullptr) end_of_name = p + std::strlen(p);
+        std::string name(p, end_of_name);
         Args args;
-        while (in >> word) args.v.push_back(std::strtod(word.c_str(), nullptr));
+        for (p = end_of_name; *p != '\0';) {
+            if (*p == ' ') {
+                p++;
+                continue;
+            }
+            char *end = nullptr;
+            args.v.push_back(std::strtod(p, &end));
+            if (end != p) {
+                p = end;
+                continue;
+            }
+            // Not a number: read as 0, as strtod gives it, and the word skipped.
+            while (*p != '\0' && *p != ' ') p++;
+        }
+        line.clear();
         auto found = kCases.find(name);
         std::vector<double> out;
         if (found != kCases.end()) out = found->second(args);
