@@ -13,13 +13,23 @@ repeats = 2
 methods = ["cdbo", "random"]
 
 [[tracks]]
-track = "ridgeway"
+track = "oval.xml"
 kernels = [6]
 "#;
 
+/// A fresh folder with the grid of 4 runs on the oval ([`common::OVAL`]), `grid.toml`.
 fn setup(name: &str) -> PathBuf {
     let dir = fresh_dir(name);
     std::fs::write(dir.join("grid.toml"), GRID).unwrap();
+    std::fs::write(dir.join("oval.xml"), common::OVAL).unwrap();
+    dir
+}
+
+/// [`setup`]'s grid on Ridgeway, whose ceiling in a run record is the one `cdbo ceiling` prints.
+fn setup_on_ridgeway(name: &str) -> PathBuf {
+    let dir = fresh_dir(name);
+    let grid = GRID.replace("track = \"oval.xml\"", "track = \"ridgeway\"");
+    std::fs::write(dir.join("grid.toml"), grid).unwrap();
     dir
 }
 
@@ -106,22 +116,22 @@ fn results_do_not_depend_on_jobs_and_shards_merge() {
     let out = ok(&dir, &["report", "s0", "s1", "s2", "--out", "merged"]);
     assert!(out.contains("4 runs from 3 folder(s)"), "{out}");
     let results = std::fs::read_to_string(dir.join("merged/results.md")).unwrap();
-    assert!(results.contains("| ridgeway | 6 | cdbo | 2 |"), "{results}");
+    assert!(results.contains("| oval.xml | 6 | cdbo | 2 |"), "{results}");
     for f in [
-        "curves_ridgeway.png",
-        "curves_ridgeway.svg",
+        "curves_oval.xml.png",
+        "curves_oval.xml.svg",
         "table1.md",
-        "fig3a_policy_ridgeway.svg",
-        "tradeoff_ridgeway_6.png",
-        "tradeoff_ridgeway_6.svg",
+        "fig3a_policy_oval.xml.svg",
+        "tradeoff_oval.xml_6.png",
+        "tradeoff_oval.xml_6.svg",
     ] {
         assert!(dir.join("merged").join(f).is_file(), "{f}");
     }
     // The budget line's best with no cap is the table's fastest method, by brute force over
-    // the table's rows: | ridgeway | 6 | METHOD | runs | MEAN ± SE | ….
+    // the table's rows: | oval.xml | 6 | METHOD | runs | MEAN ± SE | ….
     let (method, best) = results
         .lines()
-        .filter_map(|l| l.strip_prefix("| ridgeway | 6 | "))
+        .filter_map(|l| l.strip_prefix("| oval.xml | 6 | "))
         .map(|l| {
             let cols: Vec<&str> = l.split(" | ").collect();
             (cols[0], cols[2].split(" ± ").next().unwrap())
@@ -130,13 +140,13 @@ fn results_do_not_depend_on_jobs_and_shards_merge() {
         .unwrap();
     let line = results
         .lines()
-        .find(|l| l.starts_with("- ridgeway 6: at most 10 % ("))
+        .find(|l| l.starts_with("- oval.xml 6: at most 10 % ("))
         .expect("the panel's budget line");
     assert!(
         line.contains(&format!("no cap: {method} {best} ± ")),
         "{line}"
     );
-    assert!(results.contains("(tradeoff_ridgeway_6.png)"), "{results}");
+    assert!(results.contains("(tradeoff_oval.xml_6.png)"), "{results}");
 }
 
 /// Every run records the ceiling (the tracked limit profile's lap, as `cdbo ceiling`
@@ -144,7 +154,7 @@ fn results_do_not_depend_on_jobs_and_shards_merge() {
 /// stored still parse, and their cells show no percentage.
 #[test]
 fn report_gives_the_percentage_of_the_ceiling_and_reads_old_records() {
-    let dir = setup("ceiling");
+    let dir = setup_on_ridgeway("ceiling");
     ok(&dir, &["experiment", "grid.toml", "--out", "new"]);
     let ceiling = ok(&dir, &["ceiling", "--track", "ridgeway", "--kernels", "6"]);
     let old = dir.join("old/runs");

@@ -3,21 +3,7 @@
 
 use std::path::Path;
 
-use crate::common::{fails_with, json, run, scratch};
-
-const TRACK: &str = r#"<?xml version="1.0"?>
-<params name="t">
-  <section name="Main Track">
-    <attnum name="width" unit="m" val="10"/>
-    <section name="Track Segments">
-      <section name="s1"><attstr name="type" val="str"/><attnum name="lg" unit="m" val="100"/></section>
-      <section name="c1"><attstr name="type" val="lft"/><attnum name="radius" unit="m" val="50"/><attnum name="arc" unit="deg" val="180"/></section>
-      <section name="s2"><attstr name="type" val="str"/><attnum name="lg" unit="m" val="100"/></section>
-      <section name="c2"><attstr name="type" val="lft"/><attnum name="radius" unit="m" val="50"/><attnum name="arc" unit="deg" val="180"/></section>
-    </section>
-  </section>
-</params>
-"#;
+use crate::common::{OVAL as TRACK, fails_with, json, run, scratch};
 
 #[test]
 fn a_hand_written_track_file_loads() {

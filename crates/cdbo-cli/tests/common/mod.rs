@@ -11,6 +11,26 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, ChildStdin, ChildStdout, Command, ExitStatus, Output, Stdio};
 use std::time::{Duration, Instant};
 
+/// A hand-written TORCS track: an oval of two 100 m straights and two 180° turns of radius
+/// 50 m, 10 m wide, of asphalt of friction 1 (514 m a lap, a seventh of Ridgeway: a grid of
+/// races on it is quick).
+pub const OVAL: &str = r#"<?xml version="1.0"?>
+<params name="t">
+  <section name="Main Track">
+    <attnum name="width" unit="m" val="10"/>
+    <section name="Track Segments">
+      <section name="s1"><attstr name="type" val="str"/><attnum name="lg" unit="m" val="100"/></section>
+      <section name="c1"><attstr name="type" val="lft"/><attnum name="radius" unit="m" val="50"/><attnum name="arc" unit="deg" val="180"/></section>
+      <section name="s2"><attstr name="type" val="str"/><attnum name="lg" unit="m" val="100"/></section>
+      <section name="c2"><attstr name="type" val="lft"/><attnum name="radius" unit="m" val="50"/><attnum name="arc" unit="deg" val="180"/></section>
+    </section>
+  </section>
+  <section name="Surfaces">
+    <section name="asphalt"><attnum name="friction" val="1.0"/></section>
+  </section>
+</params>
+"#;
+
 /// The `cdbo` binary under test.
 pub const CDBO: &str = env!("CARGO_BIN_EXE_cdbo");
 
