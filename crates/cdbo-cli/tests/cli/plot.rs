@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use crate::common::{fails_with, scratch, succeed};
+use crate::common::{fails_with, oval_file, scratch, succeed};
 
 #[test]
 fn traces_and_plots_are_written() {
@@ -66,6 +66,8 @@ fn a_race_draws_its_figures() {
         .join(format!("cdbo-cli-race-plots-{}", std::process::id()));
     succeed(&[
         "race",
+        "--track",
+        oval_file(),
         "--laps",
         "12",
         "--kernels",

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use crate::common::{fails_with, json, run, scratch, shared, succeed};
+use crate::common::{fails_with, json, oval_file, run, scratch, shared, succeed};
 
 /// A knob a method cannot take is refused before any lap, naming the method and its knob; the
 /// older `--sigma0` is refused where the method's knob is not σ₀.
@@ -64,6 +64,8 @@ fn the_box_radius_bounds_the_search() {
     let farthest = |box_radius: Option<&str>| {
         let mut args = vec![
             "race",
+            "--track",
+            oval_file(),
             "--method",
             "pattern-search",
             "--laps",
@@ -372,7 +374,8 @@ fn a_cdbo_race_points_to_the_recommended_stack() {
         .join(format!("cdbo-cli-race-hint-{}", std::process::id()));
     let dir = out.to_str().unwrap();
     let race = |method: &str| {
-        let args = ["race", "--laps", "3", "--method", method, "--out", dir];
+        let args = ["race", "--track", oval_file(), "--laps", "3"];
+        let args = [&args[..], &["--method", method, "--out", dir]].concat();
         String::from_utf8(succeed(&args).stdout).unwrap()
     };
     let hint = "`cdbo race --preset fast-safe`";
@@ -391,7 +394,8 @@ fn the_fast_safe_preset_races_as_its_long_form() {
         .join(format!("cdbo-cli-preset-{}", std::process::id()));
     let race = |name: &str, stack: &[&str]| -> (serde_json::Value, String) {
         let out = dir.join(name);
-        let mut args = vec!["race", "--laps", "30", "--out", out.to_str().unwrap()];
+        let mut args = vec!["race", "--track", oval_file(), "--laps", "30"];
+        args.extend(["--out", out.to_str().unwrap()]);
         args.extend(stack);
         succeed(&args);
         let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
@@ -462,6 +466,8 @@ fn a_race_warm_starts_from_a_policy_file() {
     let (learn, warm) = (out.join("learn"), out.join("warm"));
     let common = [
         "race",
+        "--track",
+        oval_file(),
         "--method",
         "pattern-search",
         "--seed",

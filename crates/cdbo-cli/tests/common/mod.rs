@@ -9,6 +9,7 @@ use std::fmt::Debug;
 use std::io::{BufRead, BufReader, Lines, Write};
 use std::path::{Path, PathBuf};
 use std::process::{Child, ChildStdin, ChildStdout, Command, ExitStatus, Output, Stdio};
+use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
 /// A hand-written TORCS track: an oval of two 100 m straights and two 180° turns of radius
@@ -76,6 +77,15 @@ pub fn scratch(name: &str, content: &str) -> PathBuf {
     let p = dir.join(name);
     std::fs::write(&p, content).unwrap();
     p
+}
+
+/// The oval ([`OVAL`]) as a file, written once for this test binary: a race on it is quick.
+pub fn oval_file() -> &'static str {
+    static FILE: OnceLock<String> = OnceLock::new();
+    FILE.get_or_init(|| {
+        let file = scratch("oval-track.xml", OVAL);
+        file.to_str().unwrap().to_owned()
+    })
 }
 
 /// Runs `cdbo ARGS` ([`run`]), expects failure with exactly one `error:` line containing every
