@@ -301,13 +301,13 @@ fn a_legal_but_slow_study_says_so_first() {
 #[test]
 fn three_workers_one_killed_drive_each_trial_once() {
     let dir = fresh_dir_with_demo("workers");
-    let trials = 12;
+    let trials = 24;
     let workers: Vec<Child> = (0..3)
         .map(|_| spawn(optimize("w.db", trials, 0.1), &dir))
         .collect();
     // Kill the first once a few trials are told.
-    wait_until("4 laps driven", Duration::from_secs(60), || {
-        driven(&dir) >= 4
+    wait_until("6 laps driven", Duration::from_secs(60), || {
+        driven(&dir) >= 6
     });
     kill_first_and_reap(workers);
     every_trial_told_once_and_distinct(&history(&dir, "s", "w.db"), trials);
@@ -333,7 +333,14 @@ fn a_single_worker_is_unchanged_by_claims() {
         std::fs::write(&policy, asked.to_string()).unwrap();
         let lap: serde_json::Value = serde_json::from_str(&ok(
             &dir,
-            &["lap", "--policy", policy.to_str().unwrap(), "--json"],
+            &[
+                "lap",
+                "--track",
+                "oval.xml",
+                "--policy",
+                policy.to_str().unwrap(),
+                "--json",
+            ],
         ))
         .unwrap();
         let trial = asked["trial"].to_string();

@@ -343,7 +343,7 @@ fn optimize_records_failed_commands_with_their_reason() {
 #[test]
 fn sigkill_at_random_moments_loses_nothing() {
     let dir = fresh_dir_with_demo("sigkill");
-    let evaluator = EVALUATOR.replace("{cdbo}", CDBO);
+    let evaluator = common::OVAL_LAP.replace("{cdbo}", CDBO);
     let mut seed: u64 = 0x2545_f491_4f6c_dd1d;
     let mut random_ms = |max: u64| {
         seed ^= seed << 13;
@@ -523,7 +523,7 @@ fn a_study_steers_as_its_initial_policy_was_raced() {
 #[test]
 fn a_study_of_the_preset_is_its_long_form() {
     let dir = fresh_dir_with_demo("study-preset");
-    let evaluator = EVALUATOR.replace("{cdbo}", CDBO);
+    let evaluator = common::OVAL_LAP.replace("{cdbo}", CDBO);
     let long_form = [
         "--method",
         "safe-pattern-search",

@@ -148,13 +148,21 @@ pub fn refused<S: AsRef<OsStr> + Debug>(dir: &Path, args: &[S], needles: &[&str]
     }
 }
 
-/// A demonstration recorded on the built-in track, `demo.csv` in `dir`.
+/// A demonstration recorded on the oval ([`OVAL`], `oval.xml` in `dir`), `demo.csv` in `dir`:
+/// the laps of a study fitted to it are driven there ([`OVAL_LAP`]), a seventh of Ridgeway.
 pub fn demo(dir: &Path) {
+    std::fs::write(dir.join("oval.xml"), OVAL).unwrap();
     ok(
         dir,
-        &["lap", "--demo", "15", "--trace", "demo.csv", "--json"],
+        &[
+            "lap", "--track", "oval.xml", "--demo", "15", "--trace", "demo.csv", "--json",
+        ],
     );
 }
+
+/// An evaluator's lap on the oval of [`demo`]: `cdbo lap` of the trial's policy file, with
+/// `{cdbo}` for the binary.
+pub const OVAL_LAP: &str = "{cdbo} lap --track oval.xml --policy {policy} --json";
 
 /// Ridgeway's 15 m/s demonstration traced (`cdbo lap --trace`, `TAG-demo.csv`) and w0 of 20
 /// kernels fitted to it (`cdbo policy fit`, `TAG-w0.json`).
@@ -220,7 +228,7 @@ pub fn optimize_args(evaluator: &str, storage: &str, laps: usize) -> Vec<String>
     .to_vec()
 }
 
-/// A worker: [`optimize_args`] with 2 s leases, each lap a `cdbo lap` that first appends its
+/// A worker: [`optimize_args`] with 2 s leases, each lap a `cdbo lap` on the oval ([`OVAL_LAP`]) that first appends its
 /// policy to `driven.log` ([`driven`]) and, `pause_s` > 0, sleeps that long.
 pub fn optimize(storage: &str, laps: usize, pause_s: f64) -> Command {
     let pause = if pause_s > 0.0 {
@@ -228,8 +236,10 @@ pub fn optimize(storage: &str, laps: usize, pause_s: f64) -> Command {
     } else {
         String::new()
     };
-    let evaluator =
-        format!("echo {{policy}} >> driven.log; {pause}{CDBO} lap --policy {{policy}} --json");
+    let evaluator = format!(
+        "echo {{policy}} >> driven.log; {pause}{}",
+        OVAL_LAP.replace("{cdbo}", CDBO)
+    );
     let mut c = Command::new(CDBO);
     c.args(optimize_args(&evaluator, storage, laps))
         .args(["--lease", "2"]);
