@@ -1,34 +1,7 @@
 //! `cdbo bench circuits`: a folder of circuits raced with each stack, one row each, the same
 //! races `cdbo race` runs.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn cdbo(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_cdbo"))
-        .args(args)
-        .output()
-        .expect("runs")
-}
-
-fn json(args: &[&str]) -> serde_json::Value {
-    let out = cdbo(args);
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("JSON")
-}
-
-/// A folder of this test's own, emptied.
-fn folder(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("cdbo-bench-test-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use crate::common::{fresh_dir, json, run};
 
 /// An ellipse of half-axes `a` and `b` metres, 12 m wide, as a TUMFTM `.csv` centre line.
 fn ellipse(a: f64, b: f64) -> String {
@@ -43,7 +16,7 @@ fn ellipse(a: f64, b: f64) -> String {
 
 #[test]
 fn every_circuit_of_a_folder_is_raced_with_each_stack_as_race_races_it() {
-    let dir = folder("two");
+    let dir = fresh_dir("two");
     std::fs::write(dir.join("Round.csv"), ellipse(150.0, 150.0)).unwrap();
     std::fs::write(dir.join("Long.csv"), ellipse(300.0, 120.0)).unwrap();
     std::fs::write(dir.join("notes.txt"), "not a track").unwrap();
@@ -88,7 +61,7 @@ fn every_circuit_of_a_folder_is_raced_with_each_stack_as_race_races_it() {
         } else {
             "--method"
         };
-        let out = folder(&format!(
+        let out = fresh_dir(&format!(
             "race-{}-{stack}",
             run["circuit"].as_str().unwrap()
         ));
@@ -111,12 +84,12 @@ fn every_circuit_of_a_folder_is_raced_with_each_stack_as_race_races_it() {
 
 #[test]
 fn a_folder_without_circuits_and_an_unknown_stack_get_one_clear_line() {
-    let dir = folder("empty");
-    let out = cdbo(&["bench", "circuits", dir.to_str().unwrap()]);
+    let dir = fresh_dir("empty");
+    let out = run(&["bench", "circuits", dir.to_str().unwrap()]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success());
     assert!(err.contains("no track in this folder"), "{err}");
-    let out = cdbo(&["bench", "circuits", "ridgeway", "--stacks", "fastest"]);
+    let out = run(&["bench", "circuits", "ridgeway", "--stacks", "fastest"]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success());
     assert!(

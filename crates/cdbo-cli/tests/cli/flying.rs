@@ -1,25 +1,17 @@
 //! `cdbo race --flying`: learning on the flying lap, and both laps of the best policy in
 //! every race's summary.
 
-use std::path::Path;
-use std::process::Command;
+use crate::common::{fresh_dir, json, oval_file};
 
+/// `cdbo race --preset fast-safe` of 30 laps on the oval ([`oval_file`]) with `extra`: its
+/// summary.
 fn race(extra: &[&str], name: &str) -> serde_json::Value {
-    let out_dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("cdbo-flying-test-{}-{name}", std::process::id()));
-    let mut args = vec!["race", "--preset", "fast-safe", "--laps", "30", "--json"];
+    let out_dir = fresh_dir(&format!("flying-{name}"));
+    let mut args = vec!["race", "--track", oval_file(), "--preset", "fast-safe"];
+    args.extend(["--laps", "30", "--json"]);
     args.extend(extra);
     args.extend(["--out", out_dir.to_str().unwrap()]);
-    let out = Command::new(env!("CARGO_BIN_EXE_cdbo"))
-        .args(&args)
-        .output()
-        .expect("runs");
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("JSON")
+    json(&args)
 }
 
 #[test]
