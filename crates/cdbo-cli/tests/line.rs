@@ -159,15 +159,18 @@ fn serve_sim_and_lap_drive_a_policy_on_its_line() {
 
 /// `cdbo ceiling --line min-curvature --json` tracks the line's limit and names the centre
 /// line's beside it, the limits `cdbo limit --json` prints for both; on the centre line no
-/// second limit is written.
+/// second limit is written (on the oval, [`common::OVAL`]).
 #[test]
 fn the_ceiling_on_the_line_names_both_limits() {
     let dir = fresh_dir("ceiling-line");
-    let limit = json(&ok(&dir, &["limit", "--json"]));
+    std::fs::write(dir.join("oval.xml"), common::OVAL).unwrap();
+    let limit = json(&ok(&dir, &["limit", "--track", "oval.xml", "--json"]));
     let on_line = json(&ok(
         &dir,
         &[
             "ceiling",
+            "--track",
+            "oval.xml",
             "--kernels",
             "6",
             "--steering",
@@ -184,7 +187,10 @@ fn the_ceiling_on_the_line_names_both_limits() {
     );
     let tracked = on_line["tracked_mps"].as_f64().unwrap();
     assert!(tracked > 0.0 && tracked < on_line["limit_mps"].as_f64().unwrap());
-    let centre = json(&ok(&dir, &["ceiling", "--kernels", "6", "--json"]));
+    let centre = json(&ok(
+        &dir,
+        &["ceiling", "--track", "oval.xml", "--kernels", "6", "--json"],
+    ));
     assert_eq!(centre["limit_mps"], limit["reward_mps"]);
     assert!(centre.get("centre_line_limit_mps").is_none(), "{centre}");
 }

@@ -150,6 +150,8 @@ fn a_race_with_a_learned_line_writes_and_drives_it() {
         .join(format!("cdbo-cli-race-line-{}", std::process::id()));
     let v = json(&[
         "race",
+        "--track",
+        oval_file(),
         "--laps",
         "10",
         "--kernels",
@@ -171,7 +173,8 @@ fn a_race_with_a_learned_line_writes_and_drives_it() {
     let file: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&policy).unwrap()).unwrap();
     assert_eq!(file["line"]["weights"].as_array().map(Vec::len), Some(6));
-    let lap = json(&["lap", "--policy", policy.to_str().unwrap(), "--json"]);
+    let policy = policy.to_str().unwrap();
+    let lap = json(&["lap", "--track", oval_file(), "--policy", policy, "--json"]);
     assert_eq!(
         lap["reward_mps"].as_f64(),
         v["best_reward_mps"].as_f64(),
@@ -237,6 +240,8 @@ fn a_race_on_the_min_curvature_line_names_it() {
         .join(format!("cdbo-cli-race-mincurv-{}", std::process::id()));
     let v = json(&[
         "race",
+        "--track",
+        oval_file(),
         "--laps",
         "5",
         "--kernels",
