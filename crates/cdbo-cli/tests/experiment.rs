@@ -349,10 +349,11 @@ fn workers_fill_a_grid_in_an_sqlite_file() {
 #[test]
 fn a_grid_learning_a_line_races_as_race_does() {
     let dir = fresh_dir("grid-line");
-    let grid = "laps = 6\nrepeats = 1\nmethods = [\"random\"]\nline = \"learn\"\nline_kernels = 4\n\n[[tracks]]\ntrack = \"ridgeway\"\nkernels = [6]\n";
+    std::fs::write(dir.join("oval.xml"), common::OVAL).unwrap();
+    let grid = "laps = 6\nrepeats = 1\nmethods = [\"random\"]\nline = \"learn\"\nline_kernels = 4\n\n[[tracks]]\ntrack = \"oval.xml\"\nkernels = [6]\n";
     std::fs::write(dir.join("grid.toml"), grid).unwrap();
     ok(&dir, &["experiment", "grid.toml", "--out", "g"]);
-    let text = std::fs::read_to_string(dir.join("g/runs/ridgeway-m6-random-r0.json")).unwrap();
+    let text = std::fs::read_to_string(dir.join("g/runs/oval_xml-m6-random-r0.json")).unwrap();
     let record: serde_json::Value = serde_json::from_str(&text).unwrap();
     assert_eq!(record["line_kernels"], 4);
     assert_eq!(record["best_weights"].as_array().unwrap().len(), 10);
@@ -360,6 +361,8 @@ fn a_grid_learning_a_line_races_as_race_does() {
         &dir,
         &[
             "race",
+            "--track",
+            "oval.xml",
             "--json",
             "--method",
             "random",
@@ -396,17 +399,20 @@ fn a_grid_learning_a_line_races_as_race_does() {
 #[test]
 fn a_grid_steers_with_the_tracker_as_race_does() {
     let dir = fresh_dir("steering");
+    std::fs::write(dir.join("oval.xml"), common::OVAL).unwrap();
     let grid = "laps = 8\nrepeats = 1\nmethods = [\"random\"]\nsteering = \"tracker\"\n\
-                [[tracks]]\ntrack = \"ridgeway\"\nkernels = [6]\n";
+                [[tracks]]\ntrack = \"oval.xml\"\nkernels = [6]\n";
     std::fs::write(dir.join("grid.toml"), grid).unwrap();
     ok(&dir, &["experiment", "grid.toml", "--out", "g"]);
     let run: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(dir.join("g/runs/ridgeway-m6-random-r0.json")).unwrap(),
+        &std::fs::read_to_string(dir.join("g/runs/oval_xml-m6-random-r0.json")).unwrap(),
     )
     .unwrap();
     let race = |steering: &str| -> serde_json::Value {
         let args = [
             "race",
+            "--track",
+            "oval.xml",
             "--kernels",
             "6",
             "--laps",
@@ -513,12 +519,13 @@ fn a_grid_keeps_its_off_track_margin_as_race_does() {
 #[test]
 fn a_grid_of_the_preset_races_as_race_does() {
     let dir = fresh_dir("grid-preset");
+    std::fs::write(dir.join("oval.xml"), common::OVAL).unwrap();
     let grid = "laps = 8\nrepeats = 1\npreset = \"fast-safe\"\n\
-                [[tracks]]\ntrack = \"ridgeway\"\nkernels = [6]\n";
+                [[tracks]]\ntrack = \"oval.xml\"\nkernels = [6]\n";
     std::fs::write(dir.join("grid.toml"), grid).unwrap();
     ok(&dir, &["experiment", "grid.toml", "--out", "g"]);
     let run: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(dir.join("g/runs/ridgeway-m6-safe-pattern-search-r0.json"))
+        &std::fs::read_to_string(dir.join("g/runs/oval_xml-m6-safe-pattern-search-r0.json"))
             .unwrap(),
     )
     .unwrap();
@@ -532,6 +539,8 @@ fn a_grid_of_the_preset_races_as_race_does() {
     );
     let args = [
         "race",
+        "--track",
+        "oval.xml",
         "--preset",
         "fast-safe",
         "--kernels",
