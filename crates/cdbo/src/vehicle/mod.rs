@@ -519,6 +519,7 @@ pub mod aids;
 pub mod barrier;
 pub mod bounce;
 mod ground;
+mod hypot;
 pub mod powertrain;
 mod step;
 pub mod table;

@@ -2,6 +2,8 @@
 //! formulas in [`super`]).
 
 use super::bounce;
+use super::hypot::hypot;
+use super::tyre::Forces;
 use super::{Controls, GAME_STEP, SLIP_SPEED_FLOOR, State, Vehicle, rear_omega};
 use crate::car::{DiffKind, G};
 use crate::track::{Bumps, Frame};
@@ -9,6 +11,43 @@ use crate::track::{Bumps, Frame};
 impl Vehicle {
     pub(super) fn driven_omega(&self, s: &State) -> f64 {
         self.driven[0] * s.omega[0] + self.driven[1] * rear_omega(s)
+    }
+
+    /// A front wheel steered to (sin, cos) of its angle, under its `load` on ground of
+    /// `friction`: its wheel-frame velocities v_t = vₓ·cos + v_lat·sin and v_l = −vₓ·sin +
+    /// v_lat·cos (v_lat the axle's lateral velocity), its tyre's forces at the slips (the
+    /// formulas in [`super`]) under its budget, the budget, and 1 / max(|v_t|, v₀). Always
+    /// inlined, as [`Vehicle::rear_tyre`]: the step keeps its values in registers instead
+    /// of spilling them around a call.
+    #[inline(always)]
+    fn front_wheel(
+        &self,
+        s: &State,
+        (sn, cs): (f64, f64),
+        front_lat: f64,
+        load: f64,
+        friction: f64,
+    ) -> (Forces, f64, f64) {
+        let (tyre, r) = (&self.tyres[0], self.radius[0]);
+        let vt = s.vx * cs + front_lat * sn;
+        let vl = -s.vx * sn + front_lat * cs;
+        let inv = 1.0 / vt.abs().max(SLIP_SPEED_FLOOR);
+        let fmax = tyre.wheel_max_force(load, friction);
+        let sx = (s.omega[0] * r - vt) * inv;
+        let sy = -vl / hypot(vt, vl).max(SLIP_SPEED_FLOOR);
+        (tyre.forces(sx, sy, fmax), fmax, inv)
+    }
+
+    /// Rear wheel `i` (0 left, 1 right) spinning at `omega` on ground of `friction`: its
+    /// tyre's forces at the slips sₓ = (ωR − v_t)/max(|v_t|, v₀), s_y = −v_l/max(|v|, v₀)
+    /// under its budget, and the budget.
+    #[inline(always)]
+    fn rear_tyre(&self, omega: f64, w: &RearWheels, i: usize, friction: f64) -> (Forces, f64) {
+        let (tyre, r) = (&self.tyres[1], self.radius[1]);
+        let fmax = tyre.wheel_max_force(w.loads[i], friction);
+        let sx = (omega * r - w.vt[i]) * w.inv_denom[i];
+        let sy = -w.vl * w.inv_speed[i];
+        (tyre.forces(sx, sy, fmax), fmax)
     }
 
     /// Advances the state by `dt` seconds on the road described by `frame`.
@@ -39,7 +78,7 @@ impl Vehicle {
         let ground = self.wheel_ground(s, frame);
         let mut friction = match &ground {
             None => [frame.friction; 4],
-            Some(w) => w.map(|g| g.friction),
+            Some(w) => [w[0].friction, w[1].friction, w[2].friction, w[3].friction],
         };
         // The wheels' bounce over rough ground and the road's kinks takes some of their grip.
         if let Some(corners) = &self.corners {
@@ -73,7 +112,10 @@ impl Vehicle {
             1.0 / vt_rear[0].abs().max(SLIP_SPEED_FLOOR),
             1.0 / vt_rear[1].abs().max(SLIP_SPEED_FLOOR),
         ];
-        let inv_speed_rear = vt_rear.map(|vt| 1.0 / vt.hypot(vl_rear).max(SLIP_SPEED_FLOOR));
+        let inv_speed_rear = [
+            1.0 / hypot(vt_rear[0], vl_rear).max(SLIP_SPEED_FLOOR),
+            1.0 / hypot(vt_rear[1], vl_rear).max(SLIP_SPEED_FLOOR),
+        ];
         // An axle as the robot reads it: its wheels' mean spin against vₓ.
         let inv_axle = 1.0 / s.vx.abs().max(SLIP_SPEED_FLOOR);
 
@@ -145,17 +187,10 @@ impl Vehicle {
         let (front_x, front_y, front_moment) = {
             let tyre = &self.tyres[0];
             let r = self.radius[0];
-            let wheel = |i: usize| {
-                let (sn, cs) = angles[i];
-                let vt = s.vx * cs + front_lat * sn;
-                let vl = -s.vx * sn + front_lat * cs;
-                let inv = 1.0 / vt.abs().max(SLIP_SPEED_FLOOR);
-                let fmax = tyre.wheel_max_force(front_loads[i], friction[i]);
-                let sx = (s.omega[0] * r - vt) * inv;
-                let sy = -vl / vt.hypot(vl).max(SLIP_SPEED_FLOOR);
-                (tyre.forces(sx, sy, fmax), fmax, inv)
-            };
-            let wheels = [wheel(0), wheel(1)];
+            let wheels = [
+                self.front_wheel(s, angles[0], front_lat, front_loads[0], friction[0]),
+                self.front_wheel(s, angles[1], front_lat, front_loads[1], friction[1]),
+            ];
             // ABS: ease the pressure while the axle slides backwards past the threshold.
             let mut brake = c.brake() * self.max_brake[0];
             let threshold = self.aid_threshold[0];
@@ -396,15 +431,15 @@ impl Vehicle {
         }
 
         // Tyre forces at the spins, their reaction torques τ and dτ/dω.
-        let forces = [0, 1].map(|i| {
-            let fmax = tyre.wheel_max_force(w.loads[i], friction[i]);
-            let sx = (omega[i] * r - w.vt[i]) * w.inv_denom[i];
-            let sy = -w.vl * w.inv_speed[i];
-            (tyre.forces(sx, sy, fmax), fmax)
-        });
+        let forces = [
+            self.rear_tyre(omega[0], w, 0, friction[0]),
+            self.rear_tyre(omega[1], w, 1, friction[1]),
+        ];
         let tau = [r * forces[0].0.fx, r * forces[1].0.fx];
-        let dtau = [0, 1].map(|i| (forces[i].0.dfx_dsx * r * r * w.inv_denom[i]).max(0.0));
-        let brake_torque = [0, 1].map(|i| brake * omega[i].signum() * f64::from(omega[i] != 0.0));
+        let dtau_of = |i: usize| (forces[i].0.dfx_dsx * r * r * w.inv_denom[i]).max(0.0);
+        let dtau = [dtau_of(0), dtau_of(1)];
+        let brake_of = |i: usize| brake * omega[i].signum() * f64::from(omega[i] != 0.0);
+        let brake_torque = [brake_of(0), brake_of(1)];
         let step = if rigid {
             let d = dt * (drive - tau[0] - tau[1] - brake_torque[0] - brake_torque[1])
                 / (2.0 * inertia + dt * (dtau[0] + dtau[1]));
@@ -413,12 +448,13 @@ impl Vehicle {
             // (I + dt·d_i·(1 + h))·Δ_i − dt·h·d_j·Δ_j = dt·(T_i + h·(τ_j − τ_i) − τ_i − T_b,i),
             // h the spider's half.
             let h = spider;
-            let rhs = [0, 1].map(|i| {
-                let j = 1 - i;
+            let rhs_of = |i: usize, j: usize| {
                 dt * (split[i] + h * (tau[j] - tau[i]) - tau[i] - brake_torque[i])
-            });
-            let a = [0, 1].map(|i| inertia + dt * dtau[i] * (1.0 + h));
-            let b = [0, 1].map(|i| -dt * h * dtau[i]);
+            };
+            let rhs = [rhs_of(0, 1), rhs_of(1, 0)];
+            let a_of = |i: usize| inertia + dt * dtau[i] * (1.0 + h);
+            let a = [a_of(0), a_of(1)];
+            let b = [-dt * h * dtau[0], -dt * h * dtau[1]];
             let det = a[0] * a[1] - b[0] * b[1];
             [
                 (rhs[0] * a[1] - b[1] * rhs[1]) / det,

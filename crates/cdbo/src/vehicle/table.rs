@@ -34,7 +34,7 @@ impl HermiteTable {
     }
 
     /// (f(x), f′(x)) for x in the table's range, `None` outside it.
-    #[inline]
+    #[inline(always)]
     pub fn eval(&self, x: f64) -> Option<(f64, f64)> {
         let u = x * self.inv_step;
         if !(u >= 0.0 && u < self.intervals) {

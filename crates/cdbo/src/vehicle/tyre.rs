@@ -98,7 +98,7 @@ impl TyreModel {
     }
 
     /// Load sensitivity λ(F_z) (tabulated; the formula beyond 8 × the operating load).
-    #[inline]
+    #[inline(always)]
     pub fn load_factor(&self, fz: f64) -> f64 {
         let z = fz * self.inv_operating_load;
         match self.load_table.eval(z) {
@@ -109,7 +109,7 @@ impl TyreModel {
 
     /// Largest force one tyre can give under its load `fz` on a surface of friction `surface`
     /// (N): F_z·μ·μ_surface·λ(F_z), as simuv2's `wheel.cpp` has it per wheel.
-    #[inline]
+    #[inline(always)]
     pub fn wheel_max_force(&self, fz: f64, surface: f64) -> f64 {
         fz * self.mu * surface * self.load_factor(fz)
     }
@@ -123,7 +123,7 @@ impl TyreModel {
 
     /// g(u) = f(√u)/√u and g′(u) for u = s² ≥ 0: the tabulated values up to u = 1, the
     /// formula beyond.
-    #[inline]
+    #[inline(always)]
     pub fn ratio(&self, u: f64) -> (f64, f64) {
         self.ratio_table
             .eval(u)
@@ -159,7 +159,7 @@ impl TyreModel {
     /// derivatives with respect to sₓ, with u = sₓ² + s_y²:
     /// Fₓ = fmax·g(u)·sₓ, F_y = fmax·g(u)·s_y,
     /// ∂Fₓ/∂sₓ = fmax·[g + 2sₓ²·g′], ∂F_y/∂sₓ = fmax·2sₓs_y·g′.
-    #[inline]
+    #[inline(always)]
     pub fn forces(&self, sx: f64, sy: f64, fmax: f64) -> Forces {
         let u = sx * sx + sy * sy;
         let (g, dg) = self.ratio(u);
@@ -180,7 +180,7 @@ impl TyreModel {
     }
 
     /// The skid factor's multiplier m(u) = 1 + k·min(√u, [`SKID_SLIP_CAP`]) and dm/du.
-    #[inline]
+    #[inline(always)]
     pub fn skid_multiplier(&self, u: f64) -> (f64, f64) {
         let s = u.sqrt();
         if s >= SKID_SLIP_CAP {
