@@ -17,8 +17,13 @@ pub struct HermiteTable {
 }
 
 impl HermiteTable {
-    /// Samples `f` (returning value and derivative) at `len + 1` nodes spaced by `step`.
+    /// Samples `f` (returning value and derivative) at `len + 1` nodes spaced by `step`;
+    /// `len` below 2³¹.
     pub fn new(step: f64, len: usize, f: impl Fn(f64) -> (f64, f64)) -> HermiteTable {
+        assert!(
+            len < 1 << 31,
+            "a Hermite table of {len} intervals: at most 2³¹ − 1"
+        );
         let nodes = (0..=len)
             .map(|k| {
                 let (v, d) = f(k as f64 * step);
@@ -40,8 +45,11 @@ impl HermiteTable {
         if !(u >= 0.0 && u < self.intervals) {
             return None;
         }
-        let k = u as usize;
-        let t = u - k as f64;
+        // u ∈ [0, len) and len < 2³¹ (`new`): k = ⌊u⌋ as a 32-bit integer, whose conversions
+        // from and to a float take a few instructions where a usize's take a dozen.
+        let k = u as u32;
+        let t = u - f64::from(k);
+        let k = k as usize;
         let [(f0, m0), (f1, m1)] = self.nodes[k..k + 2] else {
             return None;
         };
