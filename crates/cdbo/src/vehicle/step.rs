@@ -169,21 +169,9 @@ impl Vehicle {
         };
         s.gearbox.shifting = (s.gearbox.shifting - dt).max(0.0);
 
-        // The front wheels: one spin for both, each steered, loaded and gripping on its own;
-        // the inner wheel turned by δ, the outer by simuv2's Ackermann angle (`steer.cpp`),
-        // tan δ_o = L·tan|δ|/(L + T·tan|δ|), T = y_f + y_r.
-        let (sin_d, cos_d) = c.steer_sin_cos;
-        let tan_d = (sin_d / cos_d).abs();
-        let (l, [y_f, y_r]) = (self.car.wheelbase, self.car.axles.half_track);
-        let tan_o = l * tan_d / (l + (y_f + y_r) * tan_d);
-        let cos_o = 1.0 / (1.0 + tan_o * tan_o).sqrt();
-        let outer = ((tan_o * cos_o).copysign(sin_d), cos_o);
-        // Left first: the left wheel is the inner one in a left-hand turn (δ > 0).
-        let angles = if sin_d >= 0.0 {
-            [(sin_d, cos_d), outer]
-        } else {
-            [outer, (sin_d, cos_d)]
-        };
+        // The front wheels: one spin for both, each steered ([`Vehicle::controls`]), loaded
+        // and gripping on its own.
+        let angles = c.wheel_angles;
         let (front_x, front_y, front_moment) = {
             let tyre = &self.tyres[0];
             let r = self.radius[0];

@@ -39,15 +39,10 @@ fn a_left_hand_turn_mirrors_a_right_hand_one() {
             right.roll = -left.roll;
             right.omega = [left.omega[0], left.omega[2], left.omega[1]];
             for _ in 0..50 {
-                v.step(
-                    &mut left,
-                    &Controls::new(0.1, throttle, brake),
-                    &frame,
-                    0.004,
-                );
+                v.step(&mut left, &v.controls(0.1, throttle, brake), &frame, 0.004);
                 v.step(
                     &mut right,
-                    &Controls::new(-0.1, throttle, brake),
+                    &v.controls(-0.1, throttle, brake),
                     &frame,
                     0.004,
                 );
@@ -200,7 +195,7 @@ fn the_rolling_resistance_turns_against_the_yaw() {
             speed / v.radius[1],
             speed / v.radius[1],
         ];
-        v.step(&mut s, &Controls::default(), &frame, dt);
+        v.step(&mut s, &v.controls(0.0, 0.0, 0.0), &frame, dt);
         s.yaw_rate
     };
     let down = v.downforce_per_v2(speed);
@@ -234,7 +229,7 @@ fn the_launch_clutch_blends_at_the_games_step() {
         let mut s = v.at_rest(0.0, 0.0, 0.0);
         s.clutch = 0.7;
         for _ in 0..(0.15 / dt).round() as usize {
-            v.step(&mut s, &Controls::new(0.0, 0.5, 0.0), &frame, dt);
+            v.step(&mut s, &v.controls(0.0, 0.5, 0.0), &frame, dt);
         }
         s.engine_speed
     };
