@@ -23,29 +23,64 @@ const EPS: f64 = f64::from_bits(0x3c90_0000_0000_0000);
 /// √(x² + y²), as the module computes it.
 #[inline]
 pub(crate) fn hypot(x: f64, y: f64) -> f64 {
-    let (x, y) = (x.abs(), y.abs());
-    let (big, small) = if x < y { (y, x) } else { (x, y) };
-    // False on a NaN or an infinity too.
-    let within = big <= LARGE && small >= TINY && small > big * EPS;
-    if !within {
+    let (big, small) = ordered(x, y);
+    if !within(big, small) {
         return x.hypot(y);
     }
-    let mut h = (big * big + small * small).sqrt();
-    let (t1, t2) = if h <= 2.0 * small {
+    corrected(big, small)
+}
+
+/// [`hypot`] of four pairs side by side, `hypot(x[i], y[i])` bit for bit: written lane by lane
+/// without branches (both of Borges' corrections computed, the one the lane's case takes
+/// kept), so that the compiler evaluates the four in vector registers; unless every lane is
+/// within the algorithm's arguments, each goes to [`hypot`].
+#[inline(always)]
+pub(crate) fn hypot_lanes(x: [f64; 4], y: [f64; 4]) -> [f64; 4] {
+    let mut big = [0.0; 4];
+    let mut small = [0.0; 4];
+    for i in 0..4 {
+        (big[i], small[i]) = ordered(x[i], y[i]);
+    }
+    if !(0..4).fold(true, |all, i| all & within(big[i], small[i])) {
+        return std::array::from_fn(|i| hypot(x[i], y[i]));
+    }
+    std::array::from_fn(|i| corrected(big[i], small[i]))
+}
+
+/// (x_max, y_min) = (max(|x|, |y|), min(|x|, |y|)).
+#[inline(always)]
+fn ordered(x: f64, y: f64) -> (f64, f64) {
+    let (x, y) = (x.abs(), y.abs());
+    if x < y { (y, x) } else { (x, y) }
+}
+
+/// Whether the module's algorithm takes (x_max, y_min): false on a NaN or an infinity too.
+#[inline(always)]
+fn within(big: f64, small: f64) -> bool {
+    (big <= LARGE) & (small >= TINY) & (small > big * EPS)
+}
+
+/// h = √(x_max² + y_min²) corrected once for the rounding of the squares (the module's
+/// formulas): both cases' terms are computed and the one for h ≤ 2·y_min or not kept.
+#[inline(always)]
+fn corrected(big: f64, small: f64) -> f64 {
+    let h = (big * big + small * small).sqrt();
+    let near = {
         let delta = h - small;
         (
             big * (2.0 * delta - big),
             (delta - 2.0 * (big - small)) * delta,
         )
-    } else {
+    };
+    let far = {
         let delta = h - big;
         (
             2.0 * delta * (big - 2.0 * small),
             (4.0 * delta - small) * small + delta * delta,
         )
     };
-    h -= (t1 + t2) / (2.0 * h);
-    h
+    let (t1, t2) = if h <= 2.0 * small { near } else { far };
+    h - (t1 + t2) / (2.0 * h)
 }
 
 #[cfg(test)]
@@ -92,6 +127,38 @@ mod tests {
                 target_env = "gnu"
             )) {
                 assert_eq!(ours.to_bits(), platform.to_bits(), "hypot({x}, {y})");
+            }
+        }
+    }
+
+    /// Four pairs side by side give each pair's [`hypot`], bit for bit, whether or not every
+    /// lane is within the algorithm's arguments.
+    #[test]
+    fn four_lanes_are_four_hypots() {
+        let mut rng = crate::rng::rng_for(8, 0);
+        let mut lanes = vec![([0.0, 3.0, 1e-300, 5.0], [0.0, 4.0, 2.0, f64::NAN])];
+        for _ in 0..50_000 {
+            let mut pair = || {
+                let scale = 10f64.powf(rng.random_range(-3.0..2.0));
+                (
+                    scale * rng.random_range(-1.0..1.0),
+                    10.0 * rng.random_range(-1.0..1.0),
+                )
+            };
+            let p = [pair(), pair(), pair(), pair()];
+            lanes.push((p.map(|p| p.0), p.map(|p| p.1)));
+        }
+        for (x, y) in lanes {
+            let four = hypot_lanes(x, y);
+            for i in 0..4 {
+                let one = hypot(x[i], y[i]);
+                assert_eq!(
+                    four[i].to_bits(),
+                    one.to_bits(),
+                    "hypot({}, {})",
+                    x[i],
+                    y[i]
+                );
             }
         }
     }

@@ -162,31 +162,72 @@ impl TyreModel {
     #[inline(always)]
     pub fn forces(&self, sx: f64, sy: f64, fmax: f64) -> Forces {
         let u = sx * sx + sy * sy;
-        let (g, dg) = self.ratio(u);
-        let (g, dg) = if self.skid > 0.0 {
-            // g·m and its derivative in u, m = 1 + k·min(√u, cap).
-            let (m, dm) = self.skid_multiplier(u);
-            (g * m, dg * m + g * dm)
-        } else {
-            (g, dg)
-        };
-        let (fg, two_dg_sx) = (fmax * g, fmax * 2.0 * dg * sx);
-        Forces {
-            fx: fg * sx,
-            fy: fg * sy,
-            dfx_dsx: fg + two_dg_sx * sx,
-            dfy_dsx: two_dg_sx * sy,
-        }
+        let ratio = self.skidding(u, self.ratio(u));
+        Forces::of(fmax, ratio, sx, sy)
     }
 
-    /// The skid factor's multiplier m(u) = 1 + k·min(√u, [`SKID_SLIP_CAP`]) and dm/du.
+    /// [`TyreModel::wheel_max_force`] of four tyres side by side, `tyres[i]` under `fz[i]` on
+    /// `surface[i]`, bit for bit: the load sensitivity's tables read in vector registers
+    /// ([`HermiteTable::eval_lanes`]), each lane by the formula past its table.
+    #[inline(always)]
+    pub fn wheel_max_force_lanes(
+        tyres: [&TyreModel; 4],
+        fz: [f64; 4],
+        surface: [f64; 4],
+    ) -> [f64; 4] {
+        let z = std::array::from_fn(|i| fz[i] * tyres[i].inv_operating_load);
+        let load_factor = match HermiteTable::eval_lanes(tyres.map(|t| &t.load_table), z) {
+            Some((l, _)) => l,
+            None => std::array::from_fn(|i| tyres[i].load_factor(fz[i])),
+        };
+        std::array::from_fn(|i| fz[i] * tyres[i].mu * surface[i] * load_factor[i])
+    }
+
+    /// [`TyreModel::forces`] of four tyres side by side, `tyres[i]` at slip (`sx[i]`, `sy[i]`)
+    /// under `fmax[i]`, bit for bit: the shape's tables read in vector registers
+    /// ([`HermiteTable::eval_lanes`]), each lane by the formula past its table.
+    #[inline(always)]
+    pub fn forces_lanes(
+        tyres: [&TyreModel; 4],
+        sx: [f64; 4],
+        sy: [f64; 4],
+        fmax: [f64; 4],
+    ) -> [Forces; 4] {
+        let u: [f64; 4] = std::array::from_fn(|i| sx[i] * sx[i] + sy[i] * sy[i]);
+        let (g, dg) = match HermiteTable::eval_lanes(tyres.map(|t| &t.ratio_table), u) {
+            Some(table) => table,
+            None => {
+                let exact: [(f64, f64); 4] = std::array::from_fn(|i| tyres[i].ratio(u[i]));
+                (exact.map(|r| r.0), exact.map(|r| r.1))
+            }
+        };
+        std::array::from_fn(|i| {
+            let ratio = tyres[i].skidding(u[i], (g[i], dg[i]));
+            Forces::of(fmax[i], ratio, sx[i], sy[i])
+        })
+    }
+
+    /// The ratio (g, g′) at u times the skid factor's multiplier m(u) with a skid factor
+    /// ([`TyreModel::skid_multiplier`]): (g·m, g′·m + g·m′); as it is without one. Both are
+    /// computed and one kept, so that four wheels' evaluate in vector registers.
+    #[inline(always)]
+    fn skidding(&self, u: f64, (g, dg): (f64, f64)) -> (f64, f64) {
+        let (m, dm) = self.skid_multiplier(u);
+        let skidding = (g * m, dg * m + g * dm);
+        if self.skid > 0.0 { skidding } else { (g, dg) }
+    }
+
+    /// The skid factor's multiplier m(u) = 1 + k·min(√u, [`SKID_SLIP_CAP`]) and dm/du: each
+    /// case computed and the one for √u kept, without branches.
     #[inline(always)]
     pub fn skid_multiplier(&self, u: f64) -> (f64, f64) {
         let s = u.sqrt();
+        let capped = (1.0 + self.skid * SKID_SLIP_CAP, 0.0);
+        let rising = (1.0 + self.skid * s, 0.5 * self.skid / s);
         if s >= SKID_SLIP_CAP {
-            (1.0 + self.skid * SKID_SLIP_CAP, 0.0)
+            capped
         } else if s > 0.0 {
-            (1.0 + self.skid * s, 0.5 * self.skid / s)
+            rising
         } else {
             (1.0, 0.0)
         }
@@ -208,7 +249,7 @@ impl TyreModel {
 }
 
 /// Tyre forces (N) and their sensitivity to longitudinal slip.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Forces {
     /// Longitudinal force, along the wheel.
     pub fx: f64,
@@ -218,6 +259,21 @@ pub struct Forces {
     pub dfx_dsx: f64,
     /// ∂F_y/∂sₓ.
     pub dfy_dsx: f64,
+}
+
+impl Forces {
+    /// The forces at slip (sₓ, s_y) under the budget `fmax` with the shape's ratio (g, g′)
+    /// at u = sₓ² + s_y² ([`TyreModel::forces`]).
+    #[inline(always)]
+    fn of(fmax: f64, (g, dg): (f64, f64), sx: f64, sy: f64) -> Forces {
+        let (fg, two_dg_sx) = (fmax * g, fmax * 2.0 * dg * sx);
+        Forces {
+            fx: fg * sx,
+            fy: fg * sy,
+            dfx_dsx: fg + two_dg_sx * sx,
+            dfy_dsx: two_dg_sx * sy,
+        }
+    }
 }
 
 #[cfg(test)]
@@ -308,6 +364,42 @@ mod tests {
             "{}",
             torcs.force_cap
         );
+    }
+
+    /// The lanes of [`TyreModel::forces_lanes`] and [`TyreModel::wheel_max_force_lanes`] give
+    /// each tyre's own forces and budget bit for bit, inside the tables and past them.
+    #[test]
+    fn four_tyres_side_by_side_are_four_tyres() {
+        use rand::Rng;
+        let skidding = Tyre {
+            skid: 0.3,
+            ..Car::spirit_300().rear_tyre
+        };
+        let models = [
+            TyreModel::new(&Car::spirit_300().front_tyre),
+            TyreModel::new(&Car::spirit_300().rear_tyre),
+            TyreModel::new(&skidding),
+        ];
+        let mut rng = crate::rng::rng_for(9, 0);
+        for n in 0..40_000 {
+            let tyres: [&TyreModel; 4] = std::array::from_fn(|_| &models[rng.random_range(0..3)]);
+            // Slips past the table's end (s = 1) and loads past 8 operating loads in some.
+            let reach = if n % 10 == 0 { 2.0 } else { 0.6 };
+            let sx: [f64; 4] = std::array::from_fn(|_| rng.random_range(-reach..reach));
+            let sy: [f64; 4] = std::array::from_fn(|_| rng.random_range(-reach..reach));
+            let top = if n % 10 == 1 { 40_000.0 } else { 8000.0 };
+            let fz: [f64; 4] = std::array::from_fn(|_| rng.random_range(0.0..top));
+            let surface: [f64; 4] = std::array::from_fn(|_| rng.random_range(0.3..1.2));
+            let fmax = TyreModel::wheel_max_force_lanes(tyres, fz, surface);
+            let forces = TyreModel::forces_lanes(tyres, sx, sy, fmax);
+            for i in 0..4 {
+                let one = tyres[i].wheel_max_force(fz[i], surface[i]);
+                assert_eq!(fmax[i].to_bits(), one.to_bits(), "{} N", fz[i]);
+                let one = tyres[i].forces(sx[i], sy[i], fmax[i]);
+                let bits = |f: Forces| [f.fx, f.fy, f.dfx_dsx, f.dfy_dsx].map(f64::to_bits);
+                assert_eq!(bits(forces[i]), bits(one), "({}, {})", sx[i], sy[i]);
+            }
+        }
     }
 
     #[test]
