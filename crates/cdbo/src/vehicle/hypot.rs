@@ -13,6 +13,8 @@
 //! simulator called before; other arguments go to [`f64::hypot`]. Inlined, the step saves the
 //! call and the spilling of every live register around it.
 
+use super::lanes::{F64x4, Lane};
+
 /// 2⁵¹¹: above it, squaring could overflow.
 const LARGE: f64 = f64::from_bits(0x5fe0_0000_0000_0000);
 /// 2⁻⁴⁵⁹: below it, squaring could lose precision.
@@ -30,57 +32,57 @@ pub(crate) fn hypot(x: f64, y: f64) -> f64 {
     corrected(big, small)
 }
 
-/// [`hypot`] of four pairs side by side, `hypot(x[i], y[i])` bit for bit: written lane by lane
-/// without branches (both of Borges' corrections computed, the one the lane's case takes
-/// kept), so that the compiler evaluates the four in vector registers; unless every lane is
-/// within the algorithm's arguments, each goes to [`hypot`].
+/// [`hypot`] of four pairs side by side, `hypot(x[i], y[i])` bit for bit, in vector registers
+/// ([`F64x4`]); unless every lane is within the algorithm's arguments, each goes to [`hypot`].
 #[inline(always)]
-pub(crate) fn hypot_lanes(x: [f64; 4], y: [f64; 4]) -> [f64; 4] {
-    let mut big = [0.0; 4];
-    let mut small = [0.0; 4];
-    for i in 0..4 {
-        (big[i], small[i]) = ordered(x[i], y[i]);
+pub(crate) fn hypot_lanes(x: F64x4, y: F64x4) -> F64x4 {
+    let (big, small) = ordered(x, y);
+    if !within(big, small).all() {
+        return F64x4(std::array::from_fn(|i| hypot(x.0[i], y.0[i])));
     }
-    if !(0..4).fold(true, |all, i| all & within(big[i], small[i])) {
-        return std::array::from_fn(|i| hypot(x[i], y[i]));
-    }
-    std::array::from_fn(|i| corrected(big[i], small[i]))
+    corrected(big, small)
 }
 
 /// (x_max, y_min) = (max(|x|, |y|), min(|x|, |y|)).
 #[inline(always)]
-fn ordered(x: f64, y: f64) -> (f64, f64) {
+fn ordered<T: Lane>(x: T, y: T) -> (T, T) {
     let (x, y) = (x.abs(), y.abs());
-    if x < y { (y, x) } else { (x, y) }
+    let swap = x.lt(y);
+    (T::select(swap, y, x), T::select(swap, x, y))
 }
 
 /// Whether the module's algorithm takes (x_max, y_min): false on a NaN or an infinity too.
 #[inline(always)]
-fn within(big: f64, small: f64) -> bool {
-    (big <= LARGE) & (small >= TINY) & (small > big * EPS)
+fn within<T: Lane>(big: T, small: T) -> T::Mask {
+    big.le(T::splat(LARGE)) & small.ge(T::splat(TINY)) & small.gt(big * T::splat(EPS))
 }
 
 /// h = √(x_max² + y_min²) corrected once for the rounding of the squares (the module's
 /// formulas): both cases' terms are computed and the one for h ≤ 2·y_min or not kept.
 #[inline(always)]
-fn corrected(big: f64, small: f64) -> f64 {
+fn corrected<T: Lane>(big: T, small: T) -> T {
+    let (two, four) = (T::splat(2.0), T::splat(4.0));
     let h = (big * big + small * small).sqrt();
     let near = {
         let delta = h - small;
         (
-            big * (2.0 * delta - big),
-            (delta - 2.0 * (big - small)) * delta,
+            big * (two * delta - big),
+            (delta - two * (big - small)) * delta,
         )
     };
     let far = {
         let delta = h - big;
         (
-            2.0 * delta * (big - 2.0 * small),
-            (4.0 * delta - small) * small + delta * delta,
+            two * delta * (big - two * small),
+            (four * delta - small) * small + delta * delta,
         )
     };
-    let (t1, t2) = if h <= 2.0 * small { near } else { far };
-    h - (t1 + t2) / (2.0 * h)
+    let is_near = h.le(two * small);
+    let (t1, t2) = (
+        T::select(is_near, near.0, far.0),
+        T::select(is_near, near.1, far.1),
+    );
+    h - (t1 + t2) / (two * h)
 }
 
 #[cfg(test)]
@@ -149,7 +151,7 @@ mod tests {
             lanes.push((p.map(|p| p.0), p.map(|p| p.1)));
         }
         for (x, y) in lanes {
-            let four = hypot_lanes(x, y);
+            let four = hypot_lanes(F64x4(x), F64x4(y)).0;
             for i in 0..4 {
                 let one = hypot(x[i], y[i]);
                 assert_eq!(

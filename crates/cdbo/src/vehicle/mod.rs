@@ -528,6 +528,7 @@ pub mod barrier;
 pub mod bounce;
 mod ground;
 mod hypot;
+mod lanes;
 pub mod powertrain;
 mod step;
 pub mod table;

@@ -3,6 +3,7 @@
 
 use super::bounce;
 use super::hypot::hypot_lanes;
+use super::lanes::{F64x4, Lane};
 use super::tyre::{Forces, TyreModel};
 use super::{Controls, GAME_STEP, SLIP_SPEED_FLOOR, State, Vehicle, rear_omega};
 use crate::car::{DiffKind, G};
@@ -26,25 +27,19 @@ impl Vehicle {
             &self.tyres[1],
             &self.tyres[1],
         ];
-        let fmax = TyreModel::wheel_max_force_lanes(tyres, w.loads, w.friction);
-        let inv: [f64; 4] = std::array::from_fn(|i| 1.0 / w.vt[i].abs().max(SLIP_SPEED_FLOOR));
-        let speed = hypot_lanes(w.vt, w.vl);
+        let (vt, vl, floor) = (F64x4(w.vt), F64x4(w.vl), F64x4::splat(SLIP_SPEED_FLOOR));
+        let fmax = TyreModel::wheel_max_force_lanes(tyres, F64x4(w.loads), F64x4(w.friction));
+        let inv = F64x4::splat(1.0) / vt.abs().max(floor);
+        let speed = hypot_lanes(vt, vl).max(floor);
         // The front wheels divide −v_l by the speed, the rear ones multiply it by the
-        // speed's reciprocal: q = n/max(|v|, v₀) with n = −v_l or 1, then s_y = q or −v_l·q.
-        let front = [true, true, false, false];
-        let sy: [f64; 4] = std::array::from_fn(|i| {
-            let (num, factor) = if front[i] {
-                (-w.vl[i], 1.0)
-            } else {
-                (1.0, -w.vl[i])
-            };
-            num / speed[i].max(SLIP_SPEED_FLOOR) * factor
-        });
-        let sx: [f64; 4] = std::array::from_fn(|i| (w.spin[i] - w.vt[i]) * inv[i]);
+        // speed's reciprocal: q = n/max(|v|, v₀) with n = −v_l or 1, then s_y = q·1 or q·(−v_l).
+        let [l, r, rl, rr] = w.vl;
+        let sy = F64x4([-l, -r, 1.0, 1.0]) / speed * F64x4([1.0, 1.0, -rl, -rr]);
+        let sx = (F64x4(w.spin) - vt) * inv;
         WheelTyres {
             forces: TyreModel::forces_lanes(tyres, sx, sy, fmax),
-            fmax,
-            inv,
+            fmax: fmax.0,
+            inv: inv.0,
         }
     }
 

@@ -18,6 +18,7 @@
 //! g is smooth in u, and Fₓ = F_max·g(u)·sₓ, F_y = F_max·g(u)·s_y need neither a square root
 //! nor a division.
 
+use super::lanes::{F64x4, Lane};
 use super::table::HermiteTable;
 use crate::car::Tyre;
 
@@ -162,75 +163,64 @@ impl TyreModel {
     #[inline(always)]
     pub fn forces(&self, sx: f64, sy: f64, fmax: f64) -> Forces {
         let u = sx * sx + sy * sy;
-        let ratio = self.skidding(u, self.ratio(u));
-        Forces::of(fmax, ratio, sx, sy)
+        let [fx, fy, dfx_dsx, dfy_dsx] = forces_of(fmax, self.ratio(u), u, (sx, sy), self.skid);
+        Forces {
+            fx,
+            fy,
+            dfx_dsx,
+            dfy_dsx,
+        }
     }
 
     /// [`TyreModel::wheel_max_force`] of four tyres side by side, `tyres[i]` under `fz[i]` on
-    /// `surface[i]`, bit for bit: the load sensitivity's tables read in vector registers
-    /// ([`HermiteTable::eval_lanes`]), each lane by the formula past its table.
+    /// `surface[i]`, bit for bit, in vector registers ([`F64x4`]); each lane by the formula
+    /// past its table.
     #[inline(always)]
-    pub fn wheel_max_force_lanes(
+    pub(crate) fn wheel_max_force_lanes(
         tyres: [&TyreModel; 4],
-        fz: [f64; 4],
-        surface: [f64; 4],
-    ) -> [f64; 4] {
-        let z = std::array::from_fn(|i| fz[i] * tyres[i].inv_operating_load);
+        fz: F64x4,
+        surface: F64x4,
+    ) -> F64x4 {
+        let z = fz * F64x4(tyres.map(|t| t.inv_operating_load));
         let load_factor = match HermiteTable::eval_lanes(tyres.map(|t| &t.load_table), z) {
             Some((l, _)) => l,
-            None => std::array::from_fn(|i| tyres[i].load_factor(fz[i])),
+            None => F64x4(std::array::from_fn(|i| tyres[i].load_factor(fz.0[i]))),
         };
-        std::array::from_fn(|i| fz[i] * tyres[i].mu * surface[i] * load_factor[i])
+        fz * F64x4(tyres.map(|t| t.mu)) * surface * load_factor
     }
 
     /// [`TyreModel::forces`] of four tyres side by side, `tyres[i]` at slip (`sx[i]`, `sy[i]`)
-    /// under `fmax[i]`, bit for bit: the shape's tables read in vector registers
-    /// ([`HermiteTable::eval_lanes`]), each lane by the formula past its table.
+    /// under `fmax[i]`, bit for bit, in vector registers ([`F64x4`]); each lane by the formula
+    /// past its table.
     #[inline(always)]
-    pub fn forces_lanes(
+    pub(crate) fn forces_lanes(
         tyres: [&TyreModel; 4],
-        sx: [f64; 4],
-        sy: [f64; 4],
-        fmax: [f64; 4],
+        sx: F64x4,
+        sy: F64x4,
+        fmax: F64x4,
     ) -> [Forces; 4] {
-        let u: [f64; 4] = std::array::from_fn(|i| sx[i] * sx[i] + sy[i] * sy[i]);
-        let (g, dg) = match HermiteTable::eval_lanes(tyres.map(|t| &t.ratio_table), u) {
+        let u = sx * sx + sy * sy;
+        let ratio = match HermiteTable::eval_lanes(tyres.map(|t| &t.ratio_table), u) {
             Some(table) => table,
             None => {
-                let exact: [(f64, f64); 4] = std::array::from_fn(|i| tyres[i].ratio(u[i]));
-                (exact.map(|r| r.0), exact.map(|r| r.1))
+                let exact: [(f64, f64); 4] = std::array::from_fn(|i| tyres[i].ratio(u.0[i]));
+                (F64x4(exact.map(|r| r.0)), F64x4(exact.map(|r| r.1)))
             }
         };
-        std::array::from_fn(|i| {
-            let ratio = tyres[i].skidding(u[i], (g[i], dg[i]));
-            Forces::of(fmax[i], ratio, sx[i], sy[i])
+        let skid = F64x4(tyres.map(|t| t.skid));
+        let [fx, fy, dfx_dsx, dfy_dsx] = forces_of(fmax, ratio, u, (sx, sy), skid);
+        std::array::from_fn(|i| Forces {
+            fx: fx.0[i],
+            fy: fy.0[i],
+            dfx_dsx: dfx_dsx.0[i],
+            dfy_dsx: dfy_dsx.0[i],
         })
     }
 
-    /// The ratio (g, g′) at u times the skid factor's multiplier m(u) with a skid factor
-    /// ([`TyreModel::skid_multiplier`]): (g·m, g′·m + g·m′); as it is without one. Both are
-    /// computed and one kept, so that four wheels' evaluate in vector registers.
-    #[inline(always)]
-    fn skidding(&self, u: f64, (g, dg): (f64, f64)) -> (f64, f64) {
-        let (m, dm) = self.skid_multiplier(u);
-        let skidding = (g * m, dg * m + g * dm);
-        if self.skid > 0.0 { skidding } else { (g, dg) }
-    }
-
-    /// The skid factor's multiplier m(u) = 1 + k·min(√u, [`SKID_SLIP_CAP`]) and dm/du: each
-    /// case computed and the one for √u kept, without branches.
+    /// The skid factor's multiplier m(u) = 1 + k·min(√u, [`SKID_SLIP_CAP`]) and dm/du.
     #[inline(always)]
     pub fn skid_multiplier(&self, u: f64) -> (f64, f64) {
-        let s = u.sqrt();
-        let capped = (1.0 + self.skid * SKID_SLIP_CAP, 0.0);
-        let rising = (1.0 + self.skid * s, 0.5 * self.skid / s);
-        if s >= SKID_SLIP_CAP {
-            capped
-        } else if s > 0.0 {
-            rising
-        } else {
-            (1.0, 0.0)
-        }
+        skid_multiplier(u, self.skid)
     }
 
     fn find_peak_slip(&self) -> f64 {
@@ -249,7 +239,7 @@ impl TyreModel {
 }
 
 /// Tyre forces (N) and their sensitivity to longitudinal slip.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Forces {
     /// Longitudinal force, along the wheel.
     pub fx: f64,
@@ -261,19 +251,35 @@ pub struct Forces {
     pub dfy_dsx: f64,
 }
 
-impl Forces {
-    /// The forces at slip (sₓ, s_y) under the budget `fmax` with the shape's ratio (g, g′)
-    /// at u = sₓ² + s_y² ([`TyreModel::forces`]).
-    #[inline(always)]
-    fn of(fmax: f64, (g, dg): (f64, f64), sx: f64, sy: f64) -> Forces {
-        let (fg, two_dg_sx) = (fmax * g, fmax * 2.0 * dg * sx);
-        Forces {
-            fx: fg * sx,
-            fy: fg * sy,
-            dfx_dsx: fg + two_dg_sx * sx,
-            dfy_dsx: two_dg_sx * sy,
-        }
-    }
+/// [Fₓ, F_y, ∂Fₓ/∂sₓ, ∂F_y/∂sₓ] ([`TyreModel::forces`]) at slip (sₓ, s_y) = `slip`, u = sₓ² + s_y²,
+/// under the budget `fmax`, with the shape's ratio (g, g′) at u and the skid factor k = `skid`
+/// (none at 0): with one, g·m and g′·m + g·m′ for its multiplier m(u)
+/// ([`TyreModel::skid_multiplier`]). Both are computed and one kept, without branches.
+#[inline(always)]
+fn forces_of<T: Lane>(fmax: T, (g, dg): (T, T), u: T, (sx, sy): (T, T), skid: T) -> [T; 4] {
+    let (m, dm) = skid_multiplier(u, skid);
+    let skidding = skid.gt(T::splat(0.0));
+    let g_skid = g * m;
+    let dg = T::select(skidding, dg * m + g * dm, dg);
+    let g = T::select(skidding, g_skid, g);
+    let (fg, two_dg_sx) = (fmax * g, fmax * T::splat(2.0) * dg * sx);
+    [fg * sx, fg * sy, fg + two_dg_sx * sx, two_dg_sx * sy]
+}
+
+/// The skid factor k's multiplier m(u) = 1 + k·min(√u, [`SKID_SLIP_CAP`]) and dm/du = k/(2√u)
+/// below the cap (0 at u = 0 and past the cap): each case computed and the one for √u kept,
+/// without branches.
+#[inline(always)]
+fn skid_multiplier<T: Lane>(u: T, skid: T) -> (T, T) {
+    let (zero, one, cap) = (T::splat(0.0), T::splat(1.0), T::splat(SKID_SLIP_CAP));
+    let s = u.sqrt();
+    let (capped, rising) = (s.ge(cap), s.gt(zero));
+    let m = T::select(rising, one + skid * s, one);
+    let dm = T::select(rising, T::splat(0.5) * skid / s, zero);
+    (
+        T::select(capped, one + skid * cap, m),
+        T::select(capped, zero, dm),
+    )
 }
 
 #[cfg(test)]
@@ -390,8 +396,8 @@ mod tests {
             let top = if n % 10 == 1 { 40_000.0 } else { 8000.0 };
             let fz: [f64; 4] = std::array::from_fn(|_| rng.random_range(0.0..top));
             let surface: [f64; 4] = std::array::from_fn(|_| rng.random_range(0.3..1.2));
-            let fmax = TyreModel::wheel_max_force_lanes(tyres, fz, surface);
-            let forces = TyreModel::forces_lanes(tyres, sx, sy, fmax);
+            let fmax = TyreModel::wheel_max_force_lanes(tyres, F64x4(fz), F64x4(surface)).0;
+            let forces = TyreModel::forces_lanes(tyres, F64x4(sx), F64x4(sy), F64x4(fmax));
             for i in 0..4 {
                 let one = tyres[i].wheel_max_force(fz[i], surface[i]);
                 assert_eq!(fmax[i].to_bits(), one.to_bits(), "{} N", fz[i]);
