@@ -10,7 +10,7 @@ use cdbo::drive::{ConstantPedal, Observation, Pedal};
 use cdbo::limit::limit_lap;
 use cdbo::sim::{FailureReason, Simulator};
 use cdbo::track::{Piece, Track};
-use cdbo::vehicle::{Controls, Vehicle};
+use cdbo::vehicle::Vehicle;
 use common::{builtin, shared_track};
 
 fn demo(track: Track) -> cdbo::sim::LapResult {
@@ -286,7 +286,7 @@ fn drive_straight(
         vehicle.shift(&mut s, throttle);
         s.gearbox.shifting = 0.0;
     }
-    let c = Controls::new(0.0, throttle, brake);
+    let c = vehicle.controls(0.0, throttle, brake);
     let dt = 0.002;
     for i in 0..(seconds / dt) as usize {
         if i % 10 == 0 {
@@ -338,7 +338,7 @@ fn over_a_sharp_enough_crest_the_tyres_carry_nothing() {
             v0 / car.rear_tyre.radius,
             v0 / car.rear_tyre.radius,
         ];
-        let c = Controls::new(0.0, 0.0, 1.0);
+        let c = vehicle.controls(0.0, 0.0, 1.0);
         for _ in 0..(seconds / dt).round() as usize {
             vehicle.step(&mut s, &c, &frame, dt);
         }
@@ -465,7 +465,7 @@ fn the_robot_pulls_away_on_the_slipping_clutch() {
     let vehicle = Vehicle::new(&car);
     let track = straight(1000.0);
     let frame = *track.frame(0);
-    let full = Controls::new(0.0, 1.0, 0.0);
+    let full = vehicle.controls(0.0, 1.0, 0.0);
     let dt = 0.002;
     let g = car.gears[0] * car.final_drive;
 

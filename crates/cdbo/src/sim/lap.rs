@@ -37,7 +37,7 @@ use crate::geometry::wrap_angle;
 use crate::line::RacingLine;
 use crate::track::{Frame, Track};
 use crate::vehicle::barrier::Body;
-use crate::vehicle::{Controls, State, Vehicle};
+use crate::vehicle::{State, Vehicle};
 
 /// Why a lap failed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
@@ -426,7 +426,7 @@ impl Simulator {
         let start = track.sample(0);
         let mut state: State = self.vehicle.at_rest(start.x, start.y, start.heading);
         let mut steering = cfg.steering.clone();
-        let mut controls = Controls::default();
+        let mut controls = self.vehicle.controls(0.0, 0.0, 0.0);
         let mut proj = track.project(state.x, state.y, 0);
         let (mut distance, mut farthest, mut slow_for) = (0.0, 0.0, 0.0);
         let mut trace = Vec::new();
@@ -475,7 +475,7 @@ impl Simulator {
                 };
                 let steer = steering.update(track, &self.vehicle, &state, &proj, &line, driver_dt);
                 let brake = self.vehicle.driver_brake(&state, (-a).max(0.0));
-                controls = Controls::new(steer, a.max(0.0), brake);
+                controls = self.vehicle.controls(steer, a.max(0.0), brake);
                 self.vehicle.shift(&mut state, controls.throttle());
                 self.vehicle
                     .clutch(&mut state, controls.throttle(), driver_dt);

@@ -36,7 +36,7 @@ use crate::car::Car;
 use crate::error::{Error, Result};
 use crate::sim::log::{LoggedLap, Sample};
 use crate::track::Track;
-use crate::vehicle::{Controls, Vehicle};
+use crate::vehicle::Vehicle;
 
 /// Windows start only where the logged car moves at least this fast (m/s).
 pub const MIN_SPEED: f64 = 5.0;
@@ -275,7 +275,7 @@ pub fn replay(
         for k in i..end {
             let q = &samples[k];
             let brake = vehicle.driver_brake(&state, (-q.pedal).max(0.0));
-            let controls = Controls::new(steers[k], q.pedal.max(0.0), brake);
+            let controls = vehicle.controls(steers[k], q.pedal.max(0.0), brake);
             match gear_index(q) {
                 // A logged change of gear starts a shift, as cdbo's gearbox does.
                 Some(g) => {

@@ -249,7 +249,7 @@ impl Track {
     ///
     /// Walks sample to sample while the point's tangential offset d = (p − cᵢ)·tᵢ lies outside
     /// [−ds/2, ds/2]; O(1) when called every physics step with the previous index.
-    #[inline]
+    #[inline(always)]
     pub fn project(&self, x: f64, y: f64, hint: usize) -> Projection {
         let n = self.samples.len();
         let mut i = if hint < n { hint } else { hint % n };

@@ -142,9 +142,15 @@ impl Vehicle {
     ) -> [(f64, f64); 4] {
         let (se, ce) = f.relative_heading(s.yaw_sin_cos);
         let [yf, yr] = self.car.axles.half_track;
-        [(self.a, yf), (self.a, -yf), (-self.b, yr), (-self.b, -yr)].map(|(xw, yw)| {
+        let place = |xw: f64, yw: f64| {
             let a = along + xw * ce - yw * se;
             (a, lateral + xw * se + yw * ce - 0.5 * f.curvature * a * a)
-        })
+        };
+        [
+            place(self.a, yf),
+            place(self.a, -yf),
+            place(-self.b, yr),
+            place(-self.b, -yr),
+        ]
     }
 }

@@ -76,28 +76,18 @@ pub const SLIP_SPEED_FLOOR: f64 = 2.0;
 /// fully at twice it.
 const AID_SLIP_RATIO: f64 = 0.5;
 
-/// The driver's commands, held between driver updates.
+/// The driver's commands, held between driver updates ([`Vehicle::controls`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Controls {
     steer: f64,
     throttle: f64,
     brake: f64,
-    /// (sin, cos) of the steering angle, computed once per driver step.
-    steer_sin_cos: (f64, f64),
+    /// (sin, cos) of the front wheels' steering angles, left and right: the inner wheel's δ,
+    /// the outer one's Ackermann angle ([`Vehicle::controls`]), computed once per driver step.
+    wheel_angles: [(f64, f64); 2],
 }
 
 impl Controls {
-    /// Commands for a road-wheel steering angle (rad, positive left), a throttle and a brake
-    /// pedal in [0, 1].
-    pub fn new(steer: f64, throttle: f64, brake: f64) -> Controls {
-        Controls {
-            steer,
-            throttle,
-            brake,
-            steer_sin_cos: steer.sin_cos(),
-        }
-    }
-
     /// Steering angle (rad).
     pub fn steer(&self) -> f64 {
         self.steer
@@ -111,12 +101,6 @@ impl Controls {
     /// Brake pedal in [0, 1].
     pub fn brake(&self) -> f64 {
         self.brake
-    }
-}
-
-impl Default for Controls {
-    fn default() -> Self {
-        Controls::new(0.0, 0.0, 0.0)
     }
 }
 
@@ -292,6 +276,30 @@ impl Vehicle {
         let w = x - i as f64;
         let (a, b) = (table[i], table[i + 1]);
         [a[0] + w * (b[0] - a[0]), a[1] + w * (b[1] - a[1])]
+    }
+
+    /// The driver's commands for a road-wheel steering angle δ (rad, positive left), a
+    /// throttle and a brake pedal in [0, 1], held between driver updates, with the front
+    /// wheels' angles: the inner wheel turned by δ, the outer by simuv2's Ackermann angle
+    /// (`steer.cpp`), tan δ_o = L·tan|δ|/(L + T·tan|δ|), T = y_f + y_r; the left wheel is the
+    /// inner one in a left-hand turn (δ > 0).
+    pub fn controls(&self, steer: f64, throttle: f64, brake: f64) -> Controls {
+        let (sin_d, cos_d) = steer.sin_cos();
+        let tan_d = (sin_d / cos_d).abs();
+        let (l, [y_f, y_r]) = (self.car.wheelbase, self.car.axles.half_track);
+        let tan_o = l * tan_d / (l + (y_f + y_r) * tan_d);
+        let cos_o = 1.0 / (1.0 + tan_o * tan_o).sqrt();
+        let outer = ((tan_o * cos_o).copysign(sin_d), cos_o);
+        Controls {
+            steer,
+            throttle,
+            brake,
+            wheel_angles: if sin_d >= 0.0 {
+                [(sin_d, cos_d), outer]
+            } else {
+                [outer, (sin_d, cos_d)]
+            },
+        }
     }
 
     /// The tyre models of the front and rear axles.
@@ -519,6 +527,8 @@ pub mod aids;
 pub mod barrier;
 pub mod bounce;
 mod ground;
+mod hypot;
+mod lanes;
 pub mod powertrain;
 mod step;
 pub mod table;

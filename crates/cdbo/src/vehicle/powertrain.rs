@@ -124,7 +124,7 @@ impl EngineMap {
     }
 
     /// Full-throttle torque at engine speed ω (N·m), 0 at and above the rev limiter.
-    #[inline]
+    #[inline(always)]
     pub fn torque(&self, omega: f64) -> f64 {
         if !(omega >= 0.0 && omega < self.rev_limiter) {
             return if omega < 0.0 { self.curve[0].1 } else { 0.0 };

@@ -2,6 +2,9 @@
 //! formulas in [`super`]).
 
 use super::bounce;
+use super::hypot::hypot_lanes;
+use super::lanes::{F64x4, Lane};
+use super::tyre::{Forces, TyreModel};
 use super::{Controls, GAME_STEP, SLIP_SPEED_FLOOR, State, Vehicle, rear_omega};
 use crate::car::{DiffKind, G};
 use crate::track::{Bumps, Frame};
@@ -9,6 +12,35 @@ use crate::track::{Bumps, Frame};
 impl Vehicle {
     pub(super) fn driven_omega(&self, s: &State) -> f64 {
         self.driven[0] * s.omega[0] + self.driven[1] * rear_omega(s)
+    }
+
+    /// Each wheel's tyre at a step, front left, front right, rear left, rear right, the four
+    /// side by side in vector registers: its budget F_max = F_z·μ·μ_r·λ(F_z) under its load
+    /// on ground of its friction, its slips sₓ = (ωR − v_t)/max(|v_t|, v₀) and
+    /// s_y = −v_l/max(|v|, v₀), |v| = √(v_t² + v_l²) (a rear wheel's as −v_l·(1/max(|v|, v₀))),
+    /// its tyre's forces there, and 1/max(|v_t|, v₀).
+    #[inline(always)]
+    fn wheel_tyres(&self, w: &WheelMotion) -> WheelTyres {
+        let tyres = [
+            &self.tyres[0],
+            &self.tyres[0],
+            &self.tyres[1],
+            &self.tyres[1],
+        ];
+        let (vt, vl, floor) = (F64x4(w.vt), F64x4(w.vl), F64x4::splat(SLIP_SPEED_FLOOR));
+        let fmax = TyreModel::wheel_max_force_lanes(tyres, F64x4(w.loads), F64x4(w.friction));
+        let inv = F64x4::splat(1.0) / vt.abs().max(floor);
+        let speed = hypot_lanes(vt, vl).max(floor);
+        // The front wheels divide −v_l by the speed, the rear ones multiply it by the
+        // speed's reciprocal: q = n/max(|v|, v₀) with n = −v_l or 1, then s_y = q·1 or q·(−v_l).
+        let [l, r, rl, rr] = w.vl;
+        let sy = F64x4([-l, -r, 1.0, 1.0]) / speed * F64x4([1.0, 1.0, -rl, -rr]);
+        let sx = (F64x4(w.spin) - vt) * inv;
+        WheelTyres {
+            forces: TyreModel::forces_lanes(tyres, sx, sy, fmax),
+            fmax: fmax.0,
+            inv: inv.0,
+        }
     }
 
     /// Advances the state by `dt` seconds on the road described by `frame`.
@@ -39,7 +71,7 @@ impl Vehicle {
         let ground = self.wheel_ground(s, frame);
         let mut friction = match &ground {
             None => [frame.friction; 4],
-            Some(w) => w.map(|g| g.friction),
+            Some(w) => [w[0].friction, w[1].friction, w[2].friction, w[3].friction],
         };
         // The wheels' bounce over rough ground and the road's kinks takes some of their grip.
         if let Some(corners) = &self.corners {
@@ -67,13 +99,6 @@ impl Vehicle {
         let turn = self.car.axles.half_track[1] * s.yaw_rate;
         let vt_rear = [s.vx - turn, s.vx + turn];
         let vl_rear = s.vy - self.b * s.yaw_rate;
-        // 1 / max(|v_t|, v₀), the longitudinal slip's denominator, and 1 / max(|v|, v₀), the
-        // lateral slip's (s_y = sin of the slip angle), per wheel.
-        let inv_rear = [
-            1.0 / vt_rear[0].abs().max(SLIP_SPEED_FLOOR),
-            1.0 / vt_rear[1].abs().max(SLIP_SPEED_FLOOR),
-        ];
-        let inv_speed_rear = vt_rear.map(|vt| 1.0 / vt.hypot(vl_rear).max(SLIP_SPEED_FLOOR));
         // An axle as the robot reads it: its wheels' mean spin against vₓ.
         let inv_axle = 1.0 / s.vx.abs().max(SLIP_SPEED_FLOOR);
 
@@ -127,35 +152,34 @@ impl Vehicle {
         };
         s.gearbox.shifting = (s.gearbox.shifting - dt).max(0.0);
 
-        // The front wheels: one spin for both, each steered, loaded and gripping on its own;
-        // the inner wheel turned by δ, the outer by simuv2's Ackermann angle (`steer.cpp`),
-        // tan δ_o = L·tan|δ|/(L + T·tan|δ|), T = y_f + y_r.
-        let (sin_d, cos_d) = c.steer_sin_cos;
-        let tan_d = (sin_d / cos_d).abs();
-        let (l, [y_f, y_r]) = (self.car.wheelbase, self.car.axles.half_track);
-        let tan_o = l * tan_d / (l + (y_f + y_r) * tan_d);
-        let cos_o = 1.0 / (1.0 + tan_o * tan_o).sqrt();
-        let outer = ((tan_o * cos_o).copysign(sin_d), cos_o);
-        // Left first: the left wheel is the inner one in a left-hand turn (δ > 0).
-        let angles = if sin_d >= 0.0 {
-            [(sin_d, cos_d), outer]
-        } else {
-            [outer, (sin_d, cos_d)]
-        };
+        // The rear wheels' spins as the differential holds them, and its torque split; then
+        // every wheel's velocity in its own frame (a front wheel's turned by its steering
+        // angle, [`Vehicle::controls`]) and its tyre's forces.
+        let rear_drive = self.driven[1] * drive_torque;
+        let diff = self.differential(s, rear_drive);
+        let angles = c.wheel_angles;
+        let turned =
+            |(sn, cs): (f64, f64)| (s.vx * cs + front_lat * sn, -s.vx * sn + front_lat * cs);
+        let (left, right) = (turned(angles[0]), turned(angles[1]));
+        let (front_spin, rear_radius) = (s.omega[0] * self.radius[0], self.radius[1]);
+        let tyres = self.wheel_tyres(&WheelMotion {
+            loads: [front_loads[0], front_loads[1], rear_loads[0], rear_loads[1]],
+            friction,
+            vt: [left.0, right.0, vt_rear[0], vt_rear[1]],
+            vl: [left.1, right.1, vl_rear, vl_rear],
+            spin: [
+                front_spin,
+                front_spin,
+                diff.omega[0] * rear_radius,
+                diff.omega[1] * rear_radius,
+            ],
+        });
+
+        // The front wheels: one spin for both, each steered, loaded and gripping on its own.
         let (front_x, front_y, front_moment) = {
             let tyre = &self.tyres[0];
             let r = self.radius[0];
-            let wheel = |i: usize| {
-                let (sn, cs) = angles[i];
-                let vt = s.vx * cs + front_lat * sn;
-                let vl = -s.vx * sn + front_lat * cs;
-                let inv = 1.0 / vt.abs().max(SLIP_SPEED_FLOOR);
-                let fmax = tyre.wheel_max_force(front_loads[i], friction[i]);
-                let sx = (s.omega[0] * r - vt) * inv;
-                let sy = -vl / vt.hypot(vl).max(SLIP_SPEED_FLOOR);
-                (tyre.forces(sx, sy, fmax), fmax, inv)
-            };
-            let wheels = [wheel(0), wheel(1)];
+            let wheels = [0, 1].map(|i| (tyres.forces[i], tyres.fmax[i], tyres.inv[i]));
             // ABS: ease the pressure while the axle slides backwards past the threshold.
             let mut brake = c.brake() * self.max_brake[0];
             let threshold = self.aid_threshold[0];
@@ -205,16 +229,13 @@ impl Vehicle {
         let (fx_rear, fy_rear) = self.rear_wheels(
             s,
             c.brake(),
-            self.driven[1] * drive_torque,
+            &diff,
             &RearWheels {
-                loads: rear_loads,
-                vt: vt_rear,
-                vl: vl_rear,
-                inv_denom: inv_rear,
-                inv_speed: inv_speed_rear,
+                forces: [tyres.forces[2], tyres.forces[3]],
+                fmax: [tyres.fmax[2], tyres.fmax[3]],
+                inv_denom: [tyres.inv[2], tyres.inv[3]],
                 inv_axle,
             },
-            [friction[2], friction[3]],
             dt,
         );
 
@@ -297,57 +318,68 @@ impl Vehicle {
     }
 }
 
-/// The rear wheels' loads and wheel-frame velocities at a step.
+/// What the step gives each wheel's tyre ([`Vehicle::wheel_tyres`]), front left, front right,
+/// rear left, rear right.
+pub(super) struct WheelMotion {
+    /// Normal loads (N).
+    pub(super) loads: [f64; 4],
+    /// The ground's friction under each.
+    pub(super) friction: [f64; 4],
+    /// Velocities along the wheel, v_t (m/s).
+    pub(super) vt: [f64; 4],
+    /// Velocities across the wheel, v_l (m/s).
+    pub(super) vl: [f64; 4],
+    /// Spin speeds ωR (m/s).
+    pub(super) spin: [f64; 4],
+}
+
+/// Each wheel's tyre at a step ([`Vehicle::wheel_tyres`]), front left, front right, rear
+/// left, rear right.
+pub(super) struct WheelTyres {
+    /// Forces at the slips.
+    pub(super) forces: [Forces; 4],
+    /// Grip budgets F_max (N).
+    pub(super) fmax: [f64; 4],
+    /// 1 / max(|v_t|, v₀), the longitudinal slip's denominator.
+    pub(super) inv: [f64; 4],
+}
+
+/// The rear wheels' tyres at a step, left and right.
 pub(super) struct RearWheels {
-    /// Normal loads of the left and right wheels (N).
-    pub(super) loads: [f64; 2],
-    /// Tangential velocities (m/s).
-    pub(super) vt: [f64; 2],
-    /// Lateral velocity, the same for both (m/s).
-    pub(super) vl: f64,
+    /// Forces at the spins the differential holds ([`Differential::omega`]).
+    pub(super) forces: [Forces; 2],
+    /// Grip budgets F_max (N).
+    pub(super) fmax: [f64; 2],
     /// 1 / max(|v_t|, v₀) of each wheel.
     pub(super) inv_denom: [f64; 2],
-    /// 1 / max(|v|, v₀) of each wheel, |v| = √(v_t² + v_l²).
-    pub(super) inv_speed: [f64; 2],
     /// 1 / max(|vₓ|, v₀) of the car.
     pub(super) inv_axle: f64,
 }
 
+/// The rear axle's differential at a step ([`Vehicle::differential`]).
+pub(super) struct Differential {
+    /// The drive torque at the axle (N·m).
+    pub(super) drive: f64,
+    /// The wheels' spins as the differential holds them (rad/s), left and right.
+    pub(super) omega: [f64; 2],
+    /// The drive torque's split between them (N·m).
+    pub(super) split: [f64; 2],
+    /// Whether they turn as one shaft.
+    pub(super) rigid: bool,
+    /// The spider's half h: 1/2 on a driven free or limited-slip axle, else 0.
+    pub(super) spider: f64,
+}
+
 impl Vehicle {
-    /// Steps the rear wheels' spins under the drive torque `drive` at the axle (N·m), the
-    /// brake pedal and their tyres' forces, and returns their forces (Fₓ and Fᵧ of the left
-    /// and right wheels, N), as simuv2's `differential.cpp` drives them:
-    ///
-    /// - **Spool** (and a limited slip past its locking torque, T > T_lock or
-    ///   T < −T_lock,brake): one shaft, 2I·dω/dt = T − Σ R·Fₓ,i − Σ T_b,i, both wheels at
-    ///   their mean spin.
-    /// - **Limited slip** below it: the wheels' speed ratio ρ = |ω₀ − ω₁|/(|ω₀| + |ω₁|) is held
-    ///   to ρ_max = ρ_s·(1 − |T|/T_lock) (ρ_s the `max slip bias`, T_lock of the torque's sign)
-    ///   by moving both spins (ρ − ρ_max)·(|ω₀| + |ω₁|)/2 towards each other, and the torque
-    ///   is split T·(1 ± (ρ − ρ_max))/2, more to the slower wheel under drive; then as free.
-    /// - **Free**: each wheel gets T_i plus simuv2's spider torque, I·dω_i/dt = T_i +
-    ///   (τ_j − τ_i)/2 − τ_i − T_b,i with τ = R·Fₓ the tyre's reaction (T_i = T/2).
-    /// - A rear axle without drive rolls free: I·dω_i/dt = −τ_i − T_b,i.
-    ///
-    /// Integrated implicitly in the spins (each τ linear in its wheel's ω, a 2×2 system),
-    /// stable at the 4 ms step where simuv2 steps explicitly at 2 ms. ABS eases both brakes
-    /// on the axle's mean slip (ω̄R − vₓ)/max(|vₓ|, v₀), except on a car the TORCS robot
-    /// drives, whose brake the driver has eased already ([`Vehicle::driver_brake`]).
-    pub(super) fn rear_wheels(
-        &self,
-        s: &mut State,
-        brake_pedal: f64,
-        drive: f64,
-        w: &RearWheels,
-        friction: [f64; 2],
-        dt: f64,
-    ) -> ([f64; 2], [f64; 2]) {
-        let tyre = &self.tyres[1];
-        let r = self.radius[1];
-        let inertia = self.wheel_inertia[1];
+    /// The rear wheels' spins and the drive torque `drive` at the axle (N·m) as simuv2's
+    /// `differential.cpp` holds them before their tyres act ([`Vehicle::rear_wheels`]):
+    /// through a spool (and a limited slip past its locking torque) both at their mean spin;
+    /// through a limited slip below it the speed ratio ρ = |ω₀ − ω₁|/(|ω₀| + |ω₁|) held to
+    /// ρ_max = ρ_s·(1 − |T|/T_lock), both spins moved (ρ − ρ_max)·(|ω₀| + |ω₁|)/2 towards
+    /// each other and the torque split T·(1 ± (ρ − ρ_max))/2; else as they are, T/2 each.
+    pub(super) fn differential(&self, s: &State, drive: f64) -> Differential {
         let diff = &self.car.differential;
         let mut omega = [s.omega[1], s.omega[2]];
-        // The differential's mode, its torque split and its speed constraint.
         let driven = self.driven[1] > 0.0;
         let rigid = driven
             && match diff.kind {
@@ -386,6 +418,46 @@ impl Vehicle {
                 }
             }
         }
+        Differential {
+            drive,
+            omega,
+            split,
+            rigid,
+            spider,
+        }
+    }
+
+    /// Steps the rear wheels' spins, held by the differential `diff` ([`Vehicle::differential`]),
+    /// under the brake pedal and their tyres' forces `w` at those spins, and returns their
+    /// forces (Fₓ and Fᵧ of the left and right wheels, N), as simuv2's `differential.cpp`
+    /// drives them:
+    ///
+    /// - **Spool** (and a limited slip past its locking torque, T > T_lock or
+    ///   T < −T_lock,brake): one shaft, 2I·dω/dt = T − Σ R·Fₓ,i − Σ T_b,i, both wheels at
+    ///   their mean spin.
+    /// - **Limited slip** below it: the speeds held and the torque split by the differential,
+    ///   then as free.
+    /// - **Free**: each wheel gets T_i plus simuv2's spider torque, I·dω_i/dt = T_i +
+    ///   (τ_j − τ_i)/2 − τ_i − T_b,i with τ = R·Fₓ the tyre's reaction (T_i = T/2).
+    /// - A rear axle without drive rolls free: I·dω_i/dt = −τ_i − T_b,i.
+    ///
+    /// Integrated implicitly in the spins (each τ linear in its wheel's ω, a 2×2 system),
+    /// stable at the 4 ms step where simuv2 steps explicitly at 2 ms. ABS eases both brakes
+    /// on the axle's mean slip (ω̄R − vₓ)/max(|vₓ|, v₀), except on a car the TORCS robot
+    /// drives, whose brake the driver has eased already ([`Vehicle::driver_brake`]).
+    #[inline(always)]
+    pub(super) fn rear_wheels(
+        &self,
+        s: &mut State,
+        brake_pedal: f64,
+        diff: &Differential,
+        w: &RearWheels,
+        dt: f64,
+    ) -> ([f64; 2], [f64; 2]) {
+        let tyre = &self.tyres[1];
+        let r = self.radius[1];
+        let inertia = self.wheel_inertia[1];
+        let (omega, split, drive) = (diff.omega, diff.split, diff.drive);
 
         // ABS on the axle's mean slip.
         let mut brake = brake_pedal * self.max_brake[1];
@@ -395,30 +467,28 @@ impl Vehicle {
             brake *= (2.0 - slide / threshold).clamp(0.0, 1.0);
         }
 
-        // Tyre forces at the spins, their reaction torques τ and dτ/dω.
-        let forces = [0, 1].map(|i| {
-            let fmax = tyre.wheel_max_force(w.loads[i], friction[i]);
-            let sx = (omega[i] * r - w.vt[i]) * w.inv_denom[i];
-            let sy = -w.vl * w.inv_speed[i];
-            (tyre.forces(sx, sy, fmax), fmax)
-        });
-        let tau = [r * forces[0].0.fx, r * forces[1].0.fx];
-        let dtau = [0, 1].map(|i| (forces[i].0.dfx_dsx * r * r * w.inv_denom[i]).max(0.0));
-        let brake_torque = [0, 1].map(|i| brake * omega[i].signum() * f64::from(omega[i] != 0.0));
-        let step = if rigid {
+        // The tyres' reaction torques τ and dτ/dω.
+        let forces = w.forces;
+        let tau = [r * forces[0].fx, r * forces[1].fx];
+        let dtau_of = |i: usize| (forces[i].dfx_dsx * r * r * w.inv_denom[i]).max(0.0);
+        let dtau = [dtau_of(0), dtau_of(1)];
+        let brake_of = |i: usize| brake * omega[i].signum() * f64::from(omega[i] != 0.0);
+        let brake_torque = [brake_of(0), brake_of(1)];
+        let step = if diff.rigid {
             let d = dt * (drive - tau[0] - tau[1] - brake_torque[0] - brake_torque[1])
                 / (2.0 * inertia + dt * (dtau[0] + dtau[1]));
             [d; 2]
         } else {
             // (I + dt·d_i·(1 + h))·Δ_i − dt·h·d_j·Δ_j = dt·(T_i + h·(τ_j − τ_i) − τ_i − T_b,i),
             // h the spider's half.
-            let h = spider;
-            let rhs = [0, 1].map(|i| {
-                let j = 1 - i;
+            let h = diff.spider;
+            let rhs_of = |i: usize, j: usize| {
                 dt * (split[i] + h * (tau[j] - tau[i]) - tau[i] - brake_torque[i])
-            });
-            let a = [0, 1].map(|i| inertia + dt * dtau[i] * (1.0 + h));
-            let b = [0, 1].map(|i| -dt * h * dtau[i]);
+            };
+            let rhs = [rhs_of(0, 1), rhs_of(1, 0)];
+            let a_of = |i: usize| inertia + dt * dtau[i] * (1.0 + h);
+            let a = [a_of(0), a_of(1)];
+            let b = [-dt * h * dtau[0], -dt * h * dtau[1]];
             let det = a[0] * a[1] - b[0] * b[1];
             [
                 (rhs[0] * a[1] - b[1] * rhs[1]) / det,
@@ -428,7 +498,7 @@ impl Vehicle {
         let mut fx = [0.0; 2];
         let mut fy = [0.0; 2];
         for i in 0..2 {
-            let (f, fmax) = forces[i];
+            let (f, fmax) = (forces[i], w.fmax[i]);
             let mut new_omega = omega[i] + step[i];
             // Brakes can stop a wheel but never spin it backwards.
             let torque = split[i] - tau[i];

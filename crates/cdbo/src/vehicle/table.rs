@@ -5,6 +5,8 @@
 //! f(x) ≈ (2t³ − 3t² + 1)fₖ + (t³ − 2t² + t)h·f′ₖ + (3t² − 2t³)fₖ₊₁ + (t³ − t²)h·f′ₖ₊₁,
 //! exact for cubics, with error O(h⁴·f⁗); the derivative of this interpolant is returned too.
 
+use super::lanes::{F64x4, Lane};
+
 /// A function and its derivative tabulated on [0, len·step].
 #[derive(Debug, Clone, PartialEq)]
 pub struct HermiteTable {
@@ -17,8 +19,13 @@ pub struct HermiteTable {
 }
 
 impl HermiteTable {
-    /// Samples `f` (returning value and derivative) at `len + 1` nodes spaced by `step`.
+    /// Samples `f` (returning value and derivative) at `len + 1` nodes spaced by `step`;
+    /// `len` below 2³¹.
     pub fn new(step: f64, len: usize, f: impl Fn(f64) -> (f64, f64)) -> HermiteTable {
+        assert!(
+            len < 1 << 31,
+            "a Hermite table of {len} intervals: at most 2³¹ − 1"
+        );
         let nodes = (0..=len)
             .map(|k| {
                 let (v, d) = f(k as f64 * step);
@@ -34,33 +41,75 @@ impl HermiteTable {
     }
 
     /// (f(x), f′(x)) for x in the table's range, `None` outside it.
-    #[inline]
+    #[inline(always)]
     pub fn eval(&self, x: f64) -> Option<(f64, f64)> {
         let u = x * self.inv_step;
         if !(u >= 0.0 && u < self.intervals) {
             return None;
         }
-        let k = u as usize;
-        let t = u - k as f64;
+        let (k, t) = node_and_fraction(u);
         let [(f0, m0), (f1, m1)] = self.nodes[k..k + 2] else {
             return None;
         };
-        let (t2, t3) = (t * t, t * t * t);
-        let f = (2.0 * t3 - 3.0 * t2 + 1.0) * f0
-            + (t3 - 2.0 * t2 + t) * m0
-            + (3.0 * t2 - 2.0 * t3) * f1
-            + (t3 - t2) * m1;
-        let d = (6.0 * (t2 - t) * (f0 - f1)
-            + (3.0 * t2 - 4.0 * t + 1.0) * m0
-            + (3.0 * t2 - 2.0 * t) * m1)
-            * self.inv_step;
-        Some((f, d))
+        Some(interpolate(t, [f0, m0, f1, m1], self.inv_step))
+    }
+
+    /// [`HermiteTable::eval`] of four tables side by side, `tables[i]` at `x[i]`, bit for bit:
+    /// the values in one vector and the derivatives in another ([`F64x4`]); `None` unless
+    /// every xᵢ is in its table's range.
+    #[inline(always)]
+    pub(crate) fn eval_lanes(tables: [&HermiteTable; 4], x: F64x4) -> Option<(F64x4, F64x4)> {
+        let inv_step = F64x4(tables.map(|t| t.inv_step));
+        let u = x * inv_step;
+        let inside = u.ge(F64x4::splat(0.0)) & u.lt(F64x4(tables.map(|t| t.intervals)));
+        if !inside.all() {
+            return None;
+        }
+        let mut t = [0.0; 4];
+        // [fₖ, h·f′ₖ, fₖ₊₁, h·f′ₖ₊₁], each a vector of the four lanes.
+        let mut nodes = [[0.0; 4]; 4];
+        for i in 0..4 {
+            let k;
+            (k, t[i]) = node_and_fraction(u.0[i]);
+            let [(f0, m0), (f1, m1)] = tables[i].nodes[k..k + 2] else {
+                return None;
+            };
+            (nodes[0][i], nodes[1][i], nodes[2][i], nodes[3][i]) = (f0, m0, f1, m1);
+        }
+        Some(interpolate(F64x4(t), nodes.map(F64x4), inv_step))
     }
 
     /// The end of the table's range.
     pub fn max_x(&self) -> f64 {
         (self.nodes.len() - 1) as f64 * self.step
     }
+}
+
+/// The interpolant and its derivative at the fraction `t` of the interval from node k,
+/// [fₖ, h·f′ₖ, fₖ₊₁, h·f′ₖ₊₁] = `[f0, m0, f1, m1]`, with 1/h = `inv_step` (the module's
+/// formula).
+#[inline(always)]
+fn interpolate<T: Lane>(t: T, [f0, m0, f1, m1]: [T; 4], inv_step: T) -> (T, T) {
+    let c = T::splat;
+    let (t2, t3) = (t * t, t * t * t);
+    let f = (c(2.0) * t3 - c(3.0) * t2 + c(1.0)) * f0
+        + (t3 - c(2.0) * t2 + t) * m0
+        + (c(3.0) * t2 - c(2.0) * t3) * f1
+        + (t3 - t2) * m1;
+    let d = (c(6.0) * (t2 - t) * (f0 - f1)
+        + (c(3.0) * t2 - c(4.0) * t + c(1.0)) * m0
+        + (c(3.0) * t2 - c(2.0) * t) * m1)
+        * inv_step;
+    (f, d)
+}
+
+/// The node k = ⌊u⌋ and the fraction t = u − k of u = x/h in [0, len), len < 2³¹
+/// ([`HermiteTable::new`]): k as a 32-bit integer, whose conversions from and to a float take a
+/// few instructions where a usize's take a dozen.
+#[inline(always)]
+fn node_and_fraction(u: f64) -> (usize, f64) {
+    let k = u as u32;
+    (k as usize, u - f64::from(k))
 }
 
 #[cfg(test)]

@@ -39,15 +39,10 @@ fn a_left_hand_turn_mirrors_a_right_hand_one() {
             right.roll = -left.roll;
             right.omega = [left.omega[0], left.omega[2], left.omega[1]];
             for _ in 0..50 {
-                v.step(
-                    &mut left,
-                    &Controls::new(0.1, throttle, brake),
-                    &frame,
-                    0.004,
-                );
+                v.step(&mut left, &v.controls(0.1, throttle, brake), &frame, 0.004);
                 v.step(
                     &mut right,
-                    &Controls::new(-0.1, throttle, brake),
+                    &v.controls(-0.1, throttle, brake),
                     &frame,
                     0.004,
                 );
@@ -200,7 +195,7 @@ fn the_rolling_resistance_turns_against_the_yaw() {
             speed / v.radius[1],
             speed / v.radius[1],
         ];
-        v.step(&mut s, &Controls::default(), &frame, dt);
+        v.step(&mut s, &v.controls(0.0, 0.0, 0.0), &frame, dt);
         s.yaw_rate
     };
     let down = v.downforce_per_v2(speed);
@@ -234,7 +229,7 @@ fn the_launch_clutch_blends_at_the_games_step() {
         let mut s = v.at_rest(0.0, 0.0, 0.0);
         s.clutch = 0.7;
         for _ in 0..(0.15 / dt).round() as usize {
-            v.step(&mut s, &Controls::new(0.0, 0.5, 0.0), &frame, dt);
+            v.step(&mut s, &v.controls(0.0, 0.5, 0.0), &frame, dt);
         }
         s.engine_speed
     };
@@ -259,20 +254,37 @@ fn the_wheels_take_up_the_roll_moment() {
     assert!((ratio - k[0] * y[0] / (k[1] * y[1])).abs() < 1e-12);
 }
 
+/// The rear wheels stepped 4 ms as [`Vehicle::step`] steps them, with the brakes off, under
+/// the drive torque `drive` at the axle (N·m), each under `load` on ground of `friction` and
+/// moving at (v_t, v_l) = `velocity` (m/s, v_t > 0): their forces (Fₓ and Fᵧ, left and right).
+fn step_rear(
+    v: &Vehicle,
+    s: &mut State,
+    drive: f64,
+    load: f64,
+    (vt, vl): (f64, f64),
+    friction: f64,
+) -> ([f64; 2], [f64; 2]) {
+    let diff = v.differential(s, drive);
+    let (tyre, r) = (&v.tyres[1], v.radius[1]);
+    let fmax = tyre.wheel_max_force(load, friction);
+    let sy = -vl / vt.hypot(vl);
+    let forces = diff.omega.map(|w| tyre.forces((w * r - vt) / vt, sy, fmax));
+    let rear = RearWheels {
+        forces,
+        fmax: [fmax; 2],
+        inv_denom: [1.0 / vt; 2],
+        inv_axle: 1.0 / vt,
+    };
+    v.rear_wheels(s, 0.0, &diff, &rear, 0.004)
+}
+
 /// Through a spool the rear wheels turn as one; through a limited slip under a drive
 /// torque T below its locking torque their speed ratio ends within ρ_s·(1 − T/T_lock);
 /// through a free one, on a slippery road, the drive spins both up alike.
 #[test]
 fn the_differential_holds_the_rear_wheels_as_its_kind() {
     let r = Car::spirit_300().rear_tyre.radius;
-    let rear = RearWheels {
-        loads: [3000.0, 3000.0],
-        vt: [30.0, 30.0],
-        vl: 0.0,
-        inv_denom: [1.0 / 30.0; 2],
-        inv_speed: [1.0 / 30.0; 2],
-        inv_axle: 1.0 / 30.0,
-    };
     let spun = |kind: DiffKind, drive: f64, omega: [f64; 2], friction: f64| {
         let mut car = Car::spirit_300();
         car.differential.kind = kind;
@@ -280,7 +292,7 @@ fn the_differential_holds_the_rear_wheels_as_its_kind() {
         let mut s = v.at_rest(0.0, 0.0, 0.0);
         s.vx = 30.0;
         s.omega = [30.0 / r, omega[0], omega[1]];
-        v.rear_wheels(&mut s, 0.0, drive, &rear, [friction; 2], 0.004);
+        step_rear(&v, &mut s, drive, 3000.0, (30.0, 0.0), friction);
         [s.omega[1], s.omega[2]]
     };
     let w = spun(DiffKind::Spool, 500.0, [30.0 / r, 33.0 / r], 1.0);
@@ -307,18 +319,10 @@ fn a_wheel_slips_sideways_by_the_sine_of_its_slip_angle() {
     let v = Vehicle::new(&car);
     let r = car.rear_tyre.radius;
     let (vt, vl, load) = (30.0, -12.0, 3000.0);
-    let rear = RearWheels {
-        loads: [load; 2],
-        vt: [vt; 2],
-        vl,
-        inv_denom: [1.0 / vt; 2],
-        inv_speed: [1.0 / f64::hypot(vt, vl); 2],
-        inv_axle: 1.0 / vt,
-    };
     let mut s = v.at_rest(0.0, 0.0, 0.0);
     s.vx = vt;
     s.omega = [vt / r; 3];
-    let (_, fy) = v.rear_wheels(&mut s, 0.0, 0.0, &rear, [1.0; 2], 0.004);
+    let (_, fy) = step_rear(&v, &mut s, 0.0, load, (vt, vl), 1.0);
     let tyre = &v.tyres[1];
     let fmax = tyre.wheel_max_force(load, 1.0);
     let alpha = (-vl / vt).atan();

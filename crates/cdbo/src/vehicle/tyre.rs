@@ -18,6 +18,7 @@
 //! g is smooth in u, and Fₓ = F_max·g(u)·sₓ, F_y = F_max·g(u)·s_y need neither a square root
 //! nor a division.
 
+use super::lanes::{F64x4, Lane};
 use super::table::HermiteTable;
 use crate::car::Tyre;
 
@@ -98,7 +99,7 @@ impl TyreModel {
     }
 
     /// Load sensitivity λ(F_z) (tabulated; the formula beyond 8 × the operating load).
-    #[inline]
+    #[inline(always)]
     pub fn load_factor(&self, fz: f64) -> f64 {
         let z = fz * self.inv_operating_load;
         match self.load_table.eval(z) {
@@ -109,7 +110,7 @@ impl TyreModel {
 
     /// Largest force one tyre can give under its load `fz` on a surface of friction `surface`
     /// (N): F_z·μ·μ_surface·λ(F_z), as simuv2's `wheel.cpp` has it per wheel.
-    #[inline]
+    #[inline(always)]
     pub fn wheel_max_force(&self, fz: f64, surface: f64) -> f64 {
         fz * self.mu * surface * self.load_factor(fz)
     }
@@ -123,7 +124,7 @@ impl TyreModel {
 
     /// g(u) = f(√u)/√u and g′(u) for u = s² ≥ 0: the tabulated values up to u = 1, the
     /// formula beyond.
-    #[inline]
+    #[inline(always)]
     pub fn ratio(&self, u: f64) -> (f64, f64) {
         self.ratio_table
             .eval(u)
@@ -159,37 +160,67 @@ impl TyreModel {
     /// derivatives with respect to sₓ, with u = sₓ² + s_y²:
     /// Fₓ = fmax·g(u)·sₓ, F_y = fmax·g(u)·s_y,
     /// ∂Fₓ/∂sₓ = fmax·[g + 2sₓ²·g′], ∂F_y/∂sₓ = fmax·2sₓs_y·g′.
-    #[inline]
+    #[inline(always)]
     pub fn forces(&self, sx: f64, sy: f64, fmax: f64) -> Forces {
         let u = sx * sx + sy * sy;
-        let (g, dg) = self.ratio(u);
-        let (g, dg) = if self.skid > 0.0 {
-            // g·m and its derivative in u, m = 1 + k·min(√u, cap).
-            let (m, dm) = self.skid_multiplier(u);
-            (g * m, dg * m + g * dm)
-        } else {
-            (g, dg)
-        };
-        let (fg, two_dg_sx) = (fmax * g, fmax * 2.0 * dg * sx);
+        let [fx, fy, dfx_dsx, dfy_dsx] = forces_of(fmax, self.ratio(u), u, (sx, sy), self.skid);
         Forces {
-            fx: fg * sx,
-            fy: fg * sy,
-            dfx_dsx: fg + two_dg_sx * sx,
-            dfy_dsx: two_dg_sx * sy,
+            fx,
+            fy,
+            dfx_dsx,
+            dfy_dsx,
         }
     }
 
+    /// [`TyreModel::wheel_max_force`] of four tyres side by side, `tyres[i]` under `fz[i]` on
+    /// `surface[i]`, bit for bit, in vector registers ([`F64x4`]); each lane by the formula
+    /// past its table.
+    #[inline(always)]
+    pub(crate) fn wheel_max_force_lanes(
+        tyres: [&TyreModel; 4],
+        fz: F64x4,
+        surface: F64x4,
+    ) -> F64x4 {
+        let z = fz * F64x4(tyres.map(|t| t.inv_operating_load));
+        let load_factor = match HermiteTable::eval_lanes(tyres.map(|t| &t.load_table), z) {
+            Some((l, _)) => l,
+            None => F64x4(std::array::from_fn(|i| tyres[i].load_factor(fz.0[i]))),
+        };
+        fz * F64x4(tyres.map(|t| t.mu)) * surface * load_factor
+    }
+
+    /// [`TyreModel::forces`] of four tyres side by side, `tyres[i]` at slip (`sx[i]`, `sy[i]`)
+    /// under `fmax[i]`, bit for bit, in vector registers ([`F64x4`]); each lane by the formula
+    /// past its table.
+    #[inline(always)]
+    pub(crate) fn forces_lanes(
+        tyres: [&TyreModel; 4],
+        sx: F64x4,
+        sy: F64x4,
+        fmax: F64x4,
+    ) -> [Forces; 4] {
+        let u = sx * sx + sy * sy;
+        let ratio = match HermiteTable::eval_lanes(tyres.map(|t| &t.ratio_table), u) {
+            Some(table) => table,
+            None => {
+                let exact: [(f64, f64); 4] = std::array::from_fn(|i| tyres[i].ratio(u.0[i]));
+                (F64x4(exact.map(|r| r.0)), F64x4(exact.map(|r| r.1)))
+            }
+        };
+        let skid = F64x4(tyres.map(|t| t.skid));
+        let [fx, fy, dfx_dsx, dfy_dsx] = forces_of(fmax, ratio, u, (sx, sy), skid);
+        std::array::from_fn(|i| Forces {
+            fx: fx.0[i],
+            fy: fy.0[i],
+            dfx_dsx: dfx_dsx.0[i],
+            dfy_dsx: dfy_dsx.0[i],
+        })
+    }
+
     /// The skid factor's multiplier m(u) = 1 + k·min(√u, [`SKID_SLIP_CAP`]) and dm/du.
-    #[inline]
+    #[inline(always)]
     pub fn skid_multiplier(&self, u: f64) -> (f64, f64) {
-        let s = u.sqrt();
-        if s >= SKID_SLIP_CAP {
-            (1.0 + self.skid * SKID_SLIP_CAP, 0.0)
-        } else if s > 0.0 {
-            (1.0 + self.skid * s, 0.5 * self.skid / s)
-        } else {
-            (1.0, 0.0)
-        }
+        skid_multiplier(u, self.skid)
     }
 
     fn find_peak_slip(&self) -> f64 {
@@ -218,6 +249,37 @@ pub struct Forces {
     pub dfx_dsx: f64,
     /// ∂F_y/∂sₓ.
     pub dfy_dsx: f64,
+}
+
+/// [Fₓ, F_y, ∂Fₓ/∂sₓ, ∂F_y/∂sₓ] ([`TyreModel::forces`]) at slip (sₓ, s_y) = `slip`, u = sₓ² + s_y²,
+/// under the budget `fmax`, with the shape's ratio (g, g′) at u and the skid factor k = `skid`
+/// (none at 0): with one, g·m and g′·m + g·m′ for its multiplier m(u)
+/// ([`TyreModel::skid_multiplier`]). Both are computed and one kept, without branches.
+#[inline(always)]
+fn forces_of<T: Lane>(fmax: T, (g, dg): (T, T), u: T, (sx, sy): (T, T), skid: T) -> [T; 4] {
+    let (m, dm) = skid_multiplier(u, skid);
+    let skidding = skid.gt(T::splat(0.0));
+    let g_skid = g * m;
+    let dg = T::select(skidding, dg * m + g * dm, dg);
+    let g = T::select(skidding, g_skid, g);
+    let (fg, two_dg_sx) = (fmax * g, fmax * T::splat(2.0) * dg * sx);
+    [fg * sx, fg * sy, fg + two_dg_sx * sx, two_dg_sx * sy]
+}
+
+/// The skid factor k's multiplier m(u) = 1 + k·min(√u, [`SKID_SLIP_CAP`]) and dm/du = k/(2√u)
+/// below the cap (0 at u = 0 and past the cap): each case computed and the one for √u kept,
+/// without branches.
+#[inline(always)]
+fn skid_multiplier<T: Lane>(u: T, skid: T) -> (T, T) {
+    let (zero, one, cap) = (T::splat(0.0), T::splat(1.0), T::splat(SKID_SLIP_CAP));
+    let s = u.sqrt();
+    let (capped, rising) = (s.ge(cap), s.gt(zero));
+    let m = T::select(rising, one + skid * s, one);
+    let dm = T::select(rising, T::splat(0.5) * skid / s, zero);
+    (
+        T::select(capped, one + skid * cap, m),
+        T::select(capped, zero, dm),
+    )
 }
 
 #[cfg(test)]
@@ -308,6 +370,42 @@ mod tests {
             "{}",
             torcs.force_cap
         );
+    }
+
+    /// The lanes of [`TyreModel::forces_lanes`] and [`TyreModel::wheel_max_force_lanes`] give
+    /// each tyre's own forces and budget bit for bit, inside the tables and past them.
+    #[test]
+    fn four_tyres_side_by_side_are_four_tyres() {
+        use rand::Rng;
+        let skidding = Tyre {
+            skid: 0.3,
+            ..Car::spirit_300().rear_tyre
+        };
+        let models = [
+            TyreModel::new(&Car::spirit_300().front_tyre),
+            TyreModel::new(&Car::spirit_300().rear_tyre),
+            TyreModel::new(&skidding),
+        ];
+        let mut rng = crate::rng::rng_for(9, 0);
+        for n in 0..40_000 {
+            let tyres: [&TyreModel; 4] = std::array::from_fn(|_| &models[rng.random_range(0..3)]);
+            // Slips past the table's end (s = 1) and loads past 8 operating loads in some.
+            let reach = if n % 10 == 0 { 2.0 } else { 0.6 };
+            let sx: [f64; 4] = std::array::from_fn(|_| rng.random_range(-reach..reach));
+            let sy: [f64; 4] = std::array::from_fn(|_| rng.random_range(-reach..reach));
+            let top = if n % 10 == 1 { 40_000.0 } else { 8000.0 };
+            let fz: [f64; 4] = std::array::from_fn(|_| rng.random_range(0.0..top));
+            let surface: [f64; 4] = std::array::from_fn(|_| rng.random_range(0.3..1.2));
+            let fmax = TyreModel::wheel_max_force_lanes(tyres, F64x4(fz), F64x4(surface)).0;
+            let forces = TyreModel::forces_lanes(tyres, F64x4(sx), F64x4(sy), F64x4(fmax));
+            for i in 0..4 {
+                let one = tyres[i].wheel_max_force(fz[i], surface[i]);
+                assert_eq!(fmax[i].to_bits(), one.to_bits(), "{} N", fz[i]);
+                let one = tyres[i].forces(sx[i], sy[i], fmax[i]);
+                let bits = |f: Forces| [f.fx, f.fy, f.dfx_dsx, f.dfy_dsx].map(f64::to_bits);
+                assert_eq!(bits(forces[i]), bits(one), "({}, {})", sx[i], sy[i]);
+            }
+        }
     }
 
     #[test]
