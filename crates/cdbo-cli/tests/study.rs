@@ -524,14 +524,7 @@ fn a_study_steers_as_its_initial_policy_was_raced() {
 fn a_study_of_the_preset_is_its_long_form() {
     let dir = fresh_dir_with_demo("study-preset");
     let evaluator = common::OVAL_LAP.replace("{cdbo}", CDBO);
-    let long_form = [
-        "--method",
-        "safe-pattern-search",
-        "--steering",
-        "tracker",
-        "--line",
-        "min-curvature",
-    ];
+    let long_form = common::FAST_SAFE_FLAGS;
     let drive = |db: &str, stack: &[&str]| -> Vec<Option<u64>> {
         let mut args = common::optimize_args(&evaluator, db, 4);
         args.extend(stack.iter().map(|s| s.to_string()));

@@ -1,6 +1,7 @@
-//! The game TORCS behind `experiment` and `serve-sim` (`--simulator torcs`): a grid of races
-//! in the game with two games at once gives the records one game at a time gives, and the
-//! service answers with game laps; no game process and no lap folder is left. Skipped (with a
+//! The game TORCS behind `experiment`, `serve-sim` and `torcs learn` (`--simulator torcs`): a
+//! grid of races in the game with two games at once gives the records one game at a time
+//! gives, the service answers with game laps, and a track becomes a race-ready policy beside
+//! the robots; no game process and no lap folder is left. Skipped (with a
 //! message) where TORCS or the robot headers (../shared/torcs-sdk) are missing.
 
 mod common;
@@ -351,4 +352,58 @@ fn transfer_drives_each_learned_best_policy_in_the_game() {
     assert!(!elsewhere.exists(), "{err}");
     nothing_left(&cache);
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// On G-Track 1 with car1-trb1, 10 kernels and 3 game laps: the policy written is the one
+/// whose laps are reported (driven again in the game, standing and flying, the same times),
+/// the flying lap is faster than the standing lap, and the robots' fastest laps stand beside.
+#[test]
+#[ignore = "slow: a ceiling, eight game laps and the robots' laps"]
+fn a_track_becomes_a_race_ready_policy_beside_the_robots() {
+    let dir = fresh_dir("torcs-learn");
+    let Some(cache) = game_cache(&dir) else {
+        return;
+    };
+    let out = dir.join("policies");
+    let o = torcs_cmd(&cache)
+        .args(["torcs", "learn", "--track", "g-track-1", "--kernels", "10"])
+        .args(["--game-laps", "3", "--json", "--out", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let r = &report[0];
+    assert_eq!(r["track"], "g-track-1");
+    assert_eq!(r["game_laps"], 3);
+    let standing = r["standing_lap_s"].as_f64().expect("a standing lap");
+    let flying = r["flying_lap_s"].as_f64().expect("a flying lap");
+    assert!(flying < standing, "{r}");
+    let robot = r["robot_standing"][1].as_f64().expect("a robot's lap");
+    assert!(robot > 30.0 && robot < 80.0, "{r}");
+    // The policy file drives the reported laps again in the game.
+    let policy = out.join("g-track-1.json");
+    assert_eq!(r["policy"], policy.display().to_string());
+    for (flag, time) in [(None, standing), (Some("--flying"), flying)] {
+        let lap = torcs_cmd(&cache)
+            .args([
+                "lap",
+                "--simulator",
+                "torcs",
+                "--track",
+                "g-track-1",
+                "--json",
+            ])
+            .args(["--policy", policy.to_str().unwrap()])
+            .args(flag)
+            .output()
+            .unwrap();
+        assert!(
+            lap.status.success(),
+            "{}",
+            String::from_utf8_lossy(&lap.stderr)
+        );
+        let lap: serde_json::Value = serde_json::from_slice(&lap.stdout).unwrap();
+        let t = lap["lap_time_s"].as_f64().unwrap();
+        assert!((t - time).abs() < 0.05, "{flag:?}: {t} s against {time} s");
+    }
 }

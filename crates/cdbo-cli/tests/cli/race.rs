@@ -413,14 +413,7 @@ fn the_fast_safe_preset_races_as_its_long_form() {
         (serde_json::from_str(&summary).unwrap(), laps)
     };
     let (preset, preset_laps) = race("preset", &["--preset", "fast-safe"]);
-    let long_form = [
-        "--method",
-        "safe-pattern-search",
-        "--steering",
-        "tracker",
-        "--line",
-        "min-curvature",
-    ];
+    let long_form = crate::common::FAST_SAFE_FLAGS;
     let (long, long_laps) = race("long", &long_form);
     let bits = |v: &serde_json::Value| v["best_reward_mps"].as_f64().unwrap().to_bits();
     assert_eq!(bits(&preset), bits(&long));

@@ -358,3 +358,13 @@ impl Service {
         child.wait().unwrap()
     }
 }
+
+/// The long form of `--preset fast-safe`.
+pub const FAST_SAFE_FLAGS: [&str; 6] = [
+    "--method",
+    "safe-pattern-search",
+    "--steering",
+    "tracker",
+    "--line",
+    "min-curvature",
+];
