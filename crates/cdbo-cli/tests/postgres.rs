@@ -240,7 +240,7 @@ fn three_workers_one_killed_tell_each_trial_once() {
     three_workers(24, "cdbo");
 }
 
-/// The acceptance run: 300 laps, of random search so that the laps (a process each) and the
+/// The full-size run: 300 laps, of random search so that the laps (a process each) and the
 /// database, not the GP, take the time.
 #[test]
 #[ignore = "slow: 300 laps of three workers (run by .ci/run)"]
