@@ -312,7 +312,7 @@ fn race_one(
         error: None,
         first_completed_lap: None,
         best_mps: 0.0,
-        limit_mps: cdbo::limit::limit_lap(track, car).reward_mps,
+        limit_mps: 0.0,
         failed_laps: 0,
         wall_s,
     };
@@ -327,7 +327,10 @@ fn race_one(
             run.limit_mps = outcome.limit.reward_mps;
             run.failed_laps = outcome.laps.iter().filter(|l| l.failure.is_some()).count();
         }
-        Err(e) => run.error = Some(e),
+        Err(e) => {
+            run.limit_mps = cdbo::limit::limit_lap(track, car).reward_mps;
+            run.error = Some(e);
+        }
     }
     run
 }

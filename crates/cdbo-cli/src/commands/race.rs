@@ -265,11 +265,7 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     let profile = cdbo::ceiling::profile(&track, &car, None);
     let (_, ceiling_mps) = cdbo::ceiling::tracked_profile(&ceiling_sim, &profile)?;
     write_outputs(&out, &outcome, config.base_line, steering)?;
-    let best_lap = outcome
-        .laps
-        .iter()
-        .filter(|l| l.reward_mps == outcome.best_reward_mps)
-        .find_map(|l| l.lap_time_s);
+    let best_lap = outcome.best_lap_time_s();
     // The speed plots re-drive the initial and best policies where the race was driven, on
     // its base line.
     let venue = match &outcome.line {

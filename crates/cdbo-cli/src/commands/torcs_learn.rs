@@ -12,7 +12,7 @@ use serde::Serialize;
 use super::torcs::robots_on;
 use super::{CliResult, game_track, print_json};
 use cdbo::data_path::DataPath;
-use cdbo::experiment::race::{BaseLine, RaceConfig, RaceOutcome, race};
+use cdbo::experiment::race::{BaseLine, RaceConfig, race};
 use cdbo::method::Preset;
 use cdbo::policy::{Policy, RacedPolicy};
 use cdbo::torcs::{self, Game, GamePedal};
@@ -149,7 +149,7 @@ fn learn_on(
                 .steered(stack.steering().steering())
                 .for_learning(None);
             let learned = race(&venue, &ours, &car, &config, |_| {})?;
-            let lap = best_lap(&learned);
+            let lap = learned.best_lap_time_s();
             (learned.best, "recommended learner", lap)
         }
     };
@@ -194,15 +194,6 @@ fn learn_on(
         robot_flying: owned(robot_flying),
         policy: file.display().to_string(),
     })
-}
-
-/// The race's best lap time (s).
-fn best_lap(outcome: &RaceOutcome) -> Option<f64> {
-    outcome
-        .laps
-        .iter()
-        .filter(|l| l.reward_mps == outcome.best_reward_mps)
-        .find_map(|l| l.lap_time_s)
 }
 
 /// The table: each track's game laps beside the fastest robot's, and how many tracks ours

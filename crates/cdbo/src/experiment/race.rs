@@ -202,6 +202,16 @@ pub struct RaceOutcome {
     pub line: Option<Arc<RacingLine>>,
 }
 
+impl RaceOutcome {
+    /// The time (s) of the first lap that reached the best reward, if one completed.
+    pub fn best_lap_time_s(&self) -> Option<f64> {
+        self.laps
+            .iter()
+            .filter(|l| l.reward_mps == self.best_reward_mps)
+            .find_map(|l| l.lap_time_s)
+    }
+}
+
 /// Runs a race where `venue` drives its laps, on `track` with `car` (cdbo's reading of them,
 /// for the limit and the base line), the demonstration and every lap on the config's base line;
 /// `progress` is called after every lap.

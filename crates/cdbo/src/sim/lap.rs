@@ -282,6 +282,12 @@ impl Default for LapConfig {
 }
 
 impl LapConfig {
+    /// Laps driven for one timed lap: 2 for a flying lap (the standing lap before it), else 1;
+    /// the time limit is theirs.
+    pub fn laps(&self) -> f64 {
+        if self.flying { 2.0 } else { 1.0 }
+    }
+
     /// Laps failing once the car's centre is `margin` metres past the road's edge (negative:
     /// inside the road), and at the barriers, nothing kept in reserve.
     pub fn fail_at(&mut self, margin: f64) {
@@ -430,9 +436,7 @@ impl Simulator {
         let mut proj = track.project(state.x, state.y, 0);
         let (mut distance, mut farthest, mut slow_for) = (0.0, 0.0, 0.0);
         let mut trace = Vec::new();
-        // The flying lap's laps: the standing one, then the timed one.
-        let laps = if cfg.flying { 2.0 } else { 1.0 };
-        let limit = laps * self.time_limit();
+        let limit = cfg.laps() * self.time_limit();
         // Where the timed lap starts: its distance (m) and time (s) at the line.
         let (mut lap_start, mut standing) = (0.0, None);
         let driver_dt = cfg.dt * cfg.driver_every as f64;

@@ -316,9 +316,7 @@ fn settings(
     let [f, r] = vehicle.aid_threshold();
     let _ = writeln!(s, "aid_slip {f:e} {r:e}");
     let _ = writeln!(s, "off_track_margin {:e}", req.config.off_track_margin);
-    // A flying lap's limit is the two laps'.
-    let laps = if req.config.flying { 2.0 } else { 1.0 };
-    let _ = writeln!(s, "time_limit {:e}", laps * time_limit);
+    let _ = writeln!(s, "time_limit {:e}", req.config.laps() * time_limit);
     if req.config.flying {
         let _ = writeln!(s, "flying 1");
     }
