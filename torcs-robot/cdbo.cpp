@@ -561,6 +561,7 @@ void drive(int, tCarElt *car, tSituation *s) {
 
     double x = clamp((lap.distance - lap.lap_start) / len, 0.0, 1.0);
     double a = pedal(x, speed, dt);
+    if (lap.cfg.flying && lap.standing < 0.0) a = drive::run_up_pedal(a, speed);
     double delta = lap.cfg.tracker ? tracker_steer(car, speed) : steer(car, speed, dt);
     choose_gear(car, std::fmax(a, 0.0), dt);
 

@@ -126,6 +126,12 @@ inline double profile_hold(const double *profile, std::size_t n, double length, 
 /// in [-1, 1], NaN taken as 0.
 inline double pedal_command(double v) { return std::isnan(v) ? 0.0 : clamp(v, -1.0, 1.0); }
 
+/// The pedal command on a flying lap's run-up (drive/mod.rs run_up_pedal): max(a, clamp(v_min -
+/// speed, -1, 1)), v_min the profile tracker's floor.
+inline double run_up_pedal(double a, double speed) {
+    return std::fmax(a, clamp(kProfileFloor - speed, -1.0, 1.0));
+}
+
 // ---- The steering ---------------------------------------------------------------------------
 
 /// The look-ahead distance max(d_min, t_la v) (m) (drive/steering.rs Steering::lookahead).

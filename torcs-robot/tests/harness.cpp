@@ -90,6 +90,11 @@ const std::map<std::string, Case> kCases = {
      }},
     {"pedal_command",  // V -> a
      [](Args &a) { return std::vector<double>{drive::pedal_command(a.num())}; }},
+    {"run_up_pedal",  // A SPEED -> a
+     [](Args &a) {
+         double pedal = a.num(), speed = a.num();
+         return std::vector<double>{drive::run_up_pedal(pedal, speed)};
+     }},
     {"speed_hold",  // INTEGRAL TARGET SPEED DT -> a INTEGRAL'
      [](Args &a) {
          double integral = a.num(), target = a.num(), speed = a.num(), dt = a.num();

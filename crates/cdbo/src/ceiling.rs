@@ -79,6 +79,17 @@ pub fn profile(track: &Track, car: &Car, line: Option<&RacingLine>) -> Limit {
     }
 }
 
+/// The speed profile a flying lap tracks ([`profile`] of a flying lap,
+/// [`LimitOptions::flying`]): the car crosses the line at the speed the lap ends with, and
+/// brakes before the line for the next lap's first corner.
+pub fn flying_profile(track: &Track, car: &Car, line: Option<&RacingLine>) -> Limit {
+    let options = LimitOptions::CRESTS.flying();
+    match line {
+        Some(line) => crate::limit::line_limit_on_centre_with(track, line, car, options),
+        None => crate::limit::limit_lap_with(track, car, options),
+    }
+}
+
 /// A speed controller following k times the limit's speed profile.
 #[derive(Debug, Clone)]
 pub struct ProfileTracker<'a> {
@@ -88,6 +99,8 @@ pub struct ProfileTracker<'a> {
     pub length: f64,
     /// The scale k.
     pub k: f64,
+    /// The profile is a flying lap's: the preview past the finish reads the next lap's start.
+    pub flying: bool,
 }
 
 impl ProfileTracker<'_> {
@@ -97,18 +110,26 @@ impl ProfileTracker<'_> {
             profile: &limit.speed,
             length,
             k,
+            flying: limit.flying,
         }
     }
 
-    /// The previewed target k·min v_lim over [s, s + v·τ] (m/s).
+    /// The previewed target k·min v_lim over [s, s + v·τ] (m/s); on a flying profile the
+    /// window past the finish goes on from the start.
     pub fn target(&self, x: f64, speed: f64) -> f64 {
         let n = self.profile.len() - 1;
         let at = |x: f64| ((x.clamp(0.0, 1.0) * n as f64).round() as usize).min(n);
-        let (i, j) = (at(x), at(x + speed * PREVIEW_S / self.length));
-        let v = self.profile[i..=j]
-            .iter()
-            .copied()
-            .fold(f64::INFINITY, f64::min);
+        let ahead = x + speed * PREVIEW_S / self.length;
+        let lowest = |i: usize, j: usize| {
+            self.profile[i..=j]
+                .iter()
+                .copied()
+                .fold(f64::INFINITY, f64::min)
+        };
+        let mut v = lowest(at(x), at(ahead));
+        if self.flying && ahead > 1.0 {
+            v = v.min(lowest(0, at(ahead - 1.0)));
+        }
         (self.k * v).max(TRACKER_FLOOR_MPS)
     }
 }
@@ -200,7 +221,18 @@ pub fn ceiling_with(
     let mut traced = sim.clone();
     traced.config.trace = true;
     let tracked = traced.lap(&mut ProfileTracker::new(profile, sim.track.length, k));
-    let mut targets: Vec<(f64, f64)> = tracked.trace.iter().map(|p| (p.x, p.pedal)).collect();
+    // A flying lap's policy is fitted to the timed lap's pedal; the run-up keeps its speed.
+    let timed_from = if sim.config.flying {
+        sim.track.length
+    } else {
+        f64::NEG_INFINITY
+    };
+    let mut targets: Vec<(f64, f64)> = tracked
+        .trace
+        .iter()
+        .filter(|p| p.distance_m >= timed_from)
+        .map(|p| (p.x, p.pedal))
+        .collect();
     let mut repair = PedalRepair::new(kernels);
     let mut ceiling = Ceiling {
         limit_mps: limit.reward_mps,
@@ -339,5 +371,23 @@ mod tests {
             lap.completed && widest < road,
             "{widest} m off the centre line"
         );
+    }
+
+    /// A flying profile's preview past the finish reads the next lap's start; a standing
+    /// one's stops at the finish.
+    #[test]
+    fn a_flying_trackers_preview_wraps_past_the_line() {
+        let mut limit = Limit {
+            lap_time_s: 2.0,
+            reward_mps: 50.0,
+            flying: true,
+            speed: vec![20.0, 50.0, 50.0, 50.0, 50.0],
+            track_length: 100.0,
+        };
+        // At x = 0.99 and 40 m/s the 0.3 s preview reaches x = 1.11: station 0's 20 m/s.
+        let target = |limit: &Limit| ProfileTracker::new(limit, 100.0, 0.9).target(0.99, 40.0);
+        assert_eq!(target(&limit), 18.0);
+        limit.flying = false;
+        assert_eq!(target(&limit), 45.0);
     }
 }

@@ -52,6 +52,10 @@ pub struct Limit {
     pub lap_time_s: f64,
     /// L / T (m/s).
     pub reward_mps: f64,
+    /// The lap is a flying one ([`LimitOptions::flying`]): its profile wraps, the speed at
+    /// the finish the speed at the start of the next lap.
+    #[serde(skip)]
+    pub flying: bool,
     /// Limit speed at each track sample (m/s), plus the finish.
     #[serde(skip)]
     pub speed: Vec<f64>,
@@ -85,13 +89,31 @@ pub struct LimitOptions {
     /// n(v) = cos φ·cos β + v²·κ_v/g, as in the simulator, and the car must not take off
     /// (module documentation). Off: n = 1, [`limit_lap`]'s crest-blind yardstick.
     pub crests: bool,
+    /// The lap is flying: entered at the speed it ends with, and ending at a speed from
+    /// which the next lap's first corner can be made (module documentation, step 2 and 3).
+    /// Off: a standing lap from v₀ = 0 to a finish line with nothing beyond it.
+    pub flying: bool,
 }
 
 impl LimitOptions {
     /// The crest-blind model of [`limit_lap`].
-    pub const FLAT: LimitOptions = LimitOptions { crests: false };
+    pub const FLAT: LimitOptions = LimitOptions {
+        crests: false,
+        flying: false,
+    };
     /// The crest-aware model.
-    pub const CRESTS: LimitOptions = LimitOptions { crests: true };
+    pub const CRESTS: LimitOptions = LimitOptions {
+        crests: true,
+        flying: false,
+    };
+
+    /// These options for a flying lap.
+    pub fn flying(self) -> LimitOptions {
+        LimitOptions {
+            flying: true,
+            ..self
+        }
+    }
 }
 
 /// The QSS limit lap of `car` along `line`, a racing line on `track`: [`limit_lap`] on
@@ -274,38 +296,59 @@ pub fn limit_lap_with(track: &Track, car: &Car, options: LimitOptions) -> Limit 
         (1.0 - (lat / max).powi(2)).max(0.0).sqrt()
     };
 
-    // 2. Forward pass from standing.
-    let mut v = vec![0.0; n + 1];
-    for i in 0..n {
-        let c = track.sample(i);
-        let vi = v[i];
-        let ni = normal(i, vi);
-        let push = engine_force(vi).min(traction(vi, ni, c.friction) * ellipse(vi, i));
-        let acc = push / m
-            - car.drag(vi) / m
-            - c.rolling_resistance.unwrap_or(rolling) * car.scales.rolling * G * ni.max(0.0)
-            - G * c.grade;
-        let next = (vi * vi + 2.0 * ds * acc).max(0.0).sqrt();
-        v[i + 1] = next.min(cap[i + 1]);
+    let forward = |v: &mut [f64]| {
+        for i in 0..n {
+            let c = track.sample(i);
+            let vi = v[i];
+            let ni = normal(i, vi);
+            let push = engine_force(vi).min(traction(vi, ni, c.friction) * ellipse(vi, i));
+            let acc = push / m
+                - car.drag(vi) / m
+                - c.rolling_resistance.unwrap_or(rolling) * car.scales.rolling * G * ni.max(0.0)
+                - G * c.grade;
+            let next = (vi * vi + 2.0 * ds * acc).max(0.0).sqrt();
+            v[i + 1] = next.min(cap[i + 1]);
+        }
+    };
+    let backward = |v: &mut [f64]| {
+        for i in (0..n).rev() {
+            let c = track.sample(i);
+            let vn = v[i + 1];
+            let ni = normal(i, vn);
+            let stop = (total_grip(vn, ni, c.friction) * ellipse(vn, i)).min(brake_force);
+            let dec = stop / m
+                + car.drag(vn) / m
+                + c.rolling_resistance.unwrap_or(rolling) * car.scales.rolling * G * ni.max(0.0)
+                + G * c.grade;
+            let allowed = (vn * vn + 2.0 * ds * dec.max(0.0)).sqrt();
+            v[i] = v[i].min(allowed);
+        }
+    };
+
+    // 2. Forward pass from standing; a flying lap's again, from the speed the first ended
+    // with.
+    let mut v: Vec<f64> = vec![0.0; n + 1];
+    for pass in 0..if options.flying { 2 } else { 1 } {
+        if pass == 1 {
+            v[0] = v[n].min(cap[0]);
+        }
+        forward(&mut v);
     }
-    // 3. Backward pass from the finish.
-    for i in (0..n).rev() {
-        let c = track.sample(i);
-        let vn = v[i + 1];
-        let ni = normal(i, vn);
-        let stop = (total_grip(vn, ni, c.friction) * ellipse(vn, i)).min(brake_force);
-        let dec = stop / m
-            + car.drag(vn) / m
-            + c.rolling_resistance.unwrap_or(rolling) * car.scales.rolling * G * ni.max(0.0)
-            + G * c.grade;
-        let allowed = (vn * vn + 2.0 * ds * dec.max(0.0)).sqrt();
-        v[i] = v[i].min(allowed);
+    // 3. Backward pass from the finish; a flying lap's finish is its start, and the second
+    // pass brakes the lap's end for the next lap's first corner.
+    for pass in 0..if options.flying { 2 } else { 1 } {
+        if pass == 1 {
+            let closed = v[0].min(v[n]);
+            (v[0], v[n]) = (closed, closed);
+        }
+        backward(&mut v);
     }
     // 4. Lap time.
     let lap_time: f64 = (0..n).map(|i| 2.0 * ds / (v[i] + v[i + 1]).max(1e-9)).sum();
     Limit {
         lap_time_s: lap_time,
         reward_mps: track.length / lap_time,
+        flying: options.flying,
         track_length: track.length,
         speed: v,
     }
@@ -451,5 +494,54 @@ mod tests {
         assert!((9.0..13.0).contains(&lim.lap_time_s), "{}", lim.lap_time_s);
         assert_eq!(lim.speed[0], 0.0);
         assert!(lim.speed.windows(2).all(|w| w[1] >= w[0]));
+    }
+
+    /// A flying lap of a circle is driven at its cornering cap all the way round, the lap
+    /// time 2πr over that speed; the standing lap is slower by its launch.
+    #[test]
+    fn a_flying_circle_is_the_cap_all_the_way_round() {
+        let r = 100.0;
+        let p = Piece::flat(std::f64::consts::TAU * r, 1.0 / r);
+        let t = Track::from_pieces("circle", "test", &[p], vec![]);
+        let car = Car::spirit_300();
+        let standing = limit_lap(&t, &car);
+        let flying = limit_lap_with(&t, &car, LimitOptions::FLAT.flying());
+        let cap = flying.speed[t.len() / 2];
+        assert!(flying.speed.iter().all(|&v| (v - cap).abs() < 1e-9 * cap));
+        assert!((flying.lap_time_s - std::f64::consts::TAU * r / cap).abs() < 1e-6);
+        assert!(flying.flying && !standing.flying);
+        assert!(standing.lap_time_s > flying.lap_time_s + 1.0);
+    }
+
+    /// A flying lap crosses the line at the speed it ends with: on two 1 km straights joined
+    /// by hairpins of radius 15 m, the line 20 m before the first, the flying lap's finish
+    /// brakes for the hairpin past the line, where the standing lap ends flat out.
+    #[test]
+    fn a_flying_lap_brakes_before_the_line_for_the_next_laps_first_corner() {
+        let r = 15.0;
+        let hairpin = Piece::flat(std::f64::consts::PI * r, 1.0 / r);
+        let pieces = [
+            Piece::flat(20.0, 0.0),
+            hairpin,
+            Piece::flat(1000.0, 0.0),
+            hairpin,
+            Piece::flat(980.0, 0.0),
+        ];
+        let t = Track::from_pieces("hairpins", "test", &pieces, vec![]);
+        let car = Car::spirit_300();
+        let standing = limit_lap(&t, &car);
+        let flying = limit_lap_with(&t, &car, LimitOptions::FLAT.flying());
+        let n = t.len();
+        assert_eq!(flying.speed[0], flying.speed[n]);
+        assert_eq!(standing.speed[0], 0.0);
+        assert!(
+            flying.speed[n] < 0.5 * standing.speed[n],
+            "{} {}",
+            flying.speed[n],
+            standing.speed[n]
+        );
+        // Past the first hairpin both laps are the same lap again.
+        assert_eq!(flying.speed[n / 2], standing.speed[n / 2]);
+        assert!(flying.lap_time_s < standing.lap_time_s);
     }
 }

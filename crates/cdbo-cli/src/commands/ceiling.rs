@@ -29,6 +29,11 @@ pub struct CeilingArgs {
     /// policy completes.
     #[arg(long, value_name = "POLICY.json")]
     out: Option<std::path::PathBuf>,
+    /// The flying lap's ceiling: the second of two laps from the standing start, timed line
+    /// to line, tracking the flying lap's profile (it crosses the line at speed and brakes
+    /// before it for the next lap's first corner).
+    #[arg(long)]
+    flying: bool,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -55,7 +60,11 @@ pub fn run(args: &CeilingArgs, data: &DataPath) -> CliResult {
         Some(line) => cdbo::limit::line_limit_on_centre(&track, line, &car),
         None => cdbo::limit::limit_lap(&track, &car),
     };
-    let profile = cdbo::ceiling::profile(&track, &car, line.as_deref());
+    let profile = if args.flying {
+        cdbo::ceiling::flying_profile(&track, &car, line.as_deref())
+    } else {
+        cdbo::ceiling::profile(&track, &car, line.as_deref())
+    };
     let which = if line.is_some() {
         "minimum-curvature-line"
     } else {
@@ -68,6 +77,7 @@ pub fn run(args: &CeilingArgs, data: &DataPath) -> CliResult {
     let mut sim = cdbo::sim::Simulator::new(track, &car);
     sim.config.steering = args.steering.steering();
     sim.config.line = line;
+    sim.config.flying = args.flying;
     let c = ceiling_with(&sim, &limit, &profile, args.kernels)?;
     if args.json {
         print_json(&CeilingReport {

@@ -127,7 +127,11 @@ fn learn_on(
         Some(line) => cdbo::limit::line_limit_on_centre(&ours, line, &car),
         None => cdbo::limit::limit_lap(&ours, &car),
     };
-    let profile = cdbo::ceiling::profile(&ours, &car, line.as_deref());
+    let profile = if args.flying {
+        cdbo::ceiling::flying_profile(&ours, &car, line.as_deref())
+    } else {
+        cdbo::ceiling::profile(&ours, &car, line.as_deref())
+    };
     let ceiling = cdbo::ceiling::ceiling_with(&sim, &limit, &profile, args.kernels)?;
     let config = RaceConfig {
         method: stack.method(),

@@ -62,6 +62,22 @@ pub fn pedal_command(a: f64) -> f64 {
     if a.is_nan() { 0.0 } else { a }
 }
 
+/// The speed (m/s) a flying lap's run-up keeps at least ([`run_up_pedal`]): the profile
+/// tracker's floor, below the demonstrator's 15 m/s.
+pub const RUN_UP_FLOOR_MPS: f64 = profile::TRACKER_FLOOR_MPS;
+
+/// The pedal command on a flying lap's run-up, the standing lap before the timed one
+/// ([`crate::sim::LapConfig::flying`]): the policy's command `a`, but never below the
+/// floor's, a = max(a, clamp(v_min − v, −1, 1)) with v_min = [`RUN_UP_FLOOR_MPS`]. A
+/// policy over the lap fraction brakes where the flying lap must, also on the run-up,
+/// where the car comes to that place from a standstill far slower: without the floor it
+/// stops there. Above v_min + 1 m/s it is the policy's command. The TORCS robot's
+/// `drive::run_up_pedal` is the same.
+#[inline]
+pub fn run_up_pedal(a: f64, speed: f64) -> f64 {
+    a.max((RUN_UP_FLOOR_MPS - speed).clamp(-1.0, 1.0))
+}
+
 /// One step of a PI controller with anti-windup, the law of the demonstrator's speed hold
 /// ([`demo`]) and of the steering ([`steering`]): for the error e over `dt` seconds,
 /// u = clamp(K_p·e + K_i·I, −u_max, u_max), where the integral I += e·dt only while the
@@ -77,4 +93,21 @@ pub fn pi_control(kp: f64, ki: f64, limit: f64, integral: &mut f64, e: f64, dt: 
         *integral += e * dt;
     }
     (kp * e + ki * *integral).clamp(-limit, limit)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The run-up's floor: full throttle from a standstill, no braking below the floor, the
+    /// policy's command once the car is a metre per second past it.
+    #[test]
+    fn the_run_up_keeps_its_floor_speed() {
+        assert_eq!(run_up_pedal(-1.0, 0.0), 1.0);
+        assert_eq!(run_up_pedal(0.2, 9.5), 0.5);
+        assert_eq!(run_up_pedal(-1.0, RUN_UP_FLOOR_MPS), 0.0);
+        assert_eq!(run_up_pedal(-0.3, 10.5), -0.3);
+        assert_eq!(run_up_pedal(-1.0, 30.0), -1.0);
+        assert_eq!(run_up_pedal(0.7, 0.0), 1.0);
+    }
 }

@@ -6,7 +6,7 @@ use crate::{Agree, Calls, LEARNED, harness, lap, written};
 use cdbo::car::Car;
 use cdbo::drive::demo::{self, SpeedHold};
 use cdbo::drive::steering::{self, PiSteering};
-use cdbo::drive::{Observation, Pedal, pedal_command, pi_control};
+use cdbo::drive::{Observation, Pedal, pedal_command, pi_control, run_up_pedal};
 use cdbo::geometry;
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 use cdbo::policy::{PolicyTable, RkhsPolicy};
@@ -39,6 +39,24 @@ fn the_robots_decisions_are_the_rust_ones_on_recorded_laps() {
     for v in [f64::NAN, -3.0, -1.0, -0.25, -0.0, 0.0, 0.7, 1.0, 2.5] {
         let a = pedal_command(v);
         calls.check("pedal", "pedal_command", &[v], &[a], Agree::Exactly);
+    }
+    // A flying lap's run-up: the floor below, at and above its speed.
+    for (a, speed) in [
+        (-1.0, 0.0),
+        (-0.3, 9.5),
+        (0.2, 9.0),
+        (-1.0, 10.0),
+        (-0.6, 10.4),
+        (-1.0, 30.0),
+    ] {
+        let floored = run_up_pedal(a, speed);
+        calls.check(
+            "run-up",
+            "run_up_pedal",
+            &[a, speed],
+            &[floored],
+            Agree::Exactly,
+        );
     }
     // The tables at their own points, where the segment changes (there a value far below
     // its neighbour's tells the two sides apart), and beyond their ends.
