@@ -1,8 +1,8 @@
 //! `cdbo torcs learn`: from a track to a race-ready policy in one command. cdbo's simulator
 //! first (the ceiling's policy: the limit's speed profile tracked on the minimum-curvature line
-//! and fitted; where no fit completes, the recommended learner's best), then a bounded number
-//! of laps of the recommended learner in the game from it, the result beside the fastest
-//! shipped robot's laps on that track.
+//! and fitted with M and with 2M kernels, the faster fit kept; where no fit completes, the
+//! recommended learner's best), then a bounded number of laps of the recommended learner in
+//! the game from it, the result beside the fastest shipped robot's laps on that track.
 
 use std::path::PathBuf;
 
@@ -26,7 +26,9 @@ pub struct LearnArgs {
     /// TORCS car name.
     #[arg(long, default_value = torcs::DEFAULT_CAR)]
     car: String,
-    /// Policy kernels M.
+    /// Policy kernels M: the ceiling's policy is fitted with M and with 2M kernels, and the
+    /// faster fit in cdbo's simulator is learned on (the finer one where a track's corners
+    /// are closer together than M kernels can brake for).
     #[arg(long, default_value_t = 50, value_parser = super::value::kernels)]
     kernels: usize,
     /// Laps of the recommended learner in the game, after cdbo's simulator (the game also
@@ -55,6 +57,8 @@ struct TrackResult {
     track: String,
     /// Where the game's laps started from: `ceiling` or `recommended learner`.
     start: &'static str,
+    /// The policy's kernels.
+    kernels: usize,
     /// The starting policy's lap in cdbo's simulator (s).
     sim_lap_s: Option<f64>,
     /// The game's laps of the learner (the demonstration not counted), and how many failed.
@@ -132,10 +136,22 @@ fn learn_on(
     } else {
         cdbo::ceiling::profile(&ours, &car, line.as_deref())
     };
-    let ceiling = cdbo::ceiling::ceiling_with(&sim, &limit, &profile, args.kernels)?;
+    // The ceiling's fits with M and 2M kernels; the faster completed one.
+    let mut ceiling = cdbo::ceiling::ceiling_with(&sim, &limit, &profile, args.kernels)?;
+    let finer = 2 * args.kernels;
+    if finer <= cdbo::learner::pattern_search::push::MAX_KERNELS {
+        let fine = cdbo::ceiling::ceiling_with(&sim, &limit, &profile, finer)?;
+        if fine.policy_mps > ceiling.policy_mps {
+            ceiling = fine;
+        }
+    }
+    let kernels = ceiling
+        .policy
+        .as_ref()
+        .map_or(args.kernels, |_| ceiling.kernels);
     let config = RaceConfig {
         method: stack.method(),
-        kernels: args.kernels,
+        kernels,
         seed: args.seed,
         base_line,
         flying: args.flying,
@@ -189,6 +205,7 @@ fn learn_on(
     Ok(TrackResult {
         track: track.to_owned(),
         start: start_name,
+        kernels,
         sim_lap_s,
         game_laps: outcome.laps.len(),
         game_failed_laps: outcome.laps.iter().filter(|l| l.failure.is_some()).count(),
@@ -204,10 +221,11 @@ fn learn_on(
 /// beats.
 fn markdown(results: &[TrackResult], args: &LearnArgs) -> String {
     let mut out = format!(
-        "{}, {} kernels, seed {}: cdbo's simulator, then {} laps of the recommended learner in \
+        "{}, {} or {} kernels, seed {}: cdbo's simulator, then {} laps of the recommended learner in \
          the game{}; the best policy's laps in the game beside the fastest shipped robot's\n\n",
         args.car,
         args.kernels,
+        2 * args.kernels,
         args.seed,
         args.game_laps,
         if args.flying {
@@ -235,9 +253,10 @@ fn markdown(results: &[TrackResult], args: &LearnArgs) -> String {
         let (ours_s, robot_s) = against(r.standing_lap_s, &r.robot_standing);
         let (ours_f, robot_f) = against(r.flying_lap_s, &r.robot_flying);
         out += &format!(
-            "| {} | {} | {} | {} ({}) | {ours_s} | {robot_s} | {ours_f} | {robot_f} |\n",
+            "| {} | {}, {} kernels | {} | {} ({}) | {ours_s} | {robot_s} | {ours_f} | {robot_f} |\n",
             r.track,
             r.start,
+            r.kernels,
             cell(r.sim_lap_s),
             r.game_laps,
             r.game_failed_laps
