@@ -38,7 +38,8 @@ pub(crate) fn hypot(x: f64, y: f64) -> f64 {
 pub(crate) fn hypot_lanes(x: F64x4, y: F64x4) -> F64x4 {
     let (big, small) = ordered(x, y);
     if !within(big, small).all() {
-        return F64x4(std::array::from_fn(|i| hypot(x.0[i], y.0[i])));
+        let (x, y) = (x.to_array(), y.to_array());
+        return F64x4::new(std::array::from_fn(|i| hypot(x[i], y[i])));
     }
     corrected(big, small)
 }
@@ -151,7 +152,7 @@ mod tests {
             lanes.push((p.map(|p| p.0), p.map(|p| p.1)));
         }
         for (x, y) in lanes {
-            let four = hypot_lanes(F64x4(x), F64x4(y)).0;
+            let four = hypot_lanes(F64x4::new(x), F64x4::new(y)).to_array();
             for i in 0..4 {
                 let one = hypot(x[i], y[i]);
                 assert_eq!(

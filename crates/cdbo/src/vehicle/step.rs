@@ -27,19 +27,24 @@ impl Vehicle {
             &self.tyres[1],
             &self.tyres[1],
         ];
-        let (vt, vl, floor) = (F64x4(w.vt), F64x4(w.vl), F64x4::splat(SLIP_SPEED_FLOOR));
-        let fmax = TyreModel::wheel_max_force_lanes(tyres, F64x4(w.loads), F64x4(w.friction));
+        let (vt, vl, floor) = (
+            F64x4::new(w.vt),
+            F64x4::new(w.vl),
+            F64x4::splat(SLIP_SPEED_FLOOR),
+        );
+        let fmax =
+            TyreModel::wheel_max_force_lanes(tyres, F64x4::new(w.loads), F64x4::new(w.friction));
         let inv = F64x4::splat(1.0) / vt.abs().max(floor);
         let speed = hypot_lanes(vt, vl).max(floor);
         // The front wheels divide −v_l by the speed, the rear ones multiply it by the
         // speed's reciprocal: q = n/max(|v|, v₀) with n = −v_l or 1, then s_y = q·1 or q·(−v_l).
         let [l, r, rl, rr] = w.vl;
-        let sy = F64x4([-l, -r, 1.0, 1.0]) / speed * F64x4([1.0, 1.0, -rl, -rr]);
-        let sx = (F64x4(w.spin) - vt) * inv;
+        let sy = F64x4::new([-l, -r, 1.0, 1.0]) / speed * F64x4::new([1.0, 1.0, -rl, -rr]);
+        let sx = (F64x4::new(w.spin) - vt) * inv;
         WheelTyres {
             forces: TyreModel::forces_lanes(tyres, sx, sy, fmax),
-            fmax: fmax.0,
-            inv: inv.0,
+            fmax: fmax.to_array(),
+            inv: inv.to_array(),
         }
     }
 

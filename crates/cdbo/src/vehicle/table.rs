@@ -59,24 +59,25 @@ impl HermiteTable {
     /// every xᵢ is in its table's range.
     #[inline(always)]
     pub(crate) fn eval_lanes(tables: [&HermiteTable; 4], x: F64x4) -> Option<(F64x4, F64x4)> {
-        let inv_step = F64x4(tables.map(|t| t.inv_step));
+        let inv_step = F64x4::new(tables.map(|t| t.inv_step));
         let u = x * inv_step;
-        let inside = u.ge(F64x4::splat(0.0)) & u.lt(F64x4(tables.map(|t| t.intervals)));
+        let inside = u.ge(F64x4::splat(0.0)) & u.lt(F64x4::new(tables.map(|t| t.intervals)));
         if !inside.all() {
             return None;
         }
+        let u = u.to_array();
         let mut t = [0.0; 4];
         // [fₖ, h·f′ₖ, fₖ₊₁, h·f′ₖ₊₁], each a vector of the four lanes.
         let mut nodes = [[0.0; 4]; 4];
         for i in 0..4 {
             let k;
-            (k, t[i]) = node_and_fraction(u.0[i]);
+            (k, t[i]) = node_and_fraction(u[i]);
             let [(f0, m0), (f1, m1)] = tables[i].nodes[k..k + 2] else {
                 return None;
             };
             (nodes[0][i], nodes[1][i], nodes[2][i], nodes[3][i]) = (f0, m0, f1, m1);
         }
-        Some(interpolate(F64x4(t), nodes.map(F64x4), inv_step))
+        Some(interpolate(F64x4::new(t), nodes.map(F64x4::new), inv_step))
     }
 
     /// The end of the table's range.

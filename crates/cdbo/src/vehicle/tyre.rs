@@ -18,7 +18,7 @@
 //! g is smooth in u, and Fₓ = F_max·g(u)·sₓ, F_y = F_max·g(u)·s_y need neither a square root
 //! nor a division.
 
-use super::lanes::{F64x4, Lane};
+use super::lanes::{AnyLane, F64x4, Lane};
 use super::table::HermiteTable;
 use crate::car::Tyre;
 
@@ -181,12 +181,15 @@ impl TyreModel {
         fz: F64x4,
         surface: F64x4,
     ) -> F64x4 {
-        let z = fz * F64x4(tyres.map(|t| t.inv_operating_load));
+        let z = fz * F64x4::new(tyres.map(|t| t.inv_operating_load));
         let load_factor = match HermiteTable::eval_lanes(tyres.map(|t| &t.load_table), z) {
             Some((l, _)) => l,
-            None => F64x4(std::array::from_fn(|i| tyres[i].load_factor(fz.0[i]))),
+            None => {
+                let fz = fz.to_array();
+                F64x4::new(std::array::from_fn(|i| tyres[i].load_factor(fz[i])))
+            }
         };
-        fz * F64x4(tyres.map(|t| t.mu)) * surface * load_factor
+        fz * F64x4::new(tyres.map(|t| t.mu)) * surface * load_factor
     }
 
     /// [`TyreModel::forces`] of four tyres side by side, `tyres[i]` at slip (`sx[i]`, `sy[i]`)
@@ -203,17 +206,22 @@ impl TyreModel {
         let ratio = match HermiteTable::eval_lanes(tyres.map(|t| &t.ratio_table), u) {
             Some(table) => table,
             None => {
-                let exact: [(f64, f64); 4] = std::array::from_fn(|i| tyres[i].ratio(u.0[i]));
-                (F64x4(exact.map(|r| r.0)), F64x4(exact.map(|r| r.1)))
+                let u = u.to_array();
+                let exact: [(f64, f64); 4] = std::array::from_fn(|i| tyres[i].ratio(u[i]));
+                (
+                    F64x4::new(exact.map(|r| r.0)),
+                    F64x4::new(exact.map(|r| r.1)),
+                )
             }
         };
-        let skid = F64x4(tyres.map(|t| t.skid));
+        let skid = F64x4::new(tyres.map(|t| t.skid));
         let [fx, fy, dfx_dsx, dfy_dsx] = forces_of(fmax, ratio, u, (sx, sy), skid);
+        let [fx, fy, dfx_dsx, dfy_dsx] = [fx, fy, dfx_dsx, dfy_dsx].map(F64x4::to_array);
         std::array::from_fn(|i| Forces {
-            fx: fx.0[i],
-            fy: fy.0[i],
-            dfx_dsx: dfx_dsx.0[i],
-            dfy_dsx: dfy_dsx.0[i],
+            fx: fx[i],
+            fy: fy[i],
+            dfx_dsx: dfx_dsx[i],
+            dfy_dsx: dfy_dsx[i],
         })
     }
 
@@ -254,14 +262,20 @@ pub struct Forces {
 /// [Fₓ, F_y, ∂Fₓ/∂sₓ, ∂F_y/∂sₓ] ([`TyreModel::forces`]) at slip (sₓ, s_y) = `slip`, u = sₓ² + s_y²,
 /// under the budget `fmax`, with the shape's ratio (g, g′) at u and the skid factor k = `skid`
 /// (none at 0): with one, g·m and g′·m + g·m′ for its multiplier m(u)
-/// ([`TyreModel::skid_multiplier`]). Both are computed and one kept, without branches.
+/// ([`TyreModel::skid_multiplier`]): where any lane has one, both are computed and each lane
+/// keeps its own, without branches; where none has, the multiplier is not computed.
 #[inline(always)]
 fn forces_of<T: Lane>(fmax: T, (g, dg): (T, T), u: T, (sx, sy): (T, T), skid: T) -> [T; 4] {
-    let (m, dm) = skid_multiplier(u, skid);
     let skidding = skid.gt(T::splat(0.0));
-    let g_skid = g * m;
-    let dg = T::select(skidding, dg * m + g * dm, dg);
-    let g = T::select(skidding, g_skid, g);
+    let (g, dg) = if skidding.any() {
+        let (m, dm) = skid_multiplier(u, skid);
+        (
+            T::select(skidding, g * m, g),
+            T::select(skidding, dg * m + g * dm, dg),
+        )
+    } else {
+        (g, dg)
+    };
     let (fg, two_dg_sx) = (fmax * g, fmax * T::splat(2.0) * dg * sx);
     [fg * sx, fg * sy, fg + two_dg_sx * sx, two_dg_sx * sy]
 }
@@ -396,8 +410,10 @@ mod tests {
             let top = if n % 10 == 1 { 40_000.0 } else { 8000.0 };
             let fz: [f64; 4] = std::array::from_fn(|_| rng.random_range(0.0..top));
             let surface: [f64; 4] = std::array::from_fn(|_| rng.random_range(0.3..1.2));
-            let fmax = TyreModel::wheel_max_force_lanes(tyres, F64x4(fz), F64x4(surface)).0;
-            let forces = TyreModel::forces_lanes(tyres, F64x4(sx), F64x4(sy), F64x4(fmax));
+            let fmax = TyreModel::wheel_max_force_lanes(tyres, F64x4::new(fz), F64x4::new(surface))
+                .to_array();
+            let forces =
+                TyreModel::forces_lanes(tyres, F64x4::new(sx), F64x4::new(sy), F64x4::new(fmax));
             for i in 0..4 {
                 let one = tyres[i].wheel_max_force(fz[i], surface[i]);
                 assert_eq!(fmax[i].to_bits(), one.to_bits(), "{} N", fz[i]);
