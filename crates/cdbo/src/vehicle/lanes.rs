@@ -39,8 +39,9 @@ pub(crate) trait Lane:
     fn sqrt(self) -> Self;
     /// [`f64::abs`].
     fn abs(self) -> Self;
-    /// [`f64::max`].
-    fn max(self, other: Self) -> Self;
+    /// [`f64::max`]`(self, floor)` for a `floor` that is neither NaN nor a zero: `floor` where
+    /// `self` is below it or NaN.
+    fn at_least(self, floor: f64) -> Self;
     /// self < other.
     fn lt(self, other: Self) -> Self::Mask;
     /// self ≤ other.
@@ -72,8 +73,8 @@ impl Lane for f64 {
     }
 
     #[inline(always)]
-    fn max(self, other: f64) -> f64 {
-        f64::max(self, other)
+    fn at_least(self, floor: f64) -> f64 {
+        f64::max(self, floor)
     }
 
     #[inline(always)]
@@ -233,13 +234,10 @@ impl Lane for F64x4 {
         F64x4([sign.and_not(self.0[0]), sign.and_not(self.0[1])])
     }
 
-    /// [`f64::max`] lane by lane: `other` where it is the greater or `self` is NaN, else
-    /// `self` (the x86-64 code of [`f64::max`]).
     #[inline(always)]
-    fn max(self, other: F64x4) -> F64x4 {
-        let greater = Lane::select(other.gt(self), other, self);
-        let nan = self.compare(self, Pair::unordered);
-        Lane::select(nan, other, greater)
+    fn at_least(self, floor: f64) -> F64x4 {
+        let floor = Pair::splat(floor);
+        F64x4([self.0[0].at_least(floor), self.0[1].at_least(floor)])
     }
 
     #[inline(always)]
@@ -363,10 +361,11 @@ impl Pair {
         Pair(sse2!(_mm_cmple_pd(self.0, o.0)))
     }
 
-    /// Whether either is NaN.
+    /// `self` where it is greater than `floor`, else `floor` (SSE2's maximum): [`f64::max`]'s
+    /// bits for a `floor` that is neither NaN nor a zero.
     #[inline(always)]
-    fn unordered(self, o: Pair) -> Pair {
-        Pair(sse2!(_mm_cmpunord_pd(self.0, o.0)))
+    fn at_least(self, floor: Pair) -> Pair {
+        Pair(sse2!(_mm_max_pd(self.0, floor.0)))
     }
 
     /// The lanes' sign bits, lane 0 in bit 0.
@@ -469,10 +468,10 @@ impl Pair {
         self.mask(o, |a, b| a <= b)
     }
 
-    /// Whether either is NaN.
+    /// [`f64::max`] lane by lane.
     #[inline(always)]
-    fn unordered(self, o: Pair) -> Pair {
-        self.mask(o, |a, b| a.is_nan() || b.is_nan())
+    fn at_least(self, floor: Pair) -> Pair {
+        self.map2(floor, f64::max)
     }
 
     /// The lanes' sign bits, lane 0 in bit 0.
@@ -526,17 +525,12 @@ mod tests {
             assert_eq!(bits((-x).to_array()), bits(lanes(&|p, _| -p)));
             assert_eq!(bits(x.sqrt().to_array()), bits(lanes(&|p, _| p.sqrt())));
             assert_eq!(bits(x.abs().to_array()), bits(lanes(&|p, _| p.abs())));
-            // f64::max leaves the sign of an equal zero open: compare values, NaN with NaN.
-            let max = x.max(y).to_array();
-            for i in 0..4 {
-                let want = a[i].max(b[i]);
-                assert!(max[i] == want || (max[i].is_nan() && want.is_nan()));
+            for floor in [2.0, -2.0, 1e-300, f64::INFINITY] {
+                assert_eq!(
+                    bits(x.at_least(floor).to_array()),
+                    bits(lanes(&|p, _| p.max(floor)))
+                );
             }
-            let floor = F64x4::splat(2.0);
-            assert_eq!(
-                bits(x.max(floor).to_array()),
-                bits(lanes(&|p, _| p.max(2.0)))
-            );
             type Compare = (fn(F64x4, F64x4) -> Mask4, fn(&f64, &f64) -> bool);
             let compares: [Compare; 4] = [
                 (<F64x4 as Lane>::lt, PartialOrd::lt),

@@ -27,15 +27,11 @@ impl Vehicle {
             &self.tyres[1],
             &self.tyres[1],
         ];
-        let (vt, vl, floor) = (
-            F64x4::new(w.vt),
-            F64x4::new(w.vl),
-            F64x4::splat(SLIP_SPEED_FLOOR),
-        );
+        let (vt, vl) = (F64x4::new(w.vt), F64x4::new(w.vl));
         let fmax =
             TyreModel::wheel_max_force_lanes(tyres, F64x4::new(w.loads), F64x4::new(w.friction));
-        let inv = F64x4::splat(1.0) / vt.abs().max(floor);
-        let speed = hypot_lanes(vt, vl).max(floor);
+        let inv = F64x4::splat(1.0) / vt.abs().at_least(SLIP_SPEED_FLOOR);
+        let speed = hypot_lanes(vt, vl).at_least(SLIP_SPEED_FLOOR);
         // The front wheels divide −v_l by the speed, the rear ones multiply it by the
         // speed's reciprocal: q = n/max(|v|, v₀) with n = −v_l or 1, then s_y = q·1 or q·(−v_l).
         let [l, r, rl, rr] = w.vl;
