@@ -1,6 +1,6 @@
 //! `cdbo torcs learn`: from a track to a race-ready policy in one command. cdbo's simulator
 //! first (the ceiling's policy: the limit's speed profile tracked on the minimum-curvature line
-//! and fitted with M and with 2M kernels, the faster fit kept; where no fit completes, the
+//! and fitted with M, 2M and 4M kernels, the fastest fit kept; where no fit completes, the
 //! recommended learner's best), then a bounded number of laps of the recommended learner in
 //! the game from it, the result beside the fastest shipped robot's laps on that track.
 
@@ -26,9 +26,9 @@ pub struct LearnArgs {
     /// TORCS car name.
     #[arg(long, default_value = torcs::DEFAULT_CAR)]
     car: String,
-    /// Policy kernels M: the ceiling's policy is fitted with M and with 2M kernels, and the
-    /// faster fit in cdbo's simulator is learned on (the finer one where a track's corners
-    /// are closer together than M kernels can brake for).
+    /// Policy kernels M: the ceiling's policy is fitted with M, 2M and 4M kernels (at most
+    /// 200, the pattern search's), and the fastest fit in cdbo's simulator is learned on (a
+    /// finer one where a track's corners are closer together than M kernels brake for).
     #[arg(long, default_value_t = 50, value_parser = super::value::kernels)]
     kernels: usize,
     /// Laps of the recommended learner in the game, after cdbo's simulator (the game also
@@ -105,6 +105,14 @@ pub fn run(args: &LearnArgs, data: &DataPath) -> CliResult {
     Ok(())
 }
 
+/// The finer policies the ceiling is also fitted with: 2M and 4M kernels, as many as the
+/// pattern search pushes ([`MAX_KERNELS`](cdbo::learner::pattern_search::push::MAX_KERNELS)).
+fn finer_kernels(kernels: usize) -> impl Iterator<Item = usize> {
+    [2 * kernels, 4 * kernels]
+        .into_iter()
+        .filter(|&m| m <= cdbo::learner::pattern_search::push::MAX_KERNELS)
+}
+
 /// A lap time in a cell: `83.85 s`, or `fails`.
 fn cell(lap: Option<f64>) -> String {
     lap.map_or("fails".into(), |t| format!("{t:.2} s"))
@@ -136,10 +144,9 @@ fn learn_on(
     } else {
         cdbo::ceiling::profile(&ours, &car, line.as_deref())
     };
-    // The ceiling's fits with M and 2M kernels; the faster completed one.
+    // The ceiling's fits with M, 2M and 4M kernels; the fastest completed one.
     let mut ceiling = cdbo::ceiling::ceiling_with(&sim, &limit, &profile, args.kernels)?;
-    let finer = 2 * args.kernels;
-    if finer <= cdbo::learner::pattern_search::push::MAX_KERNELS {
+    for finer in finer_kernels(args.kernels) {
         let fine = cdbo::ceiling::ceiling_with(&sim, &limit, &profile, finer)?;
         if fine.policy_mps > ceiling.policy_mps {
             ceiling = fine;
@@ -221,11 +228,10 @@ fn learn_on(
 /// beats.
 fn markdown(results: &[TrackResult], args: &LearnArgs) -> String {
     let mut out = format!(
-        "{}, {} or {} kernels, seed {}: cdbo's simulator, then {} laps of the recommended learner in \
+        "{}, {} kernels or finer, seed {}: cdbo's simulator, then {} laps of the recommended learner in \
          the game{}; the best policy's laps in the game beside the fastest shipped robot's\n\n",
         args.car,
         args.kernels,
-        2 * args.kernels,
         args.seed,
         args.game_laps,
         if args.flying {
