@@ -7,10 +7,12 @@ use std::sync::Arc;
 
 use crate::car::Car;
 use crate::drive::demo::SpeedHold;
+use crate::drive::profile::ProfileHold;
 use crate::drive::steering::Steering;
 use crate::error::Result;
 use crate::evaluator::Evaluator;
 use crate::evaluator::simulator::SimEvaluator;
+use crate::experiment::start::Demonstration;
 use crate::line::RacingLine;
 use crate::policy::{Policy, PolicyShape};
 use crate::sim::lap::{GAME_OFF_TRACK_MARGIN, Reserve};
@@ -151,6 +153,37 @@ impl Venue {
             } => {
                 let pedal = GamePedal::Demo(speed);
                 let hold = SpeedHold::new(speed);
+                let req = with_pedal(&recorded(request), track, pedal, &hold, false);
+                let lap = drive(game, &req)?;
+                let pairs = lap.trace.iter().map(|p| (p.x, p.pedal)).collect();
+                Ok((lap, pairs))
+            }
+        }
+    }
+
+    /// The profile demonstration: the lap of a profile hold ([`ProfileHold`]) at k times
+    /// `profile`'s speeds (m/s, at stations spaced evenly over the lap), with the (x, a)
+    /// pairs of every driver step.
+    pub fn demonstrate_profile(&self, profile: &[f64], k: f64) -> Result<Demonstration> {
+        match self {
+            Venue::Simulator(sim) => {
+                let length = sim.track.length;
+                let lap = traced(sim).lap(&mut ProfileHold { profile, length, k });
+                let pairs = lap.trace.iter().map(|p| (p.x, p.pedal)).collect();
+                Ok((lap, pairs))
+            }
+            Venue::Game {
+                game,
+                request,
+                track,
+            } => {
+                let length = track.length;
+                let pedal = GamePedal::Profile {
+                    k,
+                    length,
+                    speed: profile.to_vec(),
+                };
+                let hold = ProfileHold { profile, length, k };
                 let req = with_pedal(&recorded(request), track, pedal, &hold, false);
                 let lap = drive(game, &req)?;
                 let pairs = lap.trace.iter().map(|p| (p.x, p.pedal)).collect();

@@ -52,7 +52,9 @@ pub struct RaceArgs {
     beta: f64,
     /// Speed of the demonstrator (m/s), held exactly. Default: the paper's 15 m/s, or where
     /// that lap leaves the road, the fastest constant speed that completes (a short search,
-    /// said in one line).
+    /// said in one line); the safe pattern search instead holds 0.8 of the largest share of
+    /// the limit's speed profile on the line, braking gently, whose lap completes (said in
+    /// one line).
     #[arg(long, allow_negative_numbers = true, value_parser = super::value::positive)]
     demo_speed: Option<f64>,
     /// The method's main knob: σ₀ (CDBO's initial samples, CMA-ES's and random search's σ, the
@@ -133,6 +135,10 @@ struct Summary {
     /// Where the asked speed's demonstration failed: what was chosen instead, and why.
     #[serde(skip_serializing_if = "Option::is_none")]
     demo_choice: Option<cdbo::experiment::start::DemoChoice>,
+    /// The profile start's demonstration (the safe pattern search's), where the race began
+    /// with one: its scale of the limit's profile.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    demo_profile: Option<cdbo::experiment::profile_start::ProfileChoice>,
     /// Laps of the first policy π(w₀) that failed before its repaired lap completed (the
     /// race's first laps, among the failed ones).
     start_failed_laps: usize,
@@ -308,11 +314,13 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
         first_lap_reward_mps: outcome.laps.first().map_or(0.0, |l| l.reward_mps),
         first_lap_time_s: outcome.laps.first().and_then(|l| l.lap_time_s),
         demo_reward_mps: outcome.demo.reward_mps,
-        demo_speed_mps: outcome
-            .demo_choice
-            .as_ref()
-            .map_or(config.demo_speed, |c| c.chosen_mps),
+        demo_speed_mps: match (&outcome.demo_choice, &outcome.profile_choice) {
+            (_, Some(p)) => p.speed_mps,
+            (Some(c), None) => c.chosen_mps,
+            (None, None) => config.demo_speed,
+        },
         demo_choice: outcome.demo_choice.clone(),
+        demo_profile: outcome.profile_choice,
         start_failed_laps: outcome.start_failed_laps,
         flying: args.flying,
         best_reward_mps: outcome.best_reward_mps,
@@ -339,6 +347,9 @@ pub fn run(args: &RaceArgs, data: &DataPath, simulator: Simulator) -> CliResult 
     }
     if let Some(choice) = &summary.demo_choice {
         println!("{}", capitalised(&choice.sentence(&summary.track)));
+    }
+    if let Some(choice) = &summary.demo_profile {
+        println!("{}", capitalised(&choice.sentence()));
     }
     if summary.start_failed_laps > 0 {
         println!(

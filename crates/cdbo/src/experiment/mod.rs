@@ -6,6 +6,7 @@
 
 pub mod folder;
 pub mod grid;
+pub mod profile_start;
 pub mod race;
 pub mod record;
 pub mod shared;

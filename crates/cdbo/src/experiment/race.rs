@@ -18,6 +18,7 @@ use crate::study::run::{Event, InMemory, run};
 use crate::track::Track;
 use crate::venue::Venue;
 
+use super::profile_start::{ProfileChoice, ProfileDemonstrator};
 use super::start::{DemoChoice, Demonstration, DrivenOnce, Start, complete_start, demonstration};
 
 pub use crate::line::BaseLine;
@@ -181,6 +182,9 @@ pub struct RaceOutcome {
     pub demo: LapResult,
     /// What the demonstration search chose where the asked speed's lap failed.
     pub demo_choice: Option<DemoChoice>,
+    /// The profile start's demonstration, where the race began with one
+    /// ([`super::profile_start`]).
+    pub profile_choice: Option<ProfileChoice>,
     /// Laps of the first policy that failed before one completed
     /// ([`super::start::complete_start`]): the race's first laps, among its failed ones.
     pub start_failed_laps: usize,
@@ -232,25 +236,52 @@ pub fn race(
         }
         None => venue,
     };
-    let (demo, choice) = demonstration(config.demo_speed, config.fixed_demo_speed, |v| {
-        venue.demonstrate(v)
-    })?;
     let mut evaluator = if config.flying {
         venue.clone().flying().evaluator(config.shape()?)?
     } else {
         venue.evaluator(config.shape()?)?
     };
-    let speed = choice.as_ref().map_or(config.demo_speed, |c| c.chosen_mps);
-    let mut outcome = race_with(
-        &track.name,
-        (demo, speed),
-        limit,
-        config,
-        (evaluator.as_mut(), &mut |v| venue.demonstrate(v)),
-        progress,
-    )?;
+    // The safe pattern search starts near the limit (its budget of failed laps cannot pay
+    // for the climb from 15 m/s on a long circuit); a speed asked for is held as asked.
+    let profiled = config.method == Method::SafePatternSearch
+        && !config.fixed_demo_speed
+        && config.warm_start.is_none();
+    let profile = profiled.then(|| ProfileDemonstrator::new(track, car, line.as_deref()));
+    let chosen = match &profile {
+        Some(p) => p.choose(venue)?,
+        None => None,
+    };
+    let mut outcome = match (chosen, &profile) {
+        (Some((demo, choice)), Some(profile)) => {
+            let mut outcome = race_with(
+                &track.name,
+                (demo, choice.speed_mps),
+                limit,
+                config,
+                (evaluator.as_mut(), &mut |v| profile.demonstrate(venue, v)),
+                progress,
+            )?;
+            outcome.profile_choice = Some(choice);
+            outcome
+        }
+        _ => {
+            let (demo, choice) = demonstration(config.demo_speed, config.fixed_demo_speed, |v| {
+                venue.demonstrate(v)
+            })?;
+            let speed = choice.as_ref().map_or(config.demo_speed, |c| c.chosen_mps);
+            let mut outcome = race_with(
+                &track.name,
+                (demo, speed),
+                limit,
+                config,
+                (evaluator.as_mut(), &mut |v| venue.demonstrate(v)),
+                progress,
+            )?;
+            outcome.demo_choice = choice;
+            outcome
+        }
+    };
     outcome.line = line;
-    outcome.demo_choice = choice;
     Ok(outcome)
 }
 
@@ -351,6 +382,7 @@ fn race_with(
                 demo,
                 demo_pairs,
                 demo_choice: None,
+                profile_choice: None,
                 start_failed_laps: start_failed,
                 best: s.policy.clone(),
                 initial,
@@ -418,6 +450,7 @@ fn race_with(
         demo,
         demo_pairs,
         demo_choice: None,
+        profile_choice: None,
         start_failed_laps: start_failed,
         initial,
         best: shape.policy(&best.0)?,

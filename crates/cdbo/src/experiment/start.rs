@@ -7,7 +7,9 @@
 //! the speed falls by [`SLOWDOWN`] until a lap completes (no slower than [`SLOWEST`]), then
 //! [`BISECTIONS`] halvings of the interval between the slowest failing and the fastest
 //! completing speed. Each is one lap of the demonstrator, not counted among the race's laps
-//! (as the paper's demonstration is not). Where 15 m/s completes nothing changes.
+//! (as the paper's demonstration is not). Where 15 m/s completes nothing changes. The safe
+//! pattern search demonstrates near the limit instead ([`super::profile_start`]), unless a
+//! speed was asked for.
 //!
 //! **The first policy.** w₀, the demonstration's fit, is a smoothed copy of the demonstrator's
 //! pedal, and can be faster than the demonstrator where the fit spreads its launch: where its

@@ -25,7 +25,9 @@ pub enum Preset {
     /// curvature and the car's understeer gradient, and so holds its line at speed where the
     /// paper's PI steering, steering at a look-ahead point, cuts corners and fishtails; the
     /// minimum-curvature racing line has a faster limit lap than the centre line (`cdbo
-    /// limit` gives both). The paper's CDBO, PI steering and centre line stay the defaults.
+    /// limit` gives both). Its demonstration holds a share of the limit's speed profile on
+    /// that line ([`crate::experiment::profile_start`]), not the paper's 15 m/s. The paper's
+    /// CDBO, PI steering and centre line stay the defaults.
     FastSafe,
 }
 
