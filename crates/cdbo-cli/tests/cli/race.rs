@@ -24,11 +24,9 @@ fn bad_race_knobs_are_refused_in_one_line() {
 }
 
 /// The safe pattern search keeps to its own budget: at most 30 failed laps in a 300-lap race
-/// by default, with a best lap faster than the demonstration (27.82 m/s), and at most 10 with
-/// `--max-failed-laps 10`, with a best lap faster than its first. (Since the built-in car has
-/// two rear wheels, sc-spirit-300.xml's roll centres and springs make it oversteer at less
-/// throttle, and with 10 failed laps the search stops at 14.86 m/s, just short of the
-/// demonstration's 14.96; it reached 26.87 on the single-track car.)
+/// by default, with a best lap faster than the demonstration (its profile start's hold,
+/// 25.61 m/s: 32.91 m/s after 27 failed laps), and at most 10 with `--max-failed-laps 10`,
+/// with a best lap faster than its first (27.72 m/s: 28.23 m/s).
 #[test]
 #[ignore = "slow: two 300-lap races of the safe pattern search"]
 fn the_safe_search_keeps_its_budget_in_a_race() {
