@@ -156,7 +156,8 @@ impl PyRaceResult {
 /// searching w₀ ± `bounds` (as `--box-radius`; None: 1.5), on the flying lap if `flying` (as
 /// `--flying`: the second of two laps from the standing start, timed line to line).
 /// `demo_speed` (m/s) is held exactly, as `--demo-speed`; None: the paper's 15 m/s, or where its
-/// lap fails the fastest constant speed that completes (the race says which).
+/// lap fails the fastest constant speed that completes (the race says which); the safe pattern
+/// search's: a hold of a share of the limit's speed profile (`cdbo::experiment::profile_start`).
 /// `track` and `car` are objects or names; `knob` is the method's main knob (`cdbo race
 /// --knob`; None: its tuned value); `progress(record)` is called after every lap with the
 /// lap's record (a dict).
