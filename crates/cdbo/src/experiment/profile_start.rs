@@ -24,7 +24,7 @@
 //! A demonstration's speed, as the start reports and slows it, is k times the profile's
 //! reward (the crest-aware limit's L/T).
 //!
-//! Measured with the recommended stack at 501a56f (seeds 0–2, cdbo's simulator;
+//! Measured with the recommended stack at a9d677b (seeds 0–2, cdbo's simulator;
 //! docs/results/any-track.md): TUMFTM's 13 circuits 72.7 → 84.2 % of the centre-line limit,
 //! TORCS's 21 road tracks with car1-trb1 89.4 → 94.5 %. On the 13 circuits, seed 0:
 //! [`DECEL`] 3 against 4 m/s², and [`SCALE`] 0.8 against 0.75 and 0.85, gave 84.0 against
