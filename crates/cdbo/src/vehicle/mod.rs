@@ -16,6 +16,9 @@
 //!   game's car1-trb1 slides out of the corner there as cdbo's now does). The banking's share
 //!   of the cornering acceleration (vₓ·r·sin β) is left out: measured against the game, adding
 //!   it places fewer of the game's failures (4 of 21 road tracks against 8).
+//! - In the air ([`airborne`]): where the road falls away faster than gravity and the wings
+//!   pull the body down (m·g·n + D < 0, over a crest), no wheel carries a load until the
+//!   body, flying under them, comes down onto the road again.
 //! - Wheel loads: each axle's inner wheel gives ΔF_a = M·κ_a·y_a/(2·Σ_b κ_b·y_b²) to its outer
 //!   one, M = Σ_a Fᵧ,a·h_rc,a the tyres' lateral forces at the roll centres (simuv2's
 //!   `car.cpp`; [`crate::car::Axles`]), lagged 70 ms.
@@ -65,6 +68,7 @@
 
 use crate::car::{Car, Drive, G};
 use crate::track::Frame;
+use airborne::Heave;
 use bounce::{Bounce, Corner};
 use powertrain::{EngineMap, Gearbox, ShiftMap};
 use tyre::TyreModel;
@@ -141,6 +145,9 @@ pub struct State {
     /// Each wheel's bounce over rough ground and kinks ([`bounce`]), front left, front right,
     /// rear left, rear right.
     pub bounce: [Bounce; 4],
+    /// The body's heave over a crest ([`airborne`]): its gap above the road while the car
+    /// is in the air.
+    pub heave: Heave,
 }
 
 impl State {
@@ -524,6 +531,7 @@ const DOWNFORCE_SPEED_STEP: f64 = 0.5;
 const DOWNFORCE_SPEEDS: usize = 300;
 
 pub mod aids;
+pub mod airborne;
 pub mod barrier;
 pub mod bounce;
 mod ground;
