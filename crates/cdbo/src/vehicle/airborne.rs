@@ -1,69 +1,138 @@
 //! The body's heave over a crest: the car leaves the ground where the road falls away faster
-//! than gravity and the wings can pull it down, flies, and lands, as TORCS's simuv2 moves it.
+//! than gravity, the wings and the springs can pull the body after it, flies, and lands, as
+//! TORCS's simuv2 moves it.
 //!
 //! In simuv2 the body is a mass on its four springs (`car.cpp` integrates its height under
 //! the wheels' loads, gravity and the wings; `susp.cpp`: a spring's force is
 //! F = max(0, F₀ + k·(x₀ − x)), never pulling; `wheel.cpp`: past the suspension's course x_max,
-//! the `max_extend` of the wheel's travel, its load is 0). On the ground the springs push the
-//! body along the road's vertical curve with the load the quasi-static model gives
-//! ([`super`]): m·g·n + D, n = cos φ·cos β + vₓ²·κ_v/g the road's push per unit of the weight
-//! and D the downforce. Over a crest (κ_v < 0) that load falls, and where it would be
-//! negative no spring can hold the body to the road: the body rises, the springs lengthen to
-//! their free length, and the wheels' loads are 0. car1-trb1's springs (a wheel rate of
-//! 1.17 MN/m under some 2.8 kN) are free 2.4 mm above their static length, well inside
-//! their 0.2 m course, so the travel's stop never comes into it and the car leaves the
-//! ground where the quasi-static load reaches 0: at v² = g·R·cos φ over a crest of radius R
-//! without wings.
+//! the `max_extend` of the wheel's travel, its load is 0). On the ground the springs carry
+//! the body along the road with the load the quasi-static model gives ([`super`]):
+//! m·g·n + D, n = cos φ·cos β + vₓ²·κ_v/g the road's push per unit of the weight, κ_v the
+//! vertical curvature over [`crate::track::VERTICAL_WINDOW_M`], and D the downforce. The
+//! body leaves the road in two ways:
 //!
-//! In the air the body's gap d above the place the road would hold it at, along the road's
-//! normal, moves under gravity, the wings and the road falling away beneath it:
-//! d̈ = −(m·g·n + D)/m, the negative of the load the road would need per unit mass. No wheel
+//! - **The road curves away**: where that load would be negative no spring can hold the
+//!   body to the road (at v² = g·R·cos φ over a crest of radius R without wings).
+//! - **The road kinks away**: TORCS's heights are linear on steps of a few metres, so a
+//!   crest is a run of kinks, at each of which the grade falls by Δφ at once and the ground
+//!   drops away from the body at w = vₓ·Δφ. The wheels, light, follow it; the body, on
+//!   springs of total rate K = Σ k carrying F = m·g·n + D, follows only as far as the
+//!   springs' free length, F/K beyond their loaded one: with the energy F²/(2K) they hold
+//!   they catch the body up to w_hold = F/√(K·m). Past it the springs run free and the body
+//!   flies off at √(w² − w_hold²) (energy). car1-trb1's springs (wheel rates 119 kN/m,
+//!   5500 lbs/in with TORCS's pound a mass, times the bellcrank's 1.1²) run free 24 mm
+//!   above their static length under some 2.8 kN a wheel, inside their 0.18 m of travel, so
+//!   the travel's stop never comes into it; √(m/K) = 51 ms, and with the wings' load at
+//!   43 m/s (12 m/s² in all) they hold 0.6 m/s: a kink of 1.4 % of grade throws the car
+//!   (G-Track 3's crest at 1916 m has one of 1.8 %). A car without springs
+//!   ([`crate::car::Car::ride`]) leaves the road only where it curves away.
+//!
+//! In the air the body's gap d above the road, along its normal, moves under gravity and
+//! the wings, d̈ = −(g·cos φ·cos β + D/m), while the road beneath turns away from it at each
+//! step by its own change of grade: ḋ ← ḋ + vₓ·Δφ (the road's curve, kinks and all, here as
+//! the stations' grades give it, in place of the quasi-static load's smoothed κ_v). No wheel
 //! carries a load, so no tyre grips and nothing rolls; the body flies on at its speed, its
-//! yaw rate and the wheels' spins their own. Once the gap closes (d ≤ 0) the car lands:
-//! the springs and dampers take the landing's vertical speed, and the loads are the
+//! yaw rate and the wheels' spins their own. Once the gap closes (d ≤ 0) the car lands: the
+//! springs and dampers take the landing's vertical speed, and the loads are the
 //! quasi-static ones again from that step on. Integrated semi-implicitly at the step:
-//! ḋ ← ḋ + dt·d̈, d ← d + dt·ḋ.
+//! ḋ ← ḋ + vₓ·Δφ − dt·(g·cos φ·cos β + D/m), d ← d + dt·ḋ.
 //!
 //! Approximations: the body heaves as one (simuv2's pitch and roll would lift one axle
-//! before the other), the springs' free 2.4 mm and the landing's bounce are left out, and
-//! the gap is measured at the car's station along the road's normal, not along the vertical.
-//! On the ground (d = ḋ = 0 and the quasi-static load positive) nothing here is computed.
+//! before the other), the landing's bounce is left out, the gap is measured along the
+//! road's normal, each kink is met by springs at rest (where a kink follows another within
+//! their period, 0.3 s for car1-trb1, simuv2's body may still be bouncing off the first),
+//! and a kink is met where the car's station changes, within half a station's spacing of
+//! its place. On the ground, with the road's grade unchanged since the
+//! last step and the quasi-static load positive, nothing here is computed but that grade
+//! kept.
 
-/// The body's height above the road's hold, while the car is in the air (module
-/// documentation); zero on the ground.
+use crate::car::G;
+use crate::track::Frame;
+
+/// The body's height above the road while the car is in the air (module documentation),
+/// and the road's grade under it at the last step.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Heave {
-    /// The gap d between the body and the place the road would hold it at (m).
+    /// The gap d between the body and the road (m), 0 on the ground.
     gap: f64,
     /// Its rate ḋ (m/s).
     rate: f64,
+    /// (sin φ, cos φ) of the road's grade φ under the car at the last step; (0, 0) before
+    /// the first, which then meets no kink.
+    grade: (f64, f64),
+    /// Whether the car is in the air.
+    flying: bool,
+}
+
+/// What holds the body to the road at a step (module documentation), per unit mass.
+#[derive(Debug, Clone, Copy)]
+pub struct Hold {
+    /// The quasi-static load per unit mass, g·n + D/m (m/s²), n with the smoothed κ_v.
+    pub load: f64,
+    /// The downforce per unit mass, D/m (m/s²).
+    pub down: f64,
+    /// √(m/K) of the car's springs (s), K their total rate; `None` without springs.
+    pub springs: Option<f64>,
 }
 
 impl Heave {
-    /// Whether the car is in the air: its body above the road's hold.
+    /// Whether the car is in the air.
     #[inline]
     pub fn in_air(&self) -> bool {
-        self.gap > 0.0
+        self.flying
     }
 
-    /// The gap d above the road's hold (m), 0 on the ground.
+    /// The gap d above the road (m), 0 on the ground.
     pub fn gap(&self) -> f64 {
         self.gap
     }
 
-    /// Advances the heave by `dt` under `support`, the load per unit mass the road would
-    /// need to hold the body to it, g·n + D/m (m/s²): the body leaves the ground, or stays
-    /// in the air, while the road cannot hold it; it lands where the gap closes. Returns
-    /// whether the car is in the air after the step (its wheels without load).
+    /// Advances the heave by `dt` at forward speed `vx` on the road of `frame`, held by
+    /// `hold`: the body leaves the ground, or stays in the air, while the road cannot hold
+    /// it; it lands where the gap closes. Returns whether the car is in the air after the
+    /// step (its wheels without load).
     #[inline]
-    pub fn step(&mut self, support: f64, dt: f64) -> bool {
-        if !self.in_air() && support >= 0.0 {
-            return false;
+    pub fn step(&mut self, frame: &Frame, vx: f64, hold: &Hold, dt: f64) -> bool {
+        let (sin0, cos0) = self.grade;
+        self.grade = (frame.sin_pitch, frame.cos_pitch);
+        // sin Δφ of the grade's fall since the last step: positive where the road turns
+        // down (over a crest).
+        let fall = sin0 * frame.cos_pitch - cos0 * frame.sin_pitch;
+        if !self.in_air() {
+            if hold.load < 0.0 {
+                // The road curves away faster than the body can fall: it rises off it at
+                // the rate the smoothed curve's excess gives it over the step.
+                self.flying = true;
+                self.rate = -dt * hold.load;
+                self.gap = dt * self.rate;
+                return true;
+            }
+            let Some(springs) = hold.springs.filter(|_| fall > 0.0) else {
+                return false;
+            };
+            let (w, caught) = (vx * fall, hold.load * springs);
+            if w <= caught {
+                return false;
+            }
+            // The road kinks away faster than the springs can pull the body after it: the
+            // body flies off at what their energy leaves of w.
+            self.flying = true;
+            self.rate = (w * w - caught * caught).sqrt() - w;
         }
-        self.rate -= dt * support;
+        let weight = G * frame.cos_pitch * frame.cos_banking + hold.down;
+        self.rate += vx * fall - dt * weight;
         self.gap += dt * self.rate;
         if self.gap <= 0.0 {
-            *self = Heave::default();
+            if hold.load < 0.0 {
+                // The road's stations turn it in steps, but on the whole it still curves
+                // away faster than the body falls: the body skims it, unloaded.
+                (self.gap, self.rate) = (0.0, 0.0);
+                return true;
+            }
+            *self = Heave {
+                grade: self.grade,
+                ..Heave::default()
+            };
             return false;
         }
         true
@@ -187,34 +256,65 @@ mod tests {
         );
     }
 
-    /// On the ground, held by a road that can hold it, the body stays on it to the last bit.
+    /// A straight road along x, level to 50 m, then straight down at the grade −`fall`: one
+    /// kink at 50 m. Its frames before and after it.
+    fn kink(fall: f64) -> (Frame, Frame) {
+        let mut down = Piece::flat(100.0, 0.0);
+        down.z1 = -100.0 * fall;
+        let t = Track::from_pieces("kink", "test", &[Piece::flat(50.0, 0.0), down], vec![]);
+        (*t.frame(t.index_at(25.0)), *t.frame(t.index_at(75.0)))
+    }
+
+    /// On the ground, held by a road that neither curves nor kinks away, the body stays on
+    /// it, whatever its load, with or without springs.
     #[test]
     fn a_held_body_stays_on_the_ground() {
-        let mut h = Heave::default();
-        for support in [G, 0.0, 0.1, 30.0] {
-            assert!(!h.step(support, 0.004));
-            assert_eq!(h, Heave::default());
+        let (level, _) = kink(0.0);
+        for springs in [None, Some(0.016)] {
+            let mut h = Heave::default();
+            for load in [G, 0.0, 0.1, 30.0] {
+                let hold = Hold {
+                    load,
+                    down: 0.0,
+                    springs,
+                };
+                assert!(!h.step(&level, 40.0, &hold, 0.004));
+                assert!(!h.in_air() && h.rate == 0.0 && h.gap == 0.0);
+            }
         }
     }
 
-    /// Thrown up at 1 m/s on level ground (support g), the body lands after 2·ḋ/g, within a
-    /// step, and its highest gap is ḋ²/(2g) within a step's rise.
+    /// Over a kink where the grade falls by Δφ at 40 m/s, springs of √(m/K) = 16 ms under the
+    /// weight g catch the body up to w_hold = g·√(m/K) = 0.157 m/s: at w = vₓ·Δφ 2 % below it
+    /// the car stays on the ground, at twice it it flies off at √(w² − w_hold²) and lands
+    /// after 2·√(w² − w_hold²)/(g·cos φ), within a step (1 ms); a car without springs meets
+    /// the kink on the ground.
     #[test]
-    fn a_thrown_body_lands_after_its_ballistic_time() {
-        let dt = 0.001;
-        let mut h = Heave {
-            gap: 0.0,
-            rate: 1.0,
+    fn a_kink_throws_the_body_past_what_the_springs_hold() {
+        let (speed, springs, dt) = (40.0, 0.016, 0.001);
+        let caught = G * springs;
+        let flight = |w: f64, springs: Option<f64>| -> f64 {
+            let (before, after) = kink(w / speed);
+            let mut h = Heave::default();
+            let hold = Hold {
+                load: G,
+                down: 0.0,
+                springs,
+            };
+            assert!(!h.step(&before, speed, &hold, dt));
+            let mut time = 0.0;
+            while h.step(&after, speed, &hold, dt) {
+                time += dt;
+            }
+            time
         };
-        // The first step takes it up.
-        h.gap = dt * h.rate;
-        let (mut t, mut top) = (dt, 0.0f64);
-        while h.step(G, dt) {
-            t += dt;
-            top = top.max(h.gap());
-        }
-        let want = 2.0 / G;
-        assert!((t - want).abs() <= 2.0 * dt, "{t} against {want}");
-        assert!((top - 0.5 / G).abs() < 2.0 * dt, "{top}");
+        assert_eq!(flight(0.98 * caught, Some(springs)), 0.0);
+        assert_eq!(flight(2.0 * caught, None), 0.0);
+        let w = 2.0 * caught;
+        let (_, after) = kink(w / speed);
+        let rate = (w * w - caught * caught).sqrt();
+        let want = 2.0 * rate / (G * after.cos_pitch);
+        let got = flight(w, Some(springs));
+        assert!((got - want).abs() <= 1.5 * dt, "{got} against {want}");
     }
 }

@@ -1,11 +1,12 @@
 //! One step of the vehicle model: loads, tyres, wheels and body integrated over dt (the
 //! formulas in [`super`]).
 
+use super::airborne::Hold;
+use super::bounce;
 use super::hypot::hypot_lanes;
 use super::lanes::{F64x4, Lane};
 use super::tyre::{Forces, TyreModel};
 use super::{Controls, GAME_STEP, SLIP_SPEED_FLOOR, State, Vehicle, rear_omega};
-use super::bounce;
 use crate::car::{DiffKind, G};
 use crate::track::{Bumps, Frame};
 
@@ -56,7 +57,12 @@ impl Vehicle {
         // Over a crest the road may fall away faster than the body can follow: in the air
         // no wheel carries a load ([`super::airborne`]).
         let support = (self.static_load[0] + self.static_load[1]) * normal + down[0] + down[1];
-        let airborne = s.heave.step(support * self.inv_mass, dt);
+        let hold = Hold {
+            load: support * self.inv_mass,
+            down: (down[0] + down[1]) * self.inv_mass,
+            springs: self.heave_springs,
+        };
+        let airborne = s.heave.step(frame, s.vx, &hold, dt);
         let fz = if airborne {
             [0.0; 2]
         } else {
