@@ -16,9 +16,10 @@
 //! - **The road kinks away**: TORCS's heights are linear on steps of a few metres, so a
 //!   crest is a run of kinks, at each of which the grade falls by Δφ at once and the ground
 //!   drops away from the body at w = vₓ·Δφ. The wheels, light, follow it; the body, on
-//!   springs of total rate K = Σ k carrying F = m·g·n + D, follows only as far as the
-//!   springs' free length, F/K beyond their loaded one: with the energy F²/(2K) they hold
-//!   they catch the body up to w_hold = F/√(K·m). Past it the springs run free and the body
+//!   springs of total rate K = Σ k carrying F = m·g·cos φ·cos β + D on the straight step
+//!   before the kink, follows only as far as the springs' free length, F/K beyond their
+//!   loaded one: with the energy F²/(2K) they hold they catch the body up to
+//!   w_hold = F/√(K·m). Past it the springs run free and the body
 //!   flies off at √(w² − w_hold²) (energy). car1-trb1's springs (wheel rates 119 kN/m,
 //!   5500 lbs/in with TORCS's pound a mass, times the bellcrank's 1.1²) run free 24 mm
 //!   above their static length under some 2.8 kN a wheel, inside their 0.18 m of travel, so
@@ -98,6 +99,8 @@ impl Heave {
         // sin Δφ of the grade's fall since the last step: positive where the road turns
         // down (over a crest).
         let fall = sin0 * frame.cos_pitch - cos0 * frame.sin_pitch;
+        // Gravity and the wings across the road, per unit mass.
+        let weight = || G * frame.cos_pitch * frame.cos_banking + hold.down;
         if !self.in_air() {
             if hold.load < 0.0 {
                 // The road curves away faster than the body can fall: it rises off it at
@@ -110,7 +113,10 @@ impl Heave {
             let Some(springs) = hold.springs.filter(|_| fall > 0.0) else {
                 return false;
             };
-            let (w, caught) = (vx * fall, hold.load * springs);
+            // Before the kink the springs carried the body along the straight step of road
+            // it leaves (its weight, not the smoothed curve's load, which spreads this very
+            // kink over the window).
+            let (w, caught) = (vx * fall, weight() * springs);
             if w <= caught {
                 return false;
             }
@@ -119,8 +125,7 @@ impl Heave {
             self.flying = true;
             self.rate = (w * w - caught * caught).sqrt() - w;
         }
-        let weight = G * frame.cos_pitch * frame.cos_banking + hold.down;
-        self.rate += vx * fall - dt * weight;
+        self.rate += vx * fall - dt * weight();
         self.gap += dt * self.rate;
         if self.gap <= 0.0 {
             if hold.load < 0.0 {
