@@ -18,18 +18,20 @@
 //!   drops away from the body at w = vₓ·Δφ. The wheels, light, follow it; the body, on
 //!   springs of total rate K = Σ k carrying F, follows only as far as the springs' free
 //!   length, F/K beyond their loaded one: with the energy F²/(2K) they hold they catch the
-//!   body up to w_hold = F/√(K·m). F is the load the road's other kinks leave the springs:
-//!   on a crest of kinks a few metres apart, closer than the springs' period, the body
-//!   never settles back onto them between kinks, and they carry the smoothed curve's load
-//!   m·g·n + D less this kink's own share of it, m·vₓ²·Δφ/W over the window W, at most the
-//!   weight m·g·cos φ·cos β + D of a straight step (an isolated kink). Past w_hold the
-//!   springs run free and the body flies off at √(w² − w_hold²) (energy). car1-trb1's
-//!   springs (wheel rates 119 kN/m, 5500 lbs/in with TORCS's pound a mass, times the
-//!   bellcrank's 1.1²) run free 24 mm above their static length under some 2.8 kN a wheel,
-//!   inside their 0.18 m of travel, so the travel's stop never comes into it; √(m/K) is
-//!   51 ms, and on a straight step at 43 m/s, with the wings' load (12 m/s² in all), they
-//!   hold 0.6 m/s: an isolated kink of 1.4 % of grade throws the car (G-Track 3's crest at
-//!   1916 m has one of 1.8 %, after one of 0.9 % at 1912 m). A car without springs
+//!   body up to w_hold = F/√(K·m), F the load they carry, the quasi-static m·g·n + D: on a
+//!   crest of kinks a few metres apart, closer than the springs' period, the body never
+//!   settles back onto them between kinks, and they carry the smoothed curve's load. Past
+//!   w_hold the springs run free and the body flies off at √(w² − w_hold²) (energy).
+//!   car1-trb1's springs (wheel rates 119 kN/m, 5500 lbs/in with TORCS's pound a mass,
+//!   times the bellcrank's 1.1²) run free 24 mm above their static length under some 2.8 kN
+//!   a wheel, inside their 0.18 m of travel, so the travel's stop never comes into it;
+//!   √(m/K) is 51 ms, and on a straight road at 43 m/s, with the wings' load (12 m/s² in
+//!   all), they hold 0.6 m/s, less where the smoothed curve takes load off around a kink
+//!   (by vₓ²·Δφ/W, W = [`crate::track::VERTICAL_WINDOW_M`]): a lone kink of about 1 % of
+//!   grade throws the car. On G-Track 3 (kinks of 0.9, 1.8, 1.2 and 0.6 % every 4 m from
+//!   1912 m) a policy the game's car leaves the road with flies at 1917 m for 0.07 s and
+//!   at 1947 m for 0.09 s; the game's car, on the same inputs, holds its yaw rate still
+//!   (in the air) over 1917 to 1924 m and 1950 to 1954 m. A car without springs
 //!   ([`crate::car::Car::ride`]) leaves the road only where it curves away.
 //!
 //! In the air the body's gap d above the road, along its normal, moves under gravity and
@@ -52,7 +54,7 @@
 //! kept.
 
 use crate::car::G;
-use crate::track::{Frame, VERTICAL_WINDOW_M};
+use crate::track::Frame;
 
 /// The body's height above the road while the car is in the air (module documentation),
 /// and the road's grade under it at the last step.
@@ -117,11 +119,8 @@ impl Heave {
             let Some(springs) = hold.springs.filter(|_| fall > 0.0) else {
                 return false;
             };
-            // The springs meet the kink with the load the road's other kinks leave them:
-            // the smoothed curve's, less this kink's share of it (Δφ/W over the window W),
-            // at most the weight of a straight step.
-            let load = (hold.load + vx * vx * fall / VERTICAL_WINDOW_M).min(weight());
-            let (w, caught) = (vx * fall, load * springs);
+            // The springs meet the kink carrying the quasi-static load.
+            let (w, caught) = (vx * fall, hold.load * springs);
             if w <= caught {
                 return false;
             }
