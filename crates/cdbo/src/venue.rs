@@ -12,7 +12,6 @@ use crate::drive::steering::Steering;
 use crate::error::Result;
 use crate::evaluator::Evaluator;
 use crate::evaluator::simulator::SimEvaluator;
-use crate::experiment::start::Demonstration;
 use crate::line::RacingLine;
 use crate::policy::{Policy, PolicyShape};
 use crate::sim::lap::{GAME_OFF_TRACK_MARGIN, Reserve};
@@ -164,7 +163,11 @@ impl Venue {
     /// The profile demonstration: the lap of a profile hold ([`ProfileHold`]) at k times
     /// `profile`'s speeds (m/s, at stations spaced evenly over the lap), with the (x, a)
     /// pairs of every driver step.
-    pub fn demonstrate_profile(&self, profile: &[f64], k: f64) -> Result<Demonstration> {
+    pub fn demonstrate_profile(
+        &self,
+        profile: &[f64],
+        k: f64,
+    ) -> Result<(LapResult, Vec<(f64, f64)>)> {
         match self {
             Venue::Simulator(sim) => {
                 let length = sim.track.length;
