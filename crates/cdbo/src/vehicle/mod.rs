@@ -16,10 +16,6 @@
 //!   game's car1-trb1 slides out of the corner there as cdbo's now does). The banking's share
 //!   of the cornering acceleration (vₓ·r·sin β) is left out: measured against the game, adding
 //!   it places fewer of the game's failures (4 of 21 road tracks against 8).
-//! - In the air ([`airborne`]): where the road curves away faster than gravity and the wings
-//!   pull the body down (m·g·n + D < 0, over a crest), or kinks away faster than the springs
-//!   can pull it after the road, no wheel carries a load until the body comes down onto the
-//!   road again.
 //! - Wheel loads: each axle's inner wheel gives ΔF_a = M·κ_a·y_a/(2·Σ_b κ_b·y_b²) to its outer
 //!   one, M = Σ_a Fᵧ,a·h_rc,a the tyres' lateral forces at the roll centres (simuv2's
 //!   `car.cpp`; [`crate::car::Axles`]), lagged 70 ms.
@@ -69,7 +65,6 @@
 
 use crate::car::{Car, Drive, G};
 use crate::track::Frame;
-use airborne::Heave;
 use bounce::{Bounce, Corner};
 use powertrain::{EngineMap, Gearbox, ShiftMap};
 use tyre::TyreModel;
@@ -146,9 +141,6 @@ pub struct State {
     /// Each wheel's bounce over rough ground and kinks ([`bounce`]), front left, front right,
     /// rear left, rear right.
     pub bounce: [Bounce; 4],
-    /// The body's heave over a crest ([`airborne`]): its gap above the road while the car
-    /// is in the air.
-    pub heave: Heave,
 }
 
 impl State {
@@ -203,10 +195,6 @@ pub struct Vehicle {
     /// What moves a front and a rear wheel over rough ground ([`bounce`]); `None` for a
     /// car without a suspension ([`Car::ride`]), which rides rough ground as smooth.
     corners: Option<[Corner; 2]>,
-    /// √(m/K) of the car's springs, K = 2·(k_f + k_r) their total wheel rate (s): how fast
-    /// they can pull the body after a road that kinks away ([`airborne`]); `None` for a car
-    /// without a suspension ([`Car::ride`]).
-    heave_springs: Option<f64>,
 }
 
 impl Vehicle {
@@ -255,9 +243,6 @@ impl Vehicle {
                     .collect(),
             },
             corners: car.ride.map(|ride| [0, 1].map(|k| Corner::of(&ride, k))),
-            heave_springs: car
-                .ride
-                .map(|ride| (car.mass / (2.0 * (ride.rate[0] + ride.rate[1]))).sqrt()),
             tyres,
             radius: [car.front_tyre.radius, car.rear_tyre.radius],
             wheel_inertia: [2.0 * car.front_tyre.inertia, car.rear_tyre.inertia],
@@ -539,7 +524,6 @@ const DOWNFORCE_SPEED_STEP: f64 = 0.5;
 const DOWNFORCE_SPEEDS: usize = 300;
 
 pub mod aids;
-pub mod airborne;
 pub mod barrier;
 pub mod bounce;
 mod ground;

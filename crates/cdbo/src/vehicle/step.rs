@@ -1,7 +1,6 @@
 //! One step of the vehicle model: loads, tyres, wheels and body integrated over dt (the
 //! formulas in [`super`]).
 
-use super::airborne::Hold;
 use super::bounce;
 use super::hypot::hypot_lanes;
 use super::lanes::{F64x4, Lane};
@@ -54,23 +53,10 @@ impl Vehicle {
         let down = [per_v2[0] * v2, per_v2[1] * v2];
         let normal = Self::road_push(frame, s.vx);
         let transfer = self.transfer_per_accel * s.ax - self.wing_pitch_per_v2 * v2;
-        // Over a crest the road may fall away faster than the body can follow: in the air
-        // no wheel carries a load ([`super::airborne`]).
-        let support = (self.static_load[0] + self.static_load[1]) * normal + down[0] + down[1];
-        let hold = Hold {
-            load: support * self.inv_mass,
-            down: (down[0] + down[1]) * self.inv_mass,
-            springs: self.heave_springs,
-        };
-        let airborne = s.heave.step(frame, s.vx, &hold, dt);
-        let fz = if airborne {
-            [0.0; 2]
-        } else {
-            [
-                (self.static_load[0] * normal - transfer + down[0]).max(0.0),
-                (self.static_load[1] * normal + transfer + down[1]).max(0.0),
-            ]
-        };
+        let fz = [
+            (self.static_load[0] * normal - transfer + down[0]).max(0.0),
+            (self.static_load[1] * normal + transfer + down[1]).max(0.0),
+        ];
         // The wheels' loads, left and right: the roll moment moves ΔF_a from each axle's inner
         // wheel to its outer one (the left wheel is the inner one while the roll moment is
         // positive, in a left-hand corner).
@@ -81,11 +67,7 @@ impl Vehicle {
                 (0.5 * fz[k] + shift).max(0.0),
             ]
         };
-        let (front_loads, rear_loads) = if airborne {
-            ([0.0; 2], [0.0; 2])
-        } else {
-            (wheel_loads(0), wheel_loads(1))
-        };
+        let (front_loads, rear_loads) = (wheel_loads(0), wheel_loads(1));
         // Each wheel's surface: the road's, or a verge's past the road's edge.
         let ground = self.wheel_ground(s, frame);
         let mut friction = match &ground {
