@@ -354,7 +354,7 @@ fn transfer_drives_each_learned_best_policy_in_the_game() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// On G-Track 1 with car1-trb1, 10 kernels (or 20 or 40) and 3 game laps: the policy written is the one
+/// On G-Track 1 with car1-trb1, 10 kernels (or 20 or 40), 3 game laps, learning the flying lap: the policy written is the one
 /// whose laps are reported (driven again in the game, standing and flying, the same times),
 /// the flying lap is faster than the standing lap, and the robots' fastest laps stand beside.
 #[test]
@@ -366,7 +366,15 @@ fn a_track_becomes_a_race_ready_policy_beside_the_robots() {
     };
     let out = dir.join("policies");
     let o = torcs_cmd(&cache)
-        .args(["torcs", "learn", "--track", "g-track-1", "--kernels", "10"])
+        .args([
+            "torcs",
+            "learn",
+            "--track",
+            "g-track-1",
+            "--kernels",
+            "10",
+            "--flying",
+        ])
         .args(["--game-laps", "3", "--json", "--out", out.to_str().unwrap()])
         .output()
         .unwrap();
