@@ -393,6 +393,8 @@ impl PyLapResult {
 #[pyclass(name = "Simulator", module = "cdbo", frozen)]
 pub struct PySimulator {
     pub sim: Simulator,
+    /// The car the simulator drives.
+    pub car: cdbo::car::Car,
     /// The base line the simulator's laps hold (`line=`).
     pub base: BaseLine,
 }
@@ -423,7 +425,7 @@ impl PySimulator {
         sim.config.steering = steering.steering();
         sim.config.learn_with(off_track_margin);
         sim.config.line = held;
-        Ok(PySimulator { sim, base })
+        Ok(PySimulator { sim, base, car })
     }
 
     /// One lap with `policy`; `line`, a second `Policy`, is a learned line d(x): its raw sum
@@ -474,6 +476,33 @@ impl PySimulator {
             array(py, x),
             array(py, a),
         ))
+    }
+
+    /// The recommended learner's demonstration, as `cdbo race --method safe-pattern-search`
+    /// drives it: a hold of a share of the limit's speed profile on the laps' line (the profile
+    /// start), its lap and (x, a) pairs as two arrays and the speed it holds (m/s); None
+    /// where no share of the profile completes.
+    fn demonstrate_profile<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<Option<(PyLapResult, Array<'py>, Array<'py>, f64)>> {
+        let venue = cdbo::venue::Venue::Simulator(Box::new(self.sim.clone()));
+        let demonstrator = cdbo::experiment::profile_start::ProfileDemonstrator::new(
+            &self.sim.track,
+            &self.car,
+            self.sim.config.line.as_deref(),
+        );
+        let chosen = py.detach(|| demonstrator.choose(&venue)).py()?;
+        let Some(((lap, pairs), choice)) = chosen else {
+            return Ok(None);
+        };
+        let (x, a) = pairs.into_iter().unzip();
+        Ok(Some((
+            PyLapResult::new(py, lap, false)?,
+            array(py, x),
+            array(py, a),
+            choice.speed_mps,
+        )))
     }
 
     /// The track.

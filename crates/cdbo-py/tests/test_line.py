@@ -94,10 +94,11 @@ def test_the_recommended_learner_in_the_readmes_loop_is_the_clis_race(cli, tmp_p
     """The learner the README recommends for a car, `safe-pattern-search` on the path tracker,
     written as the README's loop (`env.optimizer(..., max_failed=B)`, ask, drive, tell the
     whole lap), asks the laps `cdbo race --method safe-pattern-search --steering tracker
-    --max-failed-laps B` drives, bit for bit, and keeps to its budget."""
+    --max-failed-laps B --demo-speed 15` drives (the paper's demonstration, as the environment
+    without a method), bit for bit, and keeps to its budget."""
     laps, budget = 60, 5
     args = ("--method", "safe-pattern-search", "--kernels", 20, "--laps", laps)
-    flags = ("--steering", "tracker", "--max-failed-laps", budget, "--seed", 3)
+    flags = ("--steering", "tracker", "--max-failed-laps", budget, "--seed", 3, "--demo-speed", 15)
     summary = json.loads(cli("race", "--json", *args, *flags, "--out", tmp_path))
     env = cdbo.RaceEnv("ridgeway", kernels=20, steering="tracker")
     opt = env.optimizer("safe-pattern-search", seed=3, max_failed=budget)

@@ -94,7 +94,7 @@ class RaceEnv(_Base):
         track="ridgeway",
         car="spirit-300",
         kernels: int = 30,
-        demo_speed: float = 15.0,
+        demo_speed=None,
         bounds: float = DEFAULT_BOX_RADIUS,
         data_dir=None,
         line=None,
@@ -123,7 +123,16 @@ class RaceEnv(_Base):
             steering=steering,
             off_track_margin=off_track_margin,
         )
-        demo, x, a = self.simulator.demonstrate(demo_speed)
+        # The recommended learner starts from the profile start, as `cdbo race` does, unless a
+        # demonstration speed is given; every other method from the paper's 15 m/s.
+        profile = None
+        if demo_speed is None and self.method == "safe-pattern-search":
+            profile = self.simulator.demonstrate_profile()
+        if profile is not None:
+            demo, x, a, demo_speed = profile
+        else:
+            demo_speed = 15.0 if demo_speed is None else demo_speed
+            demo, x, a = self.simulator.demonstrate(demo_speed)
         if not demo.completed:
             raise ValueError(
                 f"the {demo_speed} m/s demonstration does not complete "
