@@ -71,19 +71,24 @@ pub const REPAIR_LAPS: usize = 150;
 /// read at the centre line's stations
 /// ([`line_limit_on_centre_with`](crate::limit::line_limit_on_centre_with)).
 pub fn profile(track: &Track, car: &Car, line: Option<&RacingLine>) -> Limit {
-    match line {
-        Some(line) => {
-            crate::limit::line_limit_on_centre_with(track, line, car, LimitOptions::CRESTS)
-        }
-        None => crate::limit::limit_lap_with(track, car, LimitOptions::CRESTS),
-    }
+    profile_with(track, car, line, LimitOptions::CRESTS)
 }
 
 /// The speed profile a flying lap tracks ([`profile`] of a flying lap,
 /// [`LimitOptions::flying`]): the car crosses the line at the speed the lap ends with, and
 /// brakes before the line for the next lap's first corner.
 pub fn flying_profile(track: &Track, car: &Car, line: Option<&RacingLine>) -> Limit {
-    let options = LimitOptions::CRESTS.flying();
+    profile_with(track, car, line, LimitOptions::CRESTS.flying())
+}
+
+/// The limit's profile under `options`, on `line` read at the centre line's stations, or on
+/// the centre line.
+fn profile_with(
+    track: &Track,
+    car: &Car,
+    line: Option<&RacingLine>,
+    options: LimitOptions,
+) -> Limit {
     match line {
         Some(line) => crate::limit::line_limit_on_centre_with(track, line, car, options),
         None => crate::limit::limit_lap_with(track, car, options),
