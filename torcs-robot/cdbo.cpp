@@ -124,6 +124,7 @@ struct Lap {
     FILE *trace = nullptr;
     double start_time = -1.0, last_time = 0.0;
     double distance = 0.0, farthest = 0.0, last_station = 0.0, slow_for = 0.0;
+    bool slow_off_road = false;  // off the road since the car became slow
     double lap_start = 0.0;  // the timed lap's start: 0, or one length into a flying lap
     double standing = -1.0;  // a flying lap's standing lap (s), once completed
     double steer_integral = 0.0, demo_integral = 0.0;
@@ -554,8 +555,11 @@ void drive(int, tCarElt *car, tSituation *s) {
     } else if (t > lap.cfg.time_limit) {
         failure = "time_limit";
     } else {
-        lap.slow_for = (std::fabs(vx) < kStallSpeed && speed < kStallSpeed) ? lap.slow_for + dt : 0.0;
-        if (lap.slow_for > kStallTime) failure = "stalled";
+        bool slow = std::fabs(vx) < kStallSpeed && speed < kStallSpeed;
+        lap.slow_for = slow ? lap.slow_for + dt : 0.0;
+        // A car come to rest off the road (in the gravel short of the margin) left it.
+        lap.slow_off_road = slow && (lap.slow_off_road || std::fabs(lateral) > half_width);
+        if (lap.slow_for > kStallTime) failure = lap.slow_off_road ? "off_track" : "stalled";
     }
     if (failure) finish(t, now, failure, 0.0);
 

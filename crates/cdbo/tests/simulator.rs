@@ -594,3 +594,46 @@ fn a_flying_lap_failing_on_its_second_lap_fails_at_that_laps_fraction() {
         "{failure:?}"
     );
 }
+
+/// Full throttle to `x`, then full brake.
+struct BrakeAt(f64);
+
+impl Pedal for BrakeAt {
+    fn pedal(&mut self, o: &Observation) -> f64 {
+        if o.x < self.0 { 1.0 } else { -1.0 }
+    }
+}
+
+/// A car braking into a bend over a sand run-off: braking early it stops on the road and
+/// stalls, too slow; braking late it slides off and comes to rest in the sand, short of the
+/// off-track margin (5 m here), and that lap left the road: it fails off track, too fast, as
+/// the repair must read it.
+#[test]
+fn a_car_come_to_rest_off_the_road_left_it() {
+    use cdbo::track::{Surface, Verge};
+    let sand = Surface {
+        friction: 0.7,
+        rolling_resistance: Some(0.3),
+        ..Surface::PLAIN
+    };
+    let lap = |brake_at: f64| {
+        let mut sim = bend(Verge {
+            side_width: 20.0,
+            side: sand,
+            ..Verge::NONE
+        });
+        sim.config.fail_at(5.0);
+        let lap = sim.lap(&mut BrakeAt(brake_at));
+        let failure = lap.failure.expect("the car stops in the bend");
+        (failure, *lap.trace.last().unwrap())
+    };
+    let (early, on_road) = lap(0.25);
+    assert_eq!(early.reason, FailureReason::Stalled, "{early:?}");
+    assert!(on_road.lateral.abs() < 5.0, "{on_road:?}");
+    let (late, in_sand) = lap(0.28);
+    assert_eq!(late.reason, FailureReason::OffTrack, "{late:?}");
+    assert!(!late.reason.too_slow());
+    // At rest in the sand: past the edge, inside the margin, after 5 s below 1 m/s.
+    assert!((5.0..10.0).contains(&in_sand.lateral.abs()), "{in_sand:?}");
+    assert!(in_sand.speed < 1.0, "{in_sand:?}");
+}

@@ -14,7 +14,9 @@
 //! - **spun**: the car faces more than 90° away from the track, or slides with a body slip
 //!   angle above 60° at more than 3 m/s;
 //! - **backwards**: the car has moved 10 m back from the farthest point it reached;
-//! - **stalled**: slower than 1 m/s for 5 s ([`STALL_SPEED`]);
+//! - **stalled**: slower than 1 m/s for 5 s ([`STALL_SPEED`]); a car that comes to rest off
+//!   the road (its centre past the edge while it is that slow, in the gravel short of the
+//!   off-track margin) left the road: it fails **off track**, too fast, not too slow;
 //! - **time limit**: the lap takes longer than its limit.
 //!
 //! Nothing else ends a lap: whether these happen follows from speed, grip and steering.
@@ -437,6 +439,8 @@ impl Simulator {
         let mut controls = self.vehicle.controls(0.0, 0.0, 0.0);
         let mut proj = track.project(state.x, state.y, 0);
         let (mut distance, mut farthest, mut slow_for) = (0.0, 0.0, 0.0);
+        // Whether the car has been off the road since it became slow.
+        let mut slow_off_road = false;
         let mut trace = Vec::new();
         let limit = cfg.laps() * self.time_limit();
         // Where the timed lap starts: its distance (m) and time (s) at the line.
@@ -566,12 +570,14 @@ impl Simulator {
             } else if t > limit {
                 Some(super::FailureReason::TimeLimit)
             } else {
-                slow_for = if state.vx.abs() < STALL_SPEED && state.speed() < STALL_SPEED {
-                    slow_for + cfg.dt
+                let slow = state.vx.abs() < STALL_SPEED && state.speed() < STALL_SPEED;
+                slow_for = if slow { slow_for + cfg.dt } else { 0.0 };
+                slow_off_road = slow && (slow_off_road || proj.lateral.abs() > road.half_width);
+                (slow_for > STALL_TIME).then_some(if slow_off_road {
+                    super::FailureReason::OffTrack
                 } else {
-                    0.0
-                };
-                (slow_for > STALL_TIME).then_some(super::FailureReason::Stalled)
+                    super::FailureReason::Stalled
+                })
             };
             if let Some(reason) = failure {
                 let mut r = fail(reason, (distance - lap_start).max(0.0), t, standing);
