@@ -2,6 +2,7 @@
 //! optimum, still near the optimum, with fewer failed laps than the pattern search, and saved
 //! and resumed bit for bit.
 
+use cdbo::learner::safe_search::memory::Pedals;
 use cdbo::method::{Method, Spec, resume};
 use cdbo::optimizers::{FailedLap, Optimizer};
 
@@ -123,4 +124,55 @@ fn a_lifted_budget_is_the_pattern_search() {
             "seed {seed}: the cliff fails {plain_failed} laps"
         );
     }
+}
+
+/// A lap that failed before the search's start (a race's start lap, repaired until it
+/// completed) is remembered: the search's first push of a lap policy's whole pedal keeps under
+/// the reach κ of that lap's excess on the stretch before where it failed, and pushes
+/// elsewhere; told nothing, the search pushes there too.
+#[test]
+fn the_safe_search_remembers_the_laps_failed_before_its_start() {
+    let kernels = 20;
+    let lengthscale = cdbo::policy::rkhs::default_lengthscale(kernels);
+    let start = vec![0.2; kernels];
+    // More pedal at kernels 8–9 (x ≈ 0.42–0.47) left the road at x = 0.5.
+    let mut failed = start.clone();
+    (8..=9).for_each(|i| failed[i] += 0.4);
+    let failure = FailedLap::too_fast(0.5);
+    let pedals = Pedals::new(kernels, Some(lengthscale), None);
+    let last = (pedals.points() - 1) as f64;
+    let places =
+        |from: f64, to: f64| ((from * last).ceil() as usize)..=((to * last).floor() as usize);
+    let reference = pedals.sample(&start).unwrap();
+    let excess = |w: &[f64], from: f64, to: f64| {
+        let pedal = pedals.sample(w).unwrap();
+        let stretch = places(from, to);
+        let n = stretch.clone().count() as f64;
+        stretch.map(|k| pedal[k] - reference[k]).sum::<f64>() / n
+    };
+    let before = 0.5 - pedals.window();
+    let gap = excess(&failed, before, 0.5);
+    assert!(gap > 0.1, "{gap}");
+    let spec = Spec::race(Method::SafePatternSearch)
+        .policy(lengthscale)
+        .unwrap();
+    let mut told = spec
+        .optimizer_after(start.clone(), &[(failed.clone(), failure)])
+        .unwrap();
+    let mut plain = spec.optimizer(start.clone()).unwrap();
+    // The start is the first lap asked, and completes; the push is the second.
+    for opt in [&mut told, &mut plain] {
+        let w = opt.ask().unwrap();
+        assert_eq!(w, start);
+        opt.tell_lap(&w, 10.0, None).unwrap();
+    }
+    let pushed = plain.ask().unwrap();
+    let remembered = told.ask().unwrap();
+    let reach = cdbo::learner::safe_search::REACH;
+    assert!(excess(&pushed, before, 0.5) > 0.2, "{pushed:?}");
+    assert!(
+        excess(&remembered, before, 0.5) < reach * gap,
+        "{remembered:?}"
+    );
+    assert!(excess(&remembered, 0.8, 0.9) > 0.2, "{remembered:?}");
 }

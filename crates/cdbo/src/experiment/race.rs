@@ -410,7 +410,10 @@ fn race_with(
     let optimizer = spec
         .policy(lengthscale)?
         .track_length(limit.track_length)?
-        .optimizer(first)?;
+        .optimizer_after(
+            first,
+            &start.as_ref().map(Start::failures).unwrap_or_default(),
+        )?;
     let mut source = InMemory::new(optimizer, config.laps - start_failed);
     let (lap, mut start_s) = remembered;
     let mut evaluator = DrivenOnce::new(evaluator, lap);

@@ -12,19 +12,22 @@
 //! speed was asked for.
 //!
 //! **The first policy.** w₀, the demonstration's fit, is a smoothed copy of the demonstrator's
-//! pedal, and can be faster than the demonstrator where the fit spreads its launch: where its
-//! lap leaves the road its pedal is lowered before the place (to half the demonstrator's
-//! throttle at most), where it stalls raised just before it (up to full throttle), by a step
-//! that halves where a repair overshot, and where lowering does not help it is fitted again to
-//! a slower demonstration, until its lap completes ([`complete_start`]). These laps are the
-//! race's first laps and count among its failed ones; the method then starts from the policy
-//! whose lap completed (its first lap, which it does not drive again).
+//! pedal, and can be faster than the demonstrator where the fit spreads its launch or rounds
+//! its brake: where its lap leaves the road its pedal is lowered before the place (to half the
+//! demonstrator's throttle at most, to full braking where the demonstrator brakes), where it
+//! stalls raised just before it (up to full throttle), by a step that halves where a repair
+//! overshot, and where lowering does not help it is fitted again to a slower demonstration,
+//! the repairs made so far kept, until its lap completes ([`complete_start`]). These laps are
+//! the race's first laps and count among its failed ones; the method then starts from the
+//! policy whose lap completed (its first lap, which it does not drive again), and the safe
+//! pattern search remembers them ([`crate::learner::safe_search::SafeSearch::after_failures`]).
 
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 use crate::evaluator::{Evaluator, Outcome};
 use crate::learner::pattern_search::push::REPAIR_DISTANCE;
+use crate::optimizers::FailedLap;
 use crate::policy::repair::REPAIR_SPACINGS;
 use crate::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
 use crate::policy::{Policy, RkhsPolicy};
@@ -130,6 +133,8 @@ pub struct Start {
     pub policy: Policy,
     /// The outcome of each lap driven, in order: failed ones, then the completed one, if any.
     pub laps: Vec<(Outcome, f64)>,
+    /// The weights of each lap driven, in the order of `laps`.
+    pub driven: Vec<Vec<f64>>,
     /// The speed (m/s) of the demonstration the policy was last fitted to.
     pub speed_mps: f64,
 }
@@ -141,6 +146,16 @@ impl Start {
             .iter()
             .filter(|(o, _)| matches!(o, Outcome::Failed { .. }))
             .count()
+    }
+
+    /// The failed laps whose venue said where they failed: their weights, and where and how
+    /// each failed (what a car's timer tells).
+    pub fn failures(&self) -> Vec<(Vec<f64>, FailedLap)> {
+        self.driven
+            .iter()
+            .zip(&self.laps)
+            .filter_map(|(w, (outcome, _))| outcome.failed_lap().map(|f| (w.clone(), f)))
+            .collect()
     }
 
     /// Whether the last lap completed.
@@ -155,8 +170,8 @@ impl Start {
 /// with `evaluator` until its lap completes, at most `max_failed` laps failing. After a lap too
 /// fast (off the road, spun, backwards), the fit's targets over the [`REPAIR_DISTANCE`] metres
 /// (at least two kernel spacings) before the failure are lowered by a step δ, but none
-/// below half the demonstrator's throttle there (a cruising pedal braked, or only coasting,
-/// over that stretch stops the car); after a lap too slow (stalled, time limit), they are
+/// below its [`floor`]: half the demonstrator's throttle where it presses, full braking where
+/// it brakes; after a lap too slow (stalled, time limit), they are
 /// raised by δ over the kernel spacing before the stall, up to full throttle, however often it
 /// stalls there (a slower demonstration cannot help a car that stops; raised over more road,
 /// a 30-kernel pedal on Spring's 22 km, 760 m a spacing, reached the corner before the hill
@@ -166,8 +181,9 @@ impl Start {
 /// too fast failed within a kernel spacing of where one failed since the last fit to a
 /// demonstration, or the targets are at their floor already — or where raising cannot (full
 /// throttle already), or the venue did not say where, w₀ is fitted again to a demonstration
-/// [`START_SLOWDOWN`] as fast, by `demonstrate`. Each lap's outcome and the
-/// seconds it took are kept.
+/// [`START_SLOWDOWN`] as fast, by `demonstrate`, its targets moved as the repairs so far moved
+/// the last one's ([`carried`]: a corner lowered stays lowered, rather than failing again on
+/// the slower fit). Each lap's weights, outcome and the seconds it took are kept.
 pub fn complete_start(
     evaluator: &mut dyn Evaluator,
     initial: Policy,
@@ -190,14 +206,17 @@ pub fn complete_start(
     let mut start = Start {
         policy: initial,
         laps: Vec::new(),
+        driven: Vec::new(),
         speed_mps: speed,
     };
     loop {
         let t0 = std::time::Instant::now();
-        let outcome = evaluator.evaluate(start.laps.len() as i64 + 1, &start.policy.weights())?;
+        let weights = start.policy.weights();
+        let outcome = evaluator.evaluate(start.laps.len() as i64 + 1, &weights)?;
         start
             .laps
             .push((outcome.clone(), t0.elapsed().as_secs_f64()));
+        start.driven.push(weights);
         if !matches!(outcome, Outcome::Failed { .. }) || start.failed() >= max_failed {
             return Ok(start);
         }
@@ -232,7 +251,8 @@ pub fn complete_start(
                 }
                 let (lap, pairs) = demonstrate(speed)?;
                 if lap.completed {
-                    (demo, targets) = (pairs.clone(), pairs);
+                    targets = carried(&demo, &targets, &pairs);
+                    demo = pairs;
                     places.clear();
                     (step, last) = (START_STEP, None);
                     start.speed_mps = speed;
@@ -245,16 +265,46 @@ pub fn complete_start(
     }
 }
 
-/// Moves the targets (x, a) with x in [from, to] by `step`, a lowered one no further than half
-/// its demonstration's value a₀ where that presses the throttle, a₀ itself where it brakes
-/// (`demo`: the targets and the demonstration are the same pairs, moved); whether any moved.
+/// The targets of a new demonstration `pairs` moved as `targets` moved from `demo` (the
+/// repairs so far, kept): each pair's a₀ plus the move d at the nearest place of `demo` at or
+/// before it, no lower than the [`floor`] and no higher than full throttle.
+fn carried(demo: &[(f64, f64)], targets: &[(f64, f64)], pairs: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    pairs
+        .iter()
+        .map(|&(x, a0)| {
+            let i = demo.partition_point(|p| p.0 <= x).saturating_sub(1);
+            let d = match (demo.get(i), targets.get(i)) {
+                (Some(p), Some(t)) => t.1 - p.1,
+                _ => 0.0,
+            };
+            let a = if d < 0.0 {
+                (a0 + d).max(floor(a0).min(a0))
+            } else {
+                (a0 + d).min(1.0).max(a0)
+            };
+            (x, a)
+        })
+        .collect()
+}
+
+/// The lowest a target whose demonstration pedal is a₀ is lowered to: half a₀ where the
+/// demonstrator presses the throttle (a cruising pedal braked, or only coasting, over the
+/// repair's stretch stops the car), full braking where it brakes (the fit rounds the
+/// demonstrator's brake, 100–300 m long, into a lift with kernels 120–200 m apart, and the
+/// fitted car reaches the corner too fast however little throttle is left before the brake).
+fn floor(a0: f64) -> f64 {
+    if a0 > 0.0 { 0.5 * a0 } else { -1.0 }
+}
+
+/// Moves the targets (x, a) with x in [from, to] by `step`, a lowered one no further than its
+/// [`floor`] (`demo`: the targets and the demonstration are the same pairs, moved); whether
+/// any moved.
 fn shift(targets: &mut [(f64, f64)], demo: &[(f64, f64)], from: f64, to: f64, step: f64) -> bool {
     let mut moved = false;
     for ((x, a), (_, a0)) in targets.iter_mut().zip(demo) {
         if (from..=to).contains(x) {
-            let floor = if *a0 > 0.0 { 0.5 * a0 } else { *a0 };
             let next = if step < 0.0 {
-                (*a + step).max(floor)
+                (*a + step).max(floor(*a0).min(*a))
             } else {
                 (*a + step).min(1.0).max(*a)
             };
@@ -375,6 +425,94 @@ mod tests {
             "slower demonstrations asked for: {asked:?}"
         );
         assert_eq!(start.speed_mps, 15.0);
+    }
+
+    /// A venue whose lap leaves the road at x = 0.5 while the pedal at x = 0.45, inside the
+    /// demonstrator's brake, is above `most`.
+    struct Brake {
+        most: f64,
+    }
+
+    impl Evaluator for Brake {
+        fn evaluate(&mut self, _trial: i64, weights: &[f64]) -> Result<Outcome> {
+            let lengthscale = default_lengthscale(weights.len());
+            let pedal = RkhsPolicy::new(weights.to_vec(), lengthscale)?;
+            Ok(if pedal.action(0.45) > self.most {
+                Outcome::Failed {
+                    at: Some(0.5),
+                    reason: Some("off_track".into()),
+                }
+            } else {
+                Outcome::Lap {
+                    time_s: 100.0,
+                    length_m: 1000.0,
+                }
+            })
+        }
+    }
+
+    /// A first policy too fast where the demonstrator brakes (its brake fills the whole
+    /// stretch a repair lowers) brakes harder there until its lap completes: no slower
+    /// demonstration is asked for (with the brake held at the demonstrator's, nothing could
+    /// be lowered and every repair was a slower demonstration).
+    #[test]
+    fn a_first_policy_too_fast_in_a_brake_brakes_harder() {
+        let targets: Vec<(f64, f64)> = (0..100)
+            .map(|i| {
+                let x = i as f64 / 100.0;
+                (x, if (0.2..=0.5).contains(&x) { -0.2 } else { 0.4 })
+            })
+            .collect();
+        let kernels = 30;
+        let lengthscale = default_lengthscale(kernels);
+        let pedal = RkhsPolicy::fit(&targets, kernels, lengthscale, DEFAULT_RIDGE).unwrap();
+        let mut asked = Vec::new();
+        let mut demonstrate = |v: f64| {
+            asked.push(v);
+            demonstrator(f64::INFINITY, &mut Vec::new())(v)
+        };
+        // The fit brakes at 0.45 about as the demonstrator does; the venue asks 0.05 more.
+        let mut venue = Brake {
+            most: pedal.action(0.45) - 0.05,
+        };
+        let start = complete_start(
+            &mut venue,
+            pedal.into(),
+            (&targets, 15.0),
+            &mut demonstrate,
+            1000.0,
+            30,
+        )
+        .unwrap();
+        assert!(start.completed(), "{:?}", start.laps);
+        assert_eq!(start.failed(), 1, "{:?}", start.laps);
+        assert!(
+            asked.is_empty(),
+            "slower demonstrations asked for: {asked:?}"
+        );
+        assert_eq!(start.failures().len(), start.failed());
+        assert!(
+            start
+                .failures()
+                .iter()
+                .all(|(_, f)| f.at == 0.5 && !f.too_slow)
+        );
+        assert_eq!(start.driven.last(), Some(&start.policy.weights()));
+    }
+
+    /// A slower demonstration keeps the repairs made on the last: its pedal moves by the
+    /// last targets' move at the nearest place before, a lowering no further than the floor.
+    #[test]
+    fn a_slower_demonstration_keeps_the_repairs() {
+        let demo = [(0.0, 0.5), (0.5, 0.5), (0.8, -0.2)];
+        let targets = [(0.0, 0.5), (0.5, 0.3), (0.8, -0.4)];
+        let slower = [(0.1, 0.4), (0.6, 0.3), (0.7, 0.4), (0.9, -0.1)];
+        let moved = carried(&demo, &targets, &slower);
+        let expected = [(0.1, 0.4), (0.6, 0.15), (0.7, 0.2), (0.9, -0.3)];
+        for ((x, a), (ex, ea)) in moved.iter().zip(expected) {
+            assert_eq!(*x, ex);
+            assert!((a - ea).abs() < 1e-12, "{moved:?}");
+        }
     }
 
     /// Where the asked speed completes, it is the only lap; where it fails, the search slows

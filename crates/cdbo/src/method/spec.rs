@@ -16,7 +16,7 @@ use crate::optimizers::linebo::{self, LineBo};
 use crate::optimizers::random::{self, RandomSearch};
 use crate::optimizers::rembo::{self, Rembo};
 use crate::optimizers::turbo::{self, Turbo};
-use crate::optimizers::{DEFAULT_BOX_RADIUS, Optimizer, Saved, SearchBox};
+use crate::optimizers::{DEFAULT_BOX_RADIUS, FailedLap, Optimizer, Saved, SearchBox};
 
 /// A method and everything it is told besides w₀, every value checked when it was set.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -209,7 +209,19 @@ impl Spec {
     /// The method's optimiser, from w₀ (within its failed-lap budget, if it has one; the safe
     /// pattern search spends its budget itself, [`safe_search::BUDGET`] unless told).
     pub fn optimizer(&self, w0: Vec<f64>) -> Result<Box<dyn Optimizer + Send>> {
-        let method = self.method_optimizer(w0.clone())?;
+        self.optimizer_after(w0, &[])
+    }
+
+    /// The method's optimiser, from a w₀ whose lap completed after the laps `failed` (their
+    /// weights, and where and how each failed; a race's start, [`crate::experiment::start`]):
+    /// the safe pattern search remembers them ([`SafeSearch::after_failures`]), the other
+    /// methods keep no memory of failed laps and start as [`optimizer`](Self::optimizer).
+    pub fn optimizer_after(
+        &self,
+        w0: Vec<f64>,
+        failed: &[(Vec<f64>, FailedLap)],
+    ) -> Result<Box<dyn Optimizer + Send>> {
+        let method = self.method_optimizer(w0.clone(), failed)?;
         Ok(match self.max_failed_laps {
             Some(max) if self.method != Method::SafePatternSearch => {
                 let budget = FailureBudget::new(method, max);
@@ -223,7 +235,11 @@ impl Spec {
         })
     }
 
-    fn method_optimizer(&self, w0: Vec<f64>) -> Result<Box<dyn Optimizer + Send>> {
+    fn method_optimizer(
+        &self,
+        w0: Vec<f64>,
+        failed: &[(Vec<f64>, FailedLap)],
+    ) -> Result<Box<dyn Optimizer + Send>> {
         let Spec {
             method,
             seed,
@@ -315,7 +331,7 @@ impl Spec {
             Method::SafePatternSearch => {
                 let budget = max_failed_laps.unwrap_or(safe_search::BUDGET);
                 let config = safe_search::SafeSearchConfig::within(pattern_search, budget);
-                Box::new(SafeSearch::new(w0, config)?)
+                Box::new(SafeSearch::after_failures(w0, config, failed)?)
             }
         })
     }

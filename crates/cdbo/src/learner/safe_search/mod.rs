@@ -43,6 +43,7 @@ use crate::error::{Error, Result};
 use crate::learner::pattern_search::{
     PatternSearchConfig, PatternSearchProgress, PatternSearchProposer, Trial,
 };
+use crate::optimizers::FailedLap;
 use crate::optimizers::ask_tell::{AskTell, Lap, Proposal, Proposer, Recorded, SavedAs, Told};
 use memory::{FailureMemory, Pedals};
 
@@ -189,11 +190,38 @@ pub type SafeSearch = AskTell<SafeSearchProposer>;
 impl SafeSearch {
     /// A search from `start` (driven first, unmoved).
     pub fn new(start: Vec<f64>, config: SafeSearchConfig) -> Result<SafeSearch> {
+        SafeSearch::after_failures(start, config, &[])
+    }
+
+    /// A search from `start`, a lap that completed after the laps `failed` (their weights,
+    /// and where and how each failed), driven before the search and not counted in its
+    /// budget: each is remembered as a bracket against `start` over one window before where
+    /// it failed, as a push's failure is, so that the search's first laps do not drive again
+    /// what they already said. A race's start is such a lap: w₀ repaired where its laps left
+    /// the road ([`crate::experiment::start`]).
+    pub fn after_failures(
+        start: Vec<f64>,
+        config: SafeSearchConfig,
+        failed: &[(Vec<f64>, FailedLap)],
+    ) -> Result<SafeSearch> {
+        let pedals = pedals_of(&config, start.len());
+        let reference = pedals.sample(&start)?;
+        let mut memory = FailureMemory::default();
+        for (weights, failure) in failed {
+            if weights.len() != start.len() {
+                return Err(Error::invalid_value(
+                    "a failed lap before the safe search's start",
+                    format!("{} weights", weights.len()),
+                    format!("{} weights, as the start has", start.len()),
+                ));
+            }
+            memory.failed(&pedals, &pedals.sample(weights)?, &reference, *failure, 1.0);
+        }
         let search = PatternSearchProposer::new(start, config.search.clone())?;
         let progress = SafeSearchProgress {
             config,
             search: search.progress().clone(),
-            memory: FailureMemory::default(),
+            memory,
             laps: 0,
             failed: 0,
             skipped: 0,
@@ -209,6 +237,16 @@ impl SafeSearch {
         let (state, told) = state.into_parts();
         Ok(AskTell::resumed(SafeSearchProposer::resume(state)?, told))
     }
+}
+
+/// How a search of `config` reads the pedal of its `dim` weights.
+fn pedals_of(config: &SafeSearchConfig, dim: usize) -> Pedals {
+    let c = &config.search;
+    Pedals::new(
+        c.pedal_kernels.unwrap_or(dim),
+        c.lengthscale,
+        c.track_length,
+    )
 }
 
 impl SafeSearchProposer {
@@ -237,8 +275,8 @@ impl SafeSearchProposer {
             ));
         }
         let search = PatternSearchProposer::resume(state.search.clone())?;
+        let pedals = pedals_of(c, state.search.start.len());
         let n = c.search.pedal_kernels.unwrap_or(state.search.start.len());
-        let pedals = Pedals::new(n, c.search.lengthscale, c.search.track_length);
         if !state.memory.is_sound(pedals.points()) {
             return Err(Error::CorruptState {
                 method: "safe pattern search",
