@@ -412,7 +412,7 @@ fn race_with(
         .track_length(limit.track_length)?
         .optimizer_after(
             first,
-            &start.as_ref().map(Start::failures).unwrap_or_default(),
+            &start.as_ref().map(Start::departures).unwrap_or_default(),
         )?;
     let mut source = InMemory::new(optimizer, config.laps - start_failed);
     let (lap, mut start_s) = remembered;
