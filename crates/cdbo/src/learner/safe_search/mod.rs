@@ -27,9 +27,10 @@
 //!
 //! **The laps before its start.** A race drives its w₀ until it completes
 //! ([`crate::experiment::start`]); those failed laps count in the budget, and the search
-//! remembers them as brackets against w₀ ([`SafeSearch::after_failures`]): without them its
-//! first push failed again where the start had (measured on TUMFTM's 13 circuits, seeds 0–2:
-//! Austin 69.0 → 79.3 % of the centre-line limit, all 86.3 → 86.1 %; docs/results/any-track.md).
+//! remembers those too fast as brackets against w₀ ([`SafeSearch::after_failures`]): without
+//! them its first push failed again where the start had (measured at ae957d7 on TUMFTM's 13
+//! circuits, seeds 0–2: Austin 69.0 → 79.8 % of the centre-line limit, all 86.3 → 86.2 %;
+//! docs/results/any-track.md).
 //!
 //! **A lifted budget.** A budget of at least H failed laps cannot bind within the horizon: the
 //! learner is then the pattern search itself, its push, repairs and laps exactly
