@@ -28,7 +28,7 @@
 //! **The laps before its start.** A race drives its w₀ until it completes
 //! ([`crate::experiment::start`]); those failed laps count in the budget, and the search
 //! remembers those too fast as brackets against w₀ ([`SafeSearch::after_failures`]): without
-//! them its first push failed again where the start had (measured at ae957d7 on TUMFTM's 13
+//! them its first push failed again where the start had (measured at 4174b20 on TUMFTM's 13
 //! circuits, seeds 0–2: Austin 69.0 → 79.8 % of the centre-line limit, all 86.3 → 86.2 %;
 //! docs/results/any-track.md).
 //!
