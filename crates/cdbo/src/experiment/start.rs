@@ -176,7 +176,7 @@ impl Start {
 /// with `evaluator` until its lap completes, at most `max_failed` laps failing. After a lap too
 /// fast (off the road, spun, backwards), the fit's targets over the [`REPAIR_DISTANCE`] metres
 /// (at least two kernel spacings) before the failure are lowered by a step δ, but none
-/// below its [`floor`]: half the demonstrator's throttle where it presses, full braking where
+/// below its floor: half the demonstrator's throttle where it presses, full braking where
 /// it brakes; after a lap too slow (stalled, time limit), they are
 /// raised by δ over the kernel spacing before the stall, up to full throttle, however often it
 /// stalls there (a slower demonstration cannot help a car that stops; raised over more road,
@@ -188,7 +188,7 @@ impl Start {
 /// demonstration, or the targets are at their floor already — or where raising cannot (full
 /// throttle already), or the venue did not say where, w₀ is fitted again to a demonstration
 /// [`START_SLOWDOWN`] as fast, by `demonstrate`, its targets moved as the repairs so far moved
-/// the last one's ([`carried`]: a corner lowered stays lowered, rather than failing again on
+/// the last one's (a corner lowered stays lowered, rather than failing again on
 /// the slower fit). Each lap's weights, outcome and the seconds it took are kept.
 pub fn complete_start(
     evaluator: &mut dyn Evaluator,
