@@ -376,27 +376,83 @@ mod tests {
         }
     }
 
-    /// A venue whose lap stalls at x = 0.3 while the pedal at x = 0.29 is below `needed`.
-    struct Hill {
-        needed: f64,
+    /// A venue whose lap fails at `at` for `reason` while the pedal at `probe` is outside `ok`.
+    struct Gate {
+        probe: f64,
+        ok: std::ops::RangeInclusive<f64>,
+        at: f64,
+        reason: &'static str,
     }
 
-    impl Evaluator for Hill {
+    impl Evaluator for Gate {
         fn evaluate(&mut self, _trial: i64, weights: &[f64]) -> Result<Outcome> {
             let lengthscale = default_lengthscale(weights.len());
             let pedal = RkhsPolicy::new(weights.to_vec(), lengthscale)?;
-            Ok(if pedal.action(0.29) < self.needed {
-                Outcome::Failed {
-                    at: Some(0.3),
-                    reason: Some("stalled".into()),
-                }
-            } else {
+            Ok(if self.ok.contains(&pedal.action(self.probe)) {
                 Outcome::Lap {
                     time_s: 100.0,
                     length_m: 1000.0,
                 }
+            } else {
+                Outcome::Failed {
+                    at: Some(self.at),
+                    reason: Some(self.reason.into()),
+                }
             })
         }
+    }
+
+    /// A hill: the lap stalls at x = 0.3 while the pedal at x = 0.29 is below `needed`.
+    fn hill(needed: f64) -> Gate {
+        Gate {
+            probe: 0.29,
+            ok: needed..=f64::INFINITY,
+            at: 0.3,
+            reason: "stalled",
+        }
+    }
+
+    /// A brake: the lap leaves the road at x = 0.5 while the pedal at x = 0.45, inside the
+    /// demonstrator's brake, is above `most`.
+    fn brake(most: f64) -> Gate {
+        Gate {
+            probe: 0.45,
+            ok: f64::NEG_INFINITY..=most,
+            at: 0.5,
+            reason: "off_track",
+        }
+    }
+
+    /// The 30-kernel fit of `targets` (the 15 m/s demonstration's pairs).
+    fn fit(targets: &[(f64, f64)]) -> RkhsPolicy {
+        let kernels = 30;
+        RkhsPolicy::fit(
+            targets,
+            kernels,
+            default_lengthscale(kernels),
+            DEFAULT_RIDGE,
+        )
+        .unwrap()
+    }
+
+    /// The start from `pedal`, the fit of `targets`, on `venue`, with the speeds of the slower
+    /// demonstrations it asked for (every one completes).
+    fn start_on(venue: &mut Gate, pedal: RkhsPolicy, targets: &[(f64, f64)]) -> (Start, Vec<f64>) {
+        let mut asked = Vec::new();
+        let mut demonstrate = |v: f64| {
+            asked.push(v);
+            demonstrator(f64::INFINITY, &mut Vec::new())(v)
+        };
+        let start = complete_start(
+            venue,
+            pedal.into(),
+            (targets, 15.0),
+            &mut demonstrate,
+            1000.0,
+            30,
+        )
+        .unwrap();
+        (start, asked)
     }
 
     /// A first policy that stalls again and again at one place is raised there until its lap
@@ -404,24 +460,7 @@ mod tests {
     #[test]
     fn a_stalling_first_policy_is_raised_not_slowed() {
         let targets: Vec<(f64, f64)> = (0..100).map(|i| (i as f64 / 100.0, 0.2)).collect();
-        let kernels = 30;
-        let lengthscale = default_lengthscale(kernels);
-        let pedal = RkhsPolicy::fit(&targets, kernels, lengthscale, DEFAULT_RIDGE).unwrap();
-        let mut asked = Vec::new();
-        let mut demonstrate = |v: f64| {
-            asked.push(v);
-            demonstrator(f64::INFINITY, &mut Vec::new())(v)
-        };
-        let mut hill = Hill { needed: 0.55 };
-        let start = complete_start(
-            &mut hill,
-            pedal.into(),
-            (&targets, 15.0),
-            &mut demonstrate,
-            1000.0,
-            30,
-        )
-        .unwrap();
+        let (start, asked) = start_on(&mut hill(0.55), fit(&targets), &targets);
         assert!(start.completed(), "{:?}", start.laps);
         // 0.2 raised by 0.1 a lap: 0.3, 0.4, 0.5 stall (the fit sits a little below its
         // targets), 0.6 completes.
@@ -433,30 +472,6 @@ mod tests {
         assert_eq!(start.speed_mps, 15.0);
         // Stalls are the repair's to undo, not departures the learner remembers.
         assert!(start.departures().is_empty());
-    }
-
-    /// A venue whose lap leaves the road at x = 0.5 while the pedal at x = 0.45, inside the
-    /// demonstrator's brake, is above `most`.
-    struct Brake {
-        most: f64,
-    }
-
-    impl Evaluator for Brake {
-        fn evaluate(&mut self, _trial: i64, weights: &[f64]) -> Result<Outcome> {
-            let lengthscale = default_lengthscale(weights.len());
-            let pedal = RkhsPolicy::new(weights.to_vec(), lengthscale)?;
-            Ok(if pedal.action(0.45) > self.most {
-                Outcome::Failed {
-                    at: Some(0.5),
-                    reason: Some("off_track".into()),
-                }
-            } else {
-                Outcome::Lap {
-                    time_s: 100.0,
-                    length_m: 1000.0,
-                }
-            })
-        }
     }
 
     /// A first policy too fast where the demonstrator brakes (its brake fills the whole
@@ -471,27 +486,10 @@ mod tests {
                 (x, if (0.2..=0.5).contains(&x) { -0.2 } else { 0.4 })
             })
             .collect();
-        let kernels = 30;
-        let lengthscale = default_lengthscale(kernels);
-        let pedal = RkhsPolicy::fit(&targets, kernels, lengthscale, DEFAULT_RIDGE).unwrap();
-        let mut asked = Vec::new();
-        let mut demonstrate = |v: f64| {
-            asked.push(v);
-            demonstrator(f64::INFINITY, &mut Vec::new())(v)
-        };
+        let pedal = fit(&targets);
         // The fit brakes at 0.45 about as the demonstrator does; the venue asks 0.05 more.
-        let mut venue = Brake {
-            most: pedal.action(0.45) - 0.05,
-        };
-        let start = complete_start(
-            &mut venue,
-            pedal.into(),
-            (&targets, 15.0),
-            &mut demonstrate,
-            1000.0,
-            30,
-        )
-        .unwrap();
+        let mut venue = brake(pedal.action(0.45) - 0.05);
+        let (start, asked) = start_on(&mut venue, pedal, &targets);
         assert!(start.completed(), "{:?}", start.laps);
         assert_eq!(start.failed(), 1, "{:?}", start.laps);
         assert!(
