@@ -93,7 +93,7 @@ pub fn run(args: &CeilingArgs, data: &DataPath) -> CliResult {
             return Err(format!(
                 "{}: no fitted policy completes within {} repairs, so none is written",
                 out.display(),
-                cdbo::ceiling::REPAIR_LAPS
+                cdbo::ceiling::MOST_REPAIR_LAPS
             )
             .into());
         };
@@ -131,7 +131,10 @@ fn print_summary(
             c.repairs
         )
     } else {
-        format!("none completes within {} laps", cdbo::ceiling::REPAIR_LAPS)
+        format!(
+            "none completes within {} laps",
+            cdbo::ceiling::MOST_REPAIR_LAPS
+        )
     };
     println!(
         "{car} on {track}: {which} limit {:.2} m/s; tracking {:.3} x the crest-aware limit's speed profile (its lap {:.2} m/s): {:.2} m/s ({:.1} % of the {which} limit{of_centre}); {}-kernel policy fitted to its pedal, repaired where it fails: {}",

@@ -30,7 +30,22 @@ pub struct PedalRepair {
     /// The first step δ₀ at each new place (the default [`REPAIR_STEP`] is not written).
     #[serde(default = "default_step", skip_serializing_if = "is_default_step")]
     pub first: f64,
+    /// Whether a corner that fails too fast again after its repair is braked for earlier
+    /// ([`Self::braking_earlier`]).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub earlier: bool,
+    /// Too-fast failures in a row at the same corner, the first not counted.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub repeats: usize,
 }
+
+/// Whether no failure has repeated.
+fn is_zero(n: &usize) -> bool {
+    *n == 0
+}
+
+/// The most windows a repair reaches back, [`PedalRepair::braking_earlier`]: 1 + [`MOST_REPEATS`].
+pub const MOST_REPEATS: usize = 6;
 
 /// δ₀ of repairs saved before it was set.
 fn default_step() -> f64 {
@@ -51,6 +66,22 @@ impl PedalRepair {
             last: None,
             window: None,
             first: REPAIR_STEP,
+            earlier: false,
+            repeats: 0,
+        }
+    }
+
+    /// These repairs, braking earlier for a corner that fails again: a too-fast failure at or
+    /// before one spacing past the last one, and no more than [`MOST_REPEATS`] spacings
+    /// before it, is that corner again, and the n-th such failure in a row moves the targets
+    /// over (1 + n) windows before it rather than one (at most 1 + [`MOST_REPEATS`]). A repair
+    /// that only lowers the pedal in the corner brakes the car while it turns; at the limit
+    /// that spins it or stops it there, and the next repair, too slow, raises the pedal again.
+    /// Braking earlier, on the straight before the corner, is what the tracked lap did.
+    pub fn braking_earlier(self) -> PedalRepair {
+        PedalRepair {
+            earlier: true,
+            ..self
         }
     }
 
@@ -95,6 +126,19 @@ impl PedalRepair {
         stretch: f64,
     ) {
         let direction = if too_slow { 1.0 } else { -1.0 };
+        let stretch = if self.earlier && !too_slow {
+            let again = matches!(self.last, Some((x, d)) if d == direction
+                && x_fail <= x + self.spacing
+                && x_fail >= x - MOST_REPEATS as f64 * self.spacing);
+            self.repeats = if again {
+                (self.repeats + 1).min(MOST_REPEATS)
+            } else {
+                0
+            };
+            stretch * (1 + self.repeats) as f64
+        } else {
+            stretch
+        };
         match self.last {
             Some((x, d)) if (x_fail - x).abs() < self.spacing && d != direction => {
                 self.step *= 0.5;
@@ -138,6 +182,12 @@ mod tests {
         repair.repair(&mut targets, 0.8, false /* off the road: too fast */);
         assert_eq!(repair.step, REPAIR_STEP);
         assert!(close(targets[80].1, 0.4) && close(targets[57].1, 0.5));
+        // The plain repair moves the window again where the car fails again.
+        let mut plain = PedalRepair::new(11);
+        let mut targets: Vec<(f64, f64)> = (0..=100).map(|i| (i as f64 / 100.0, 0.5)).collect();
+        plain.repair(&mut targets, 0.5, false);
+        plain.repair(&mut targets, 0.5, false);
+        assert!(close(targets[30].1, 0.3) && close(targets[29].1, 0.5));
         // Over a window of its own: 0.055 of the lap before the failure, not two spacings.
         let mut narrow = PedalRepair::new(11).over(0.055);
         let mut targets: Vec<(f64, f64)> = (0..=100).map(|i| (i as f64 / 100.0, 0.5)).collect();
@@ -146,5 +196,31 @@ mod tests {
             let moved = (45..=50).contains(&i);
             assert!(close(a, if moved { 0.4 } else { 0.5 }), "x {x}: {a}");
         }
+    }
+
+    /// Braking earlier: the corner failing too fast again moves the targets over two windows,
+    /// then three; a stall between, or a failure elsewhere, starts again at one.
+    #[test]
+    fn a_corner_that_fails_again_is_braked_for_earlier() {
+        let mut repair = PedalRepair::new(11).braking_earlier();
+        let mut targets: Vec<(f64, f64)> = (0..=100).map(|i| (i as f64 / 100.0, 0.0)).collect();
+        // The targets moved by the last repair, as (first, last) indices.
+        let mut moved = |repair: &mut PedalRepair, x: f64, too_slow: bool| {
+            let before: Vec<f64> = targets.iter().map(|t| t.1).collect();
+            repair.repair(&mut targets, x, too_slow);
+            let changed: Vec<usize> = (0..=100).filter(|&i| targets[i].1 != before[i]).collect();
+            (changed[0], changed[changed.len() - 1])
+        };
+        assert_eq!(moved(&mut repair, 0.7, false), (50, 70));
+        assert_eq!(moved(&mut repair, 0.69, false), (29, 69));
+        assert_eq!(moved(&mut repair, 0.68, false), (8, 68));
+        assert_eq!(repair.repeats, 2);
+        // A stall is repaired over one window, and the next too-fast failure is new.
+        assert_eq!(moved(&mut repair, 0.7, true), (50, 70));
+        assert_eq!(moved(&mut repair, 0.7, false), (50, 70));
+        assert_eq!(moved(&mut repair, 0.7, false), (30, 70));
+        // Further on than a spacing past the last: another corner.
+        assert_eq!(moved(&mut repair, 0.95, false), (75, 95));
+        assert_eq!(repair.repeats, 0);
     }
 }
