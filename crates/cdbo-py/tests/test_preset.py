@@ -52,7 +52,7 @@ def test_the_preset_beside_an_argument_of_its_stack_is_refused(given, tmp_path):
 
 
 def test_an_unknown_preset_is_refused_naming_the_presets():
-    assert cdbo.PRESETS == ["fast-safe"]
+    assert cdbo.PRESETS == ["fast-safe", "fast"]
     with pytest.raises(ValueError, match="fastest.*fast-safe"):
         cdbo.race("ridgeway", laps=2, preset="fastest")
 

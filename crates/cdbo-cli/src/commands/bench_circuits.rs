@@ -64,10 +64,11 @@ pub enum Stack {
 }
 
 impl Stack {
-    /// The stacks the README recommends: the preset, the pattern search, the paper's CDBO.
+    /// The stacks the README recommends: the two presets (the safe pattern search, and the
+    /// pattern search on the same drive), and the paper's CDBO.
     const RECOMMENDED: [Stack; 3] = [
         Stack::Preset(Preset::FastSafe),
-        Stack::Method(Method::PatternSearch),
+        Stack::Preset(Preset::Fast),
         Stack::Method(Method::Cdbo),
     ];
 

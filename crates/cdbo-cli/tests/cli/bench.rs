@@ -93,7 +93,7 @@ fn a_folder_without_circuits_and_an_unknown_stack_get_one_clear_line() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success());
     assert!(
-        err.contains("\"fastest\" is neither a preset (fast-safe) nor a method"),
+        err.contains("\"fastest\" is neither a preset (fast-safe, fast) nor a method"),
         "{err}"
     );
 }

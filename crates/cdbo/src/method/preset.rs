@@ -29,16 +29,23 @@ pub enum Preset {
     /// that line ([`crate::experiment::profile_start`]), not the paper's 15 m/s. The paper's
     /// CDBO, PI steering and centre line stay the defaults.
     FastSafe,
+    /// `fast`, the same drive with the pattern search and no budget: `--method pattern-search
+    /// --steering tracker --line min-curvature`. Where a failed lap costs nothing (in a
+    /// simulator) it learns the fastest laps, failing several times as many laps as
+    /// `fast-safe`; it starts from the paper's demonstration, as every method but the safe
+    /// pattern search does.
+    Fast,
 }
 
 impl Preset {
     /// Every preset, in the order help lists them.
-    pub const ALL: [Preset; 1] = [Preset::FastSafe];
+    pub const ALL: [Preset; 2] = [Preset::FastSafe, Preset::Fast];
 
     /// Its name, as `--preset`, a grid and Python take it.
     pub fn name(self) -> &'static str {
         match self {
             Preset::FastSafe => "fast-safe",
+            Preset::Fast => "fast",
         }
     }
 
@@ -46,25 +53,26 @@ impl Preset {
     pub fn method(self) -> Method {
         match self {
             Preset::FastSafe => Method::SafePatternSearch,
+            Preset::Fast => Method::PatternSearch,
         }
     }
 
     /// The steering it sets.
     pub fn steering(self) -> SteeringLaw {
         match self {
-            Preset::FastSafe => SteeringLaw::Tracker,
+            Preset::FastSafe | Preset::Fast => SteeringLaw::Tracker,
         }
     }
 
     /// The line it sets.
     pub fn line(self) -> LineKind {
         match self {
-            Preset::FastSafe => LineKind::MinCurvature,
+            Preset::FastSafe | Preset::Fast => LineKind::MinCurvature,
         }
     }
 
-    /// The long form it stands for: `--method safe-pattern-search --steering tracker --line
-    /// min-curvature`.
+    /// The long form it stands for, e.g. `--method safe-pattern-search --steering tracker
+    /// --line min-curvature`.
     pub fn flags(self) -> String {
         format!(
             "--method {} --steering {} --line {}",
@@ -81,6 +89,11 @@ impl Preset {
                 "the safe pattern search (learning within a budget of failed laps, 30 unless \
                  --max-failed-laps gives another) on the path tracker and the minimum-curvature \
                  line: --method safe-pattern-search --steering tracker --line min-curvature"
+            }
+            Preset::Fast => {
+                "the pattern search with no budget on the same drive, for a simulator, where a \
+                 failed lap costs nothing: --method pattern-search --steering tracker --line \
+                 min-curvature"
             }
         }
     }
@@ -142,5 +155,18 @@ mod tests {
         assert_eq!(serde_json::from_str::<Preset>("\"fast-safe\"").unwrap(), p);
         let e = "fastest".parse::<Preset>().unwrap_err().to_string();
         assert!(e.contains("fastest") && e.contains("fast-safe"), "{e}");
+    }
+
+    /// `fast` is the pattern search on the same drive, by its name and its long form.
+    #[test]
+    fn fast_is_the_pattern_search_on_the_same_drive() {
+        let p: Preset = "fast".parse().unwrap();
+        assert_eq!(p, Preset::Fast);
+        assert_eq!(
+            p.flags(),
+            "--method pattern-search --steering tracker --line min-curvature"
+        );
+        assert!(p.description().ends_with(&p.flags()));
+        assert_eq!(serde_json::to_string(&p).unwrap(), "\"fast\"");
     }
 }
