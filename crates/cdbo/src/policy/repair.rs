@@ -44,7 +44,9 @@ fn is_zero(n: &usize) -> bool {
     *n == 0
 }
 
-/// The most windows a repair reaches back, [`PedalRepair::braking_earlier`]: 1 + [`MOST_REPEATS`].
+/// The most repeated failures a repair braking earlier counts ([`PedalRepair::braking_earlier`]):
+/// its stretch reaches back at most 1 + this many windows, and a failure up to this many
+/// spacings before the last one is still the same corner.
 pub const MOST_REPEATS: usize = 6;
 
 /// δ₀ of repairs saved before it was set.
