@@ -15,6 +15,7 @@ use cdbo::data_path::DataPath;
 use cdbo::experiment::race::{BaseLine, RaceConfig, race};
 use cdbo::method::Preset;
 use cdbo::policy::{Policy, RacedPolicy};
+use cdbo::sizes;
 use cdbo::torcs::{self, Game, GamePedal};
 use cdbo::venue::Venue;
 
@@ -106,12 +107,26 @@ pub fn run(args: &LearnArgs, data: &DataPath) -> CliResult {
 }
 
 /// The finer policies the ceiling is also fitted with: 2M and 4M kernels, as many as the
-/// pattern search pushes ([`MAX_KERNELS`](cdbo::learner::pattern_search::push::MAX_KERNELS)).
-fn finer_kernels(kernels: usize) -> impl Iterator<Item = usize> {
-    [2 * kernels, 4 * kernels]
+/// pattern search pushes ([`MAX_KERNELS`](cdbo::learner::pattern_search::push::MAX_KERNELS)),
+/// and, on a track so long that the finest of them lies more than [`FINEST_SPACING_M`] apart,
+/// one with its kernels that far apart (learned on in the game without pushes).
+fn finer_kernels(kernels: usize, track_length: f64) -> Vec<usize> {
+    let mut finer: Vec<usize> = [2 * kernels, 4 * kernels]
         .into_iter()
         .filter(|&m| m <= cdbo::learner::pattern_search::push::MAX_KERNELS)
+        .collect();
+    let finest = finer.last().copied().unwrap_or(kernels);
+    let spaced = (track_length / FINEST_SPACING_M).ceil() as usize;
+    if spaced > finest && sizes::KERNELS.check(spaced).is_ok() {
+        finer.push(spaced);
+    }
+    finer
 }
+
+/// The widest spacing of the finest fit (m): a braking zone of a trb1 car, 150–250 m, then
+/// holds three to five kernels. On TORCS's road tracks only Spring (22 km) is long enough
+/// for 200 kernels to lie further apart.
+const FINEST_SPACING_M: f64 = 50.0;
 
 /// A lap time in a cell: `83.85 s`, or `fails`.
 fn cell(lap: Option<f64>) -> String {
@@ -146,7 +161,7 @@ fn learn_on(
     };
     // The ceiling's fits with M, 2M and 4M kernels; the fastest completed one.
     let mut ceiling = cdbo::ceiling::ceiling_with(&sim, &limit, &profile, args.kernels)?;
-    for finer in finer_kernels(args.kernels) {
+    for finer in finer_kernels(args.kernels, ours.length) {
         let fine = cdbo::ceiling::ceiling_with(&sim, &limit, &profile, finer)?;
         if fine.policy_mps > ceiling.policy_mps {
             ceiling = fine;
@@ -281,4 +296,19 @@ fn markdown(results: &[TrackResult], args: &LearnArgs) -> String {
             .count()
     );
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// 2M and 4M kernels up to the pattern search's 200; on a track so long that 200 lie
+    /// more than 50 m apart (Spring, 22 km), one more fit with kernels 50 m apart.
+    #[test]
+    fn the_finest_fit_has_its_kernels_at_most_50_m_apart_on_a_long_track() {
+        assert_eq!(finer_kernels(50, 4_000.0), [100, 200]);
+        assert_eq!(finer_kernels(100, 4_000.0), [200]);
+        assert_eq!(finer_kernels(50, 22_130.0), [100, 200, 443]);
+        assert_eq!(finer_kernels(50, 10_000.0), [100, 200]);
+    }
 }
