@@ -108,7 +108,8 @@ pub fn run(args: &CeilingArgs, data: &DataPath) -> CliResult {
     Ok(())
 }
 
-/// The one-line report: the limit, the tracked profile's lap and the fitted policy's.
+/// The one-line report: the limit, the tracked profile's lap (and the locally lowered one's,
+/// where the fit targets it) and the fitted policy's.
 fn print_summary(
     c: &cdbo::ceiling::Ceiling,
     car: &str,
@@ -136,8 +137,15 @@ fn print_summary(
             cdbo::ceiling::MOST_REPAIR_LAPS
         )
     };
+    let fitted = c.lowered_mps.map_or("its".to_owned(), |v| {
+        format!(
+            "the lap of {:.3} x lowered only where it fails ({v:.2} m/s, {:.1} %), its",
+            (c.k + cdbo::ceiling::LOWERING_HEADROOM).min(1.0),
+            pct(v)
+        )
+    });
     println!(
-        "{car} on {track}: {which} limit {:.2} m/s; tracking {:.3} x the crest-aware limit's speed profile (its lap {:.2} m/s): {:.2} m/s ({:.1} % of the {which} limit{of_centre}); {}-kernel policy fitted to its pedal, repaired where it fails: {}",
+        "{car} on {track}: {which} limit {:.2} m/s; tracking {:.3} x the crest-aware limit's speed profile (its lap {:.2} m/s): {:.2} m/s ({:.1} % of the {which} limit{of_centre}); {}-kernel policy fitted to {fitted} pedal, repaired where it fails: {}",
         c.limit_mps,
         c.k,
         c.profile_mps,
