@@ -1,8 +1,9 @@
 //! `cdbo torcs learn`: from a track to a race-ready policy in one command. cdbo's simulator
 //! first (the ceiling's policy: the limit's speed profile tracked on the minimum-curvature line
-//! and fitted with M, 2M and 4M kernels, the fastest fit kept; where no fit completes, the
-//! recommended learner's best), then a bounded number of laps of the recommended learner in
-//! the game from it, the result beside the fastest shipped robot's laps on that track.
+//! and fitted with M, 2M and 4M kernels, or 50 m apart on a long track, the fastest fit kept;
+//! where no fit completes, the recommended learner's best), then a bounded number of laps of
+//! the recommended learner in the game from it, the result beside the fastest shipped robot's
+//! laps on that track.
 
 use std::path::PathBuf;
 
@@ -28,8 +29,9 @@ pub struct LearnArgs {
     #[arg(long, default_value = torcs::DEFAULT_CAR)]
     car: String,
     /// Policy kernels M: the ceiling's policy is fitted with M, 2M and 4M kernels (at most
-    /// 200, the pattern search's), and the fastest fit in cdbo's simulator is learned on (a
-    /// finer one where a track's corners are closer together than M kernels brake for).
+    /// 200, the pattern search's), and with kernels 50 m apart where the finest of those lie
+    /// further apart; the fastest fit in cdbo's simulator is learned on (a finer one where a
+    /// track's corners are closer together than M kernels brake for).
     #[arg(long, default_value_t = 50, value_parser = super::value::kernels)]
     kernels: usize,
     /// Laps of the recommended learner in the game, after cdbo's simulator (the game also
