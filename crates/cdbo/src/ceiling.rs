@@ -21,8 +21,7 @@
 //!    the whole lap. So the profile is also **lowered only where it fails**
 //!    ([`lowered_where_it_fails`]): scaled by k + [`LOWERING_HEADROOM`] (at most 1), then,
 //!    at each failure at s_f, lowered by [`LOWERING_STEP`] over [s_f − 150 m, s_f + 25 m]
-//!    (the braking zone before it), never below k, and further back where that is down to k
-//!    already, until its lap completes. Where that lap
+//!    (the braking zone before it), never below k, until its lap completes. Where that lap
 //!    is faster than the uniform one, the policy below is fitted to its pedal (car1-trb1 on
 //!    E-Track 3, tracker and minimum-curvature line: 39.45 m/s at k = 0.796, 43.85 m/s
 //!    lowered from 0.896). The uniform lap stays the ceiling learners are measured against.
@@ -248,15 +247,10 @@ pub const LOWERING_BEFORE_M: f64 = 150.0;
 /// How far past it (m).
 pub const LOWERING_AFTER_M: f64 = 25.0;
 
-/// The most braking zones a failure reaches back over ([`lowered_where_it_fails`]).
-pub const LOWERING_MOST_REACH: usize = 6;
-
 /// The profile scaled by k + [`LOWERING_HEADROOM`] (at most 1) and lowered only where its
-/// tracked lap fails: each failure at s_f lowers the scale over [s_f − r·150 m, s_f + 25 m]
-/// by [`LOWERING_STEP`], never below k, until a lap completes (within [`LOWERING_LAPS`]).
-/// The reach r starts at 1 and grows by one, up to [`LOWERING_MOST_REACH`], while the
-/// window is down to k already: the car came too fast from further back. The scaled profile
-/// and its lap's reward; `None` if none completed or a lap failed too slow.
+/// tracked lap fails: each failure at s_f lowers the scale over [s_f − 150 m, s_f + 25 m] by
+/// [`LOWERING_STEP`], never below k, until a lap completes (within [`LOWERING_LAPS`]). The
+/// scaled profile and its lap's reward; `None` if none completed or a lap failed too slow.
 pub fn lowered_where_it_fails(sim: &Simulator, profile: &Limit, k: f64) -> Option<(Limit, f64)> {
     let length = sim.track.length;
     let n = profile.speed.len() - 1;
@@ -280,12 +274,10 @@ pub fn lowered_where_it_fails(sim: &Simulator, profile: &Limit, k: f64) -> Optio
         }
         let at = failure.distance_m % length;
         let station = |s: f64| ((s / length).clamp(0.0, 1.0) * n as f64).round() as usize;
-        let window = (1..=LOWERING_MOST_REACH)
-            .map(|reach| {
-                station(at - reach as f64 * LOWERING_BEFORE_M)
-                    ..=station(at + LOWERING_AFTER_M).min(n)
-            })
-            .find(|window| scale[window.clone()].iter().any(|&s| s > k))?;
+        let window = station(at - LOWERING_BEFORE_M)..=station(at + LOWERING_AFTER_M).min(n);
+        if scale[window.clone()].iter().all(|&s| s <= k) {
+            return None;
+        }
         for s in &mut scale[window] {
             *s = (*s - LOWERING_STEP).max(k);
         }
