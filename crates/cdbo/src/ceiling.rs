@@ -293,39 +293,78 @@ pub fn ceiling_with(
     profile: &Limit,
     kernels: usize,
 ) -> Result<Ceiling> {
-    let (k, tracked_mps) = tracked_profile(sim, profile)?;
-    // The fit's pedal: the uniform scale's lap, or the locally lowered one's where faster.
-    let lowered =
-        lowered_where_it_fails(sim, profile, k).filter(|(_, reward)| *reward > tracked_mps);
-    let (fitted_profile, fitted_k) = match &lowered {
-        Some((scaled, _)) => (scaled, 1.0),
-        None => (profile, k),
-    };
-    let mut traced = sim.clone();
-    traced.config.trace = true;
-    let tracked = traced.lap(&mut ProfileTracker::new(
-        fitted_profile,
-        sim.track.length,
-        fitted_k,
-    ));
-    // A flying lap's policy is fitted to the timed lap's pedal; the run-up keeps its speed.
-    let timed_from = if sim.config.flying {
-        sim.track.length
-    } else {
-        f64::NEG_INFINITY
-    };
-    let targets: Vec<(f64, f64)> = tracked
-        .trace
-        .iter()
-        .filter(|p| p.distance_m >= timed_from)
-        .map(|p| (p.x, p.pedal))
-        .collect();
+    let tracked = TrackedLap::of(sim, profile)?;
+    ceiling_from(sim, limit, profile, &tracked, kernels)
+}
+
+/// Step 1 of the ceiling, whatever the kernels: the uniform scale's lap and the locally
+/// lowered one's, and the pedal the fits target.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrackedLap {
+    /// The profile scale k of the fastest completed uniform lap ([`tracked_profile`]).
+    pub k: f64,
+    /// Its reward (m/s).
+    pub tracked_mps: f64,
+    /// The lowered lap's reward where it is faster ([`lowered_where_it_fails`]).
+    pub lowered_mps: Option<f64>,
+    /// The pedal of the faster of the two, (x, a) at each driver step of the timed lap.
+    pub pedal: Vec<(f64, f64)>,
+}
+
+impl TrackedLap {
+    /// The tracked laps of `profile` in `sim`.
+    pub fn of(sim: &Simulator, profile: &Limit) -> Result<TrackedLap> {
+        let (k, tracked_mps) = tracked_profile(sim, profile)?;
+        // The fit's pedal: the uniform scale's lap, or the locally lowered one's where faster.
+        let lowered =
+            lowered_where_it_fails(sim, profile, k).filter(|(_, reward)| *reward > tracked_mps);
+        let (fitted_profile, fitted_k) = match &lowered {
+            Some((scaled, _)) => (scaled, 1.0),
+            None => (profile, k),
+        };
+        let mut traced = sim.clone();
+        traced.config.trace = true;
+        let lap = traced.lap(&mut ProfileTracker::new(
+            fitted_profile,
+            sim.track.length,
+            fitted_k,
+        ));
+        // A flying lap's policy is fitted to the timed lap's pedal; the run-up keeps its speed.
+        let timed_from = if sim.config.flying {
+            sim.track.length
+        } else {
+            f64::NEG_INFINITY
+        };
+        let pedal = lap
+            .trace
+            .iter()
+            .filter(|p| p.distance_m >= timed_from)
+            .map(|p| (p.x, p.pedal))
+            .collect();
+        Ok(TrackedLap {
+            k,
+            tracked_mps,
+            lowered_mps: lowered.map(|(_, reward)| reward),
+            pedal,
+        })
+    }
+}
+
+/// The ceiling of `kernels`-kernel policies fitted to `tracked`'s pedal (step 2), `tracked`
+/// being [`TrackedLap::of`] `profile` in `sim`: one tracked lap serves every kernel count.
+pub fn ceiling_from(
+    sim: &Simulator,
+    limit: &Limit,
+    profile: &Limit,
+    tracked: &TrackedLap,
+    kernels: usize,
+) -> Result<Ceiling> {
     let mut ceiling = Ceiling {
         limit_mps: limit.reward_mps,
         profile_mps: profile.reward_mps,
-        k,
-        tracked_mps,
-        lowered_mps: lowered.map(|(_, reward)| reward),
+        k: tracked.k,
+        tracked_mps: tracked.tracked_mps,
+        lowered_mps: tracked.lowered_mps,
         kernels,
         policy_mps: 0.0,
         policy: None,
@@ -340,7 +379,9 @@ pub fn ceiling_with(
     .into_iter()
     .enumerate()
     {
-        if let Some((policy, reward, repairs)) = repaired(sim, targets.clone(), kernels, repair)? {
+        if let Some((policy, reward, repairs)) =
+            repaired(sim, tracked.pedal.clone(), kernels, repair)?
+        {
             ceiling.policy_mps = reward;
             ceiling.policy = Some(policy);
             ceiling.repairs = tries * REPAIR_LAPS + repairs;

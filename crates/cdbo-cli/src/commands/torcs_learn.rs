@@ -161,10 +161,13 @@ fn learn_on(
     } else {
         cdbo::ceiling::profile(&ours, &car, line.as_deref())
     };
-    // The ceiling's fits with M, 2M and 4M kernels; the fastest completed one.
-    let mut ceiling = cdbo::ceiling::ceiling_with(&sim, &limit, &profile, args.kernels)?;
+    // The ceiling's fits with M, 2M and 4M kernels (or finer) to one tracked lap; the fastest
+    // completed one.
+    let tracked = cdbo::ceiling::TrackedLap::of(&sim, &profile)?;
+    let fit = |kernels| cdbo::ceiling::ceiling_from(&sim, &limit, &profile, &tracked, kernels);
+    let mut ceiling = fit(args.kernels)?;
     for finer in finer_kernels(args.kernels, ours.length) {
-        let fine = cdbo::ceiling::ceiling_with(&sim, &limit, &profile, finer)?;
+        let fine = fit(finer)?;
         if fine.policy_mps > ceiling.policy_mps {
             ceiling = fine;
         }
