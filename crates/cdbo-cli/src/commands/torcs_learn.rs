@@ -2,9 +2,10 @@
 //! first (the ceiling's policy: the limit's speed profile tracked on the minimum-curvature line
 //! and fitted with M, 2M and 4M kernels, or 50 m apart on a long track, the fastest fit kept;
 //! where no fit completes, the recommended learner's best), then a bounded number of laps of
-//! the recommended learner in the game from it, the result beside the fastest shipped robot's
-//! laps on that track.
+//! the recommended learner in the game from it (as many again from the next fastest fit where
+//! none of them completes), the result beside the fastest shipped robot's laps on that track.
 
+use std::cmp::Ordering;
 use std::path::PathBuf;
 
 use clap::Args;
@@ -36,7 +37,7 @@ pub struct LearnArgs {
     kernels: usize,
     /// Laps of the recommended learner in the game, after cdbo's simulator (the game also
     /// drives one demonstration lap first, and the best policy's standing and flying laps at
-    /// the end).
+    /// the end); where none of them completes, as many again from the next fastest fit.
     #[arg(long, default_value_t = 30, value_parser = super::value::laps)]
     game_laps: usize,
     /// Learn the flying lap (the second of two from the standing start, line to line)
@@ -64,6 +65,8 @@ struct TrackResult {
     kernels: usize,
     /// The starting policy's lap in cdbo's simulator (s).
     sim_lap_s: Option<f64>,
+    /// Faster fits learned from first, none of whose game laps completed.
+    fits_before: usize,
     /// The game's laps of the learner (the demonstration not counted), and how many failed.
     game_laps: usize,
     game_failed_laps: usize,
@@ -130,6 +133,16 @@ fn finer_kernels(kernels: usize, track_length: f64) -> Vec<usize> {
 /// for 200 kernels to lie further apart.
 const FINEST_SPACING_M: f64 = 50.0;
 
+/// A policy the game's laps may start from.
+struct Start {
+    policy: Policy,
+    /// `ceiling` or `recommended learner`.
+    name: &'static str,
+    kernels: usize,
+    /// Its lap in cdbo's simulator (s).
+    sim_lap_s: Option<f64>,
+}
+
 /// A lap time in a cell: `83.85 s`, or `fails`.
 fn cell(lap: Option<f64>) -> String {
     lap.map_or("fails".into(), |t| format!("{t:.2} s"))
@@ -161,55 +174,74 @@ fn learn_on(
     } else {
         cdbo::ceiling::profile(&ours, &car, line.as_deref())
     };
-    // The ceiling's fits with M, 2M and 4M kernels (or finer) to one tracked lap; the fastest
-    // completed one.
+    // The ceiling's fits with M, 2M and 4M kernels (or finer) to one tracked lap; those that
+    // complete, the fastest first (of equally fast ones the coarser).
     let tracked = cdbo::ceiling::TrackedLap::of(&sim, &profile)?;
-    let fit = |kernels| cdbo::ceiling::ceiling_from(&sim, &limit, &profile, &tracked, kernels);
-    let mut ceiling = fit(args.kernels)?;
-    for finer in finer_kernels(args.kernels, ours.length) {
-        let fine = fit(finer)?;
-        if fine.policy_mps > ceiling.policy_mps {
-            ceiling = fine;
+    let mut fits = Vec::new();
+    for kernels in std::iter::once(args.kernels).chain(finer_kernels(args.kernels, ours.length)) {
+        let fit = cdbo::ceiling::ceiling_from(&sim, &limit, &profile, &tracked, kernels)?;
+        if let Some(policy) = fit.policy {
+            let start = Start {
+                policy: policy.into(),
+                name: "ceiling",
+                kernels,
+                sim_lap_s: Some(ours.length / fit.policy_mps),
+            };
+            fits.push((fit.policy_mps, start));
         }
     }
-    let kernels = ceiling
-        .policy
-        .as_ref()
-        .map_or(args.kernels, |_| ceiling.kernels);
+    fits.sort_by(|a, b| b.0.partial_cmp(&a.0).unwrap_or(Ordering::Equal));
+    let fits: Vec<Start> = fits.into_iter().map(|(_, start)| start).collect();
     let config = RaceConfig {
         method: stack.method(),
-        kernels,
+        kernels: args.kernels,
         seed: args.seed,
         base_line,
         flying: args.flying,
         ..RaceConfig::default()
     };
-    let (start, start_name, sim_lap_s): (Policy, _, _) = match ceiling.policy {
-        Some(policy) => (
-            policy.into(),
-            "ceiling",
-            Some(ours.length / ceiling.policy_mps),
-        ),
+    let starts = if fits.is_empty() {
         // No fit completes: the recommended learner's best in cdbo's simulator.
-        None => {
-            let venue = Venue::simulator(ours.clone(), &car)
-                .steered(stack.steering().steering())
-                .for_learning(None);
-            let learned = race(&venue, &ours, &car, &config, |_| {})?;
-            let lap = learned.best_lap_time_s();
-            (learned.best, "recommended learner", lap)
-        }
+        let venue = Venue::simulator(ours.clone(), &car)
+            .steered(stack.steering().steering())
+            .for_learning(None);
+        let learned = race(&venue, &ours, &car, &config, |_| {})?;
+        vec![Start {
+            sim_lap_s: learned.best_lap_time_s(),
+            policy: learned.best,
+            name: "recommended learner",
+            kernels: args.kernels,
+        }]
+    } else {
+        fits
     };
-    // 2. The game: the recommended learner from that policy, its laps bounded.
+    // 2. The game: the recommended learner from the fastest start, its laps bounded; where
+    // none of them completes, as many again from the next start.
     let venue = Venue::game(game, track, &args.car, ours.clone())?
         .steered(stack.steering().steering())
         .for_learning(None);
-    let in_game = RaceConfig {
-        laps: args.game_laps,
-        warm_start: Some(start),
-        ..config
+    let (mut game_laps, mut game_failed_laps) = (0, 0);
+    let mut learned = None;
+    for (tried, start) in starts.into_iter().enumerate() {
+        let in_game = RaceConfig {
+            laps: args.game_laps,
+            kernels: start.kernels,
+            warm_start: Some(start.policy.clone()),
+            ..config.clone()
+        };
+        let outcome = race(&venue, &ours, &car, &in_game, |_| {})?;
+        game_laps += outcome.laps.len();
+        let failed = outcome.laps.iter().filter(|l| l.failure.is_some()).count();
+        game_failed_laps += failed;
+        let completed = failed < outcome.laps.len();
+        learned = Some((start, tried, outcome));
+        if completed {
+            break;
+        }
+    }
+    let Some((start, fits_before, outcome)) = learned else {
+        return Err(format!("{track}: no policy to start the game's laps from").into());
     };
-    let outcome = race(&venue, &ours, &car, &in_game, |_| {})?;
     // 3. Its best policy, driven again standing and flying in the game (on the race's line).
     let venue = match &outcome.line {
         Some(line) => venue.on_line(line.clone()),
@@ -231,11 +263,12 @@ fn learn_on(
     let owned = |lap: Option<(&str, f64)>| lap.map(|(r, t)| (r.to_owned(), t));
     Ok(TrackResult {
         track: track.to_owned(),
-        start: start_name,
-        kernels,
-        sim_lap_s,
-        game_laps: outcome.laps.len(),
-        game_failed_laps: outcome.laps.iter().filter(|l| l.failure.is_some()).count(),
+        start: start.name,
+        kernels: start.kernels,
+        sim_lap_s: start.sim_lap_s,
+        fits_before,
+        game_laps,
+        game_failed_laps,
         standing_lap_s: standing,
         flying_lap_s: flying,
         robot_standing: owned(robot_standing),
@@ -278,8 +311,12 @@ fn markdown(results: &[TrackResult], args: &LearnArgs) -> String {
     for r in results {
         let (ours_s, robot_s) = against(r.standing_lap_s, &r.robot_standing);
         let (ours_f, robot_f) = against(r.flying_lap_s, &r.robot_flying);
+        let after = match r.fits_before {
+            0 => String::new(),
+            n => format!(" (after {n} faster, no game lap completed)"),
+        };
         out += &format!(
-            "| {} | {}, {} kernels | {} | {} ({}) | {ours_s} | {robot_s} | {ours_f} | {robot_f} |\n",
+            "| {} | {}, {} kernels{after} | {} | {} ({}) | {ours_s} | {robot_s} | {ours_f} | {robot_f} |\n",
             r.track,
             r.start,
             r.kernels,
