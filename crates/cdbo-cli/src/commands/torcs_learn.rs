@@ -143,6 +143,41 @@ struct Start {
     sim_lap_s: Option<f64>,
 }
 
+/// The starts learned from in turn ([`in_turn`]): the last, how many came before it, its
+/// outcome, and the laps of all and how many of them failed.
+struct InTurn<S, O> {
+    start: S,
+    before: usize,
+    outcome: O,
+    laps: usize,
+    failed: usize,
+}
+
+/// Learns from each of `starts` in turn, `learn` giving its laps, failed laps and outcome,
+/// until one's laps do not all fail (or the starts run out); `None` without starts.
+fn in_turn<S, O>(
+    starts: Vec<S>,
+    mut learn: impl FnMut(&S) -> Result<(usize, usize, O), Box<dyn std::error::Error>>,
+) -> Result<Option<InTurn<S, O>>, Box<dyn std::error::Error>> {
+    let (mut laps, mut failed) = (0, 0);
+    let mut last = None;
+    for (before, start) in starts.into_iter().enumerate() {
+        let (n, f, outcome) = learn(&start)?;
+        (laps, failed) = (laps + n, failed + f);
+        last = Some(InTurn {
+            start,
+            before,
+            outcome,
+            laps,
+            failed,
+        });
+        if f < n {
+            break;
+        }
+    }
+    Ok(last)
+}
+
 /// A lap time in a cell: `83.85 s`, or `fails`.
 fn cell(lap: Option<f64>) -> String {
     lap.map_or("fails".into(), |t| format!("{t:.2} s"))
@@ -220,9 +255,7 @@ fn learn_on(
     let venue = Venue::game(game, track, &args.car, ours.clone())?
         .steered(stack.steering().steering())
         .for_learning(None);
-    let (mut game_laps, mut game_failed_laps) = (0, 0);
-    let mut learned = None;
-    for (tried, start) in starts.into_iter().enumerate() {
+    let learned = in_turn(starts, |start| {
         let in_game = RaceConfig {
             laps: args.game_laps,
             kernels: start.kernels,
@@ -230,16 +263,17 @@ fn learn_on(
             ..config.clone()
         };
         let outcome = race(&venue, &ours, &car, &in_game, |_| {})?;
-        game_laps += outcome.laps.len();
         let failed = outcome.laps.iter().filter(|l| l.failure.is_some()).count();
-        game_failed_laps += failed;
-        let completed = failed < outcome.laps.len();
-        learned = Some((start, tried, outcome));
-        if completed {
-            break;
-        }
-    }
-    let Some((start, fits_before, outcome)) = learned else {
+        Ok((outcome.laps.len(), failed, outcome))
+    })?;
+    let Some(InTurn {
+        start,
+        before: fits_before,
+        outcome,
+        laps: game_laps,
+        failed: game_failed_laps,
+    }) = learned
+    else {
         return Err(format!("{track}: no policy to start the game's laps from").into());
     };
     // 3. Its best policy, driven again standing and flying in the game (on the race's line).
@@ -346,6 +380,23 @@ mod tests {
 
     /// 2M and 4M kernels up to the pattern search's 200; on a track so long that 200 lie
     /// more than 50 m apart (Spring, 22 km), one more fit with kernels 50 m apart.
+    /// A start whose laps all failed gives way to the next, its laps counted; the first
+    /// start with a completed lap ends the turns.
+    #[test]
+    fn the_next_start_is_learned_from_only_where_every_lap_failed() {
+        let laps = |failed: &usize| Ok((30, *failed, *failed));
+        let learned = in_turn(vec![30, 30, 12, 0], laps).unwrap().unwrap();
+        assert_eq!(
+            (learned.start, learned.before, learned.laps, learned.failed),
+            (12, 2, 90, 72)
+        );
+        let first = in_turn(vec![29, 30], laps).unwrap().unwrap();
+        assert_eq!((first.start, first.before, first.laps), (29, 0, 30));
+        let none = in_turn(vec![30, 30], laps).unwrap().unwrap();
+        assert_eq!((none.start, none.before, none.failed), (30, 1, 60));
+        assert!(in_turn(Vec::<usize>::new(), laps).unwrap().is_none());
+    }
+
     #[test]
     fn the_finest_fit_has_its_kernels_at_most_50_m_apart_on_a_long_track() {
         assert_eq!(finer_kernels(50, 4_000.0), [100, 200]);
