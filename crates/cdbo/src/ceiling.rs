@@ -25,10 +25,10 @@
 //!    is faster than the uniform one, the policy below is fitted to its pedal (car1-trb1 on
 //!    E-Track 3, tracker and minimum-curvature line: 39.45 m/s at k = 0.796, 43.85 m/s
 //!    lowered from 0.896). The uniform lap stays the ceiling learners are measured against.
-//! 2. **The policy class**: the pedal of that lap (or of the lowered one), a(x), fitted by ridge regression with M
-//!    kernels (paper eq. 9), then **repaired where it fails** ([`PedalRepair`]): while the
-//!    fitted policy's lap fails at x_f, the fit's targets over the [`REPAIR_SPACINGS`] kernel
-//!    spacings before it, x ∈ [x_f − 2/(M − 1), x_f], move by δ, down where the car was too
+//! 2. **The policy class**: the pedal of that lap (or of the lowered one), a(x), fitted by
+//!    ridge regression with M kernels (paper eq. 9), then **repaired where it fails**
+//!    ([`PedalRepair`]): while the fitted policy's lap fails at x_f, the fit's targets over
+//!    the [`REPAIR_SPACINGS`] kernel spacings before it, x ∈ [x_f − 2/(M − 1), x_f], move by δ, down where the car was too
 //!    fast (off the road, spun, backwards) and up where it was too slow (stalled, past the
 //!    time limit), and the policy is fitted again. δ starts at δ₀ = [`REPAIR_STEP`], halves
 //!    when the next failure lies within one spacing of the last and asks for the other
