@@ -27,17 +27,17 @@
 //!    lowered from 0.896). The uniform lap stays the ceiling learners are measured against.
 //! 2. **The policy class**: the pedal of that lap (or of the lowered one), a(x), fitted by
 //!    ridge regression with M kernels (paper eq. 9), then **repaired where it fails**
-//!    ([`PedalRepair`]): while the fitted policy's lap fails at x_f, the fit's targets over
-//!    the [`REPAIR_SPACINGS`] kernel spacings before it, x ∈ [x_f − 2/(M − 1), x_f], move by δ, down where the car was too
-//!    fast (off the road, spun, backwards) and up where it was too slow (stalled, past the
-//!    time limit), and the policy is fitted again. δ starts at δ₀ = [`REPAIR_STEP`], halves
-//!    when the next failure lies within one spacing of the last and asks for the other
-//!    direction (a bisection of the pedal there), and returns to δ₀ once a failure lies
-//!    further on. The first completed lap (within [`REPAIR_LAPS`] laps) gives the fitted
-//!    policy, a lower bound of the M-kernel policies' best. Where none completes, the repairs
-//!    start again from the tracked lap's pedal, braking earlier for a corner that fails again
-//!    ([`PedalRepair::braking_earlier`]): lowered only in the corner, the pedal brakes the
-//!    car while it turns, and at the limit it spins or stops there. car1-trb1's flying laps
+//!    ([`PedalRepair`]): while the fitted policy's lap fails at x_f, the fit's targets over the
+//!    [`REPAIR_SPACINGS`] kernel spacings before it, x ∈ [x_f − 2/(M − 1), x_f], move by δ,
+//!    down where the car was too fast (off the road, spun, backwards) and up where it was too
+//!    slow (stalled, past the time limit), and the policy is fitted again. δ starts at δ₀ =
+//!    [`REPAIR_STEP`], halves when the next failure lies within one spacing of the last and
+//!    asks for the other direction (a bisection of the pedal there), and returns to δ₀ once a
+//!    failure lies further on. The first completed lap (within [`REPAIR_LAPS`] laps) gives the
+//!    fitted policy, a lower bound of the M-kernel policies' best. Where none completes, the
+//!    repairs start again from the tracked lap's pedal, braking earlier for a corner that fails
+//!    again ([`PedalRepair::braking_earlier`]): lowered only in the corner, the pedal brakes
+//!    the car while it turns, and at the limit it spins or stops there. car1-trb1's flying laps
 //!    on E-Track 2, where the car reaches the first corners at speed, fitted with 100 and 200
 //!    kernels: no plain repair completes in 150 laps; braking earlier, 41.6 and 43.7 m/s after
 //!    15 and 25 (docs/results/torcs.md).
