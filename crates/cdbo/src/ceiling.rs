@@ -240,6 +240,11 @@ fn largest_completing_scale(sim: &Simulator, limit: &Limit) -> Result<(f64, (f64
 pub const LOWERING_LAPS: usize = 100;
 /// How far above the uniform scale k the locally lowered profile starts.
 pub const LOWERING_HEADROOM: f64 = 0.1;
+/// The scale the lowered profile starts from: k + [`LOWERING_HEADROOM`], at most 1.
+pub fn lowering_from(k: f64) -> f64 {
+    (k + LOWERING_HEADROOM).min(1.0)
+}
+
 /// How much a failure lowers the scale before it.
 pub const LOWERING_STEP: f64 = 0.02;
 /// How far before a failure the scale is lowered (m): a braking zone of a fast car.
@@ -254,7 +259,7 @@ pub const LOWERING_AFTER_M: f64 = 25.0;
 pub fn lowered_where_it_fails(sim: &Simulator, profile: &Limit, k: f64) -> Option<(Limit, f64)> {
     let length = sim.track.length;
     let n = profile.speed.len() - 1;
-    let mut scale = vec![(k + LOWERING_HEADROOM).min(1.0); n + 1];
+    let mut scale = vec![lowering_from(k); n + 1];
     for _ in 0..LOWERING_LAPS {
         let scaled = Limit {
             speed: profile
@@ -294,13 +299,15 @@ pub fn ceiling_with(
     kernels: usize,
 ) -> Result<Ceiling> {
     let tracked = TrackedLap::of(sim, profile)?;
-    ceiling_from(sim, limit, profile, &tracked, kernels)
+    ceiling_from(sim, limit, &tracked, kernels)
 }
 
 /// Step 1 of the ceiling, whatever the kernels: the uniform scale's lap and the locally
 /// lowered one's, and the pedal the fits target.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrackedLap {
+    /// The reward of the limit whose profile was tracked (m/s).
+    pub profile_mps: f64,
     /// The profile scale k of the fastest completed uniform lap ([`tracked_profile`]).
     pub k: f64,
     /// Its reward (m/s).
@@ -342,6 +349,7 @@ impl TrackedLap {
             .map(|p| (p.x, p.pedal))
             .collect();
         Ok(TrackedLap {
+            profile_mps: profile.reward_mps,
             k,
             tracked_mps,
             lowered_mps: lowered.map(|(_, reward)| reward),
@@ -351,17 +359,16 @@ impl TrackedLap {
 }
 
 /// The ceiling of `kernels`-kernel policies fitted to `tracked`'s pedal (step 2), `tracked`
-/// being [`TrackedLap::of`] `profile` in `sim`: one tracked lap serves every kernel count.
+/// being [`TrackedLap::of`] a profile in `sim`: one tracked lap serves every kernel count.
 pub fn ceiling_from(
     sim: &Simulator,
     limit: &Limit,
-    profile: &Limit,
     tracked: &TrackedLap,
     kernels: usize,
 ) -> Result<Ceiling> {
     let mut ceiling = Ceiling {
         limit_mps: limit.reward_mps,
-        profile_mps: profile.reward_mps,
+        profile_mps: tracked.profile_mps,
         k: tracked.k,
         tracked_mps: tracked.tracked_mps,
         lowered_mps: tracked.lowered_mps,
@@ -490,7 +497,7 @@ mod tests {
         let (k, uniform) = tracked_profile(&sim, &limit).unwrap();
         let (scaled, reward) = lowered_where_it_fails(&sim, &limit, k).unwrap();
         assert!(reward > uniform + 2.0, "{reward} against {uniform} m/s");
-        let top = (k + LOWERING_HEADROOM).min(1.0);
+        let top = lowering_from(k);
         let scales: Vec<f64> = (scaled.speed.iter().zip(&limit.speed))
             .filter(|(_, v)| **v > 0.0)
             .map(|(s, v)| s / v)

@@ -140,7 +140,7 @@ fn print_summary(
     let fitted = c.lowered_mps.map_or("its".to_owned(), |v| {
         format!(
             "the lap of {:.3} x lowered only where it fails ({v:.2} m/s, {:.1} %), its",
-            (c.k + cdbo::ceiling::LOWERING_HEADROOM).min(1.0),
+            cdbo::ceiling::lowering_from(c.k),
             pct(v)
         )
     });

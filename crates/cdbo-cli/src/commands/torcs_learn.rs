@@ -214,7 +214,7 @@ fn learn_on(
     let tracked = cdbo::ceiling::TrackedLap::of(&sim, &profile)?;
     let mut fits = Vec::new();
     for kernels in std::iter::once(args.kernels).chain(finer_kernels(args.kernels, ours.length)) {
-        let fit = cdbo::ceiling::ceiling_from(&sim, &limit, &profile, &tracked, kernels)?;
+        let fit = cdbo::ceiling::ceiling_from(&sim, &limit, &tracked, kernels)?;
         if let Some(policy) = fit.policy {
             let start = Start {
                 policy: policy.into(),
