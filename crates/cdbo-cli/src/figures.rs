@@ -502,34 +502,13 @@ where
     Ok(())
 }
 
-/// (distance, speed) rows of a `cdbo lap --trace` file.
+/// (distance, speed) rows of a `cdbo lap --trace` file ([`cdbo::sim::trace`]).
 pub fn read_trace_speeds(path: &Path) -> Result<Vec<(f64, f64)>, Box<dyn std::error::Error>> {
-    let text = cdbo::bounded::read_text(path, &cdbo::bounded::TRACE_FILE)?;
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
-    let col = |name: &str| {
-        header.iter().position(|h| *h == name).ok_or_else(|| {
-            format!(
-                "{}: no {name} column (expected a `cdbo lap --trace` file)",
-                path.display()
-            )
-        })
-    };
-    let (d, v) = (col("distance_m")?, col("speed_mps")?);
-    let mut rows = Vec::new();
-    for (i, line) in lines.enumerate() {
-        let f: Vec<&str> = line.split(',').collect();
-        let num = |k: usize| {
-            f.get(k)
-                .and_then(|s| s.parse::<f64>().ok())
-                .ok_or_else(|| format!("{}:{}: bad row", path.display(), i + 2))
-        };
-        rows.push((num(d)?, num(v)?));
-    }
-    if rows.is_empty() {
+    let trace = cdbo::sim::trace::read(path)?;
+    if trace.is_empty() {
         return Err(format!("{}: no rows", path.display()).into());
     }
-    Ok(rows)
+    Ok(trace.iter().map(|p| (p.distance_m, p.speed)).collect())
 }
 
 fn speed_at(rows: &[(f64, f64)], s: f64) -> f64 {

@@ -291,33 +291,7 @@ fn write_trace(path: &std::path::Path, trace: &[cdbo::sim::TracePoint]) -> CliRe
     use std::io::Write;
     let file = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut w = std::io::BufWriter::new(file);
-    writeln!(
-        w,
-        "t_s,distance_m,x,speed_mps,pedal,steer_rad,lateral_m,heading_error_rad,slip_angle_rad,gear,rpm,pos_x_m,pos_y_m,yaw_rate_rad_s,wheel_speed_front_mps,wheel_speed_rear_left_mps,wheel_speed_rear_right_mps"
-    )?;
-    for p in trace {
-        writeln!(
-            w,
-            "{:.3},{:.3},{:.6},{:.4},{:.4},{:.5},{:.4},{:.5},{:.5},{},{:.0},{:.3},{:.3},{:.5},{:.4},{:.4},{:.4}",
-            p.t,
-            p.distance_m,
-            p.x,
-            p.speed,
-            p.pedal,
-            p.steer,
-            p.lateral,
-            p.heading_error,
-            p.slip_angle,
-            p.gear,
-            p.rpm,
-            p.pos_x,
-            p.pos_y,
-            p.yaw_rate,
-            p.wheel_speeds[0],
-            p.wheel_speeds[1],
-            p.wheel_speeds[2]
-        )?;
-    }
+    cdbo::sim::trace::write(&mut w, trace)?;
     w.flush()?;
     Ok(())
 }

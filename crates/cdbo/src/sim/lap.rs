@@ -39,6 +39,7 @@ use crate::drive::steering::Steering;
 use crate::drive::{Observation, Pedal, pedal_command, run_up_pedal};
 use crate::geometry::wrap_angle;
 use crate::line::RacingLine;
+use crate::sim::trace::TracePoint;
 use crate::track::{Frame, Track};
 use crate::vehicle::barrier::Body;
 use crate::vehicle::{State, Vehicle};
@@ -106,41 +107,6 @@ pub struct Failure {
     pub distance_m: f64,
     /// Time since the start (s).
     pub time_s: f64,
-}
-
-/// One driver step of a lap, recorded when a trace is asked for.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct TracePoint {
-    /// Time (s).
-    pub t: f64,
-    /// Distance covered along the centre line (m).
-    pub distance_m: f64,
-    /// Lap fraction x.
-    pub x: f64,
-    /// Speed (m/s).
-    pub speed: f64,
-    /// Pedal command a ∈ [−1, 1].
-    pub pedal: f64,
-    /// Steering angle (rad).
-    pub steer: f64,
-    /// Offset from the centre line (m), positive left.
-    pub lateral: f64,
-    /// Angle between the car's heading and the centre line's (rad).
-    pub heading_error: f64,
-    /// Body slip angle atan(v_y / vₓ) (rad).
-    pub slip_angle: f64,
-    /// Gear (1 = first).
-    pub gear: usize,
-    /// Engine speed (rpm).
-    pub rpm: f64,
-    /// Position (m).
-    pub pos_x: f64,
-    /// Position (m).
-    pub pos_y: f64,
-    /// Yaw rate (rad/s, positive turning left).
-    pub yaw_rate: f64,
-    /// The wheels' speeds ω·R (m/s): the front axle's, the rear left's, the rear right's.
-    pub wheel_speeds: [f64; 3],
 }
 
 /// The outcome of a lap.

@@ -24,7 +24,7 @@ use crate::car::Car;
 use crate::drive::steering::Steering;
 use crate::error::{Error, Result};
 use crate::policy::RkhsPolicy;
-use crate::sim::lap::{Failure, LapConfig, LapResult, TracePoint};
+use crate::sim::lap::{Failure, LapConfig, LapResult};
 use crate::vehicle::Vehicle;
 use crate::vehicle::powertrain::{DOWNSHIFT_MARGIN, THROTTLE_LEVELS};
 
@@ -425,7 +425,7 @@ impl Game {
             });
         }
         let trace = match trace.filter(|_| req.record) {
-            Some(path) => read_trace(&path)?,
+            Some(path) => crate::sim::trace::read(&path)?,
             None => Vec::new(),
         };
         Ok(Ok(LapResult {
@@ -668,57 +668,6 @@ fn default_time_limit(install: &crate::torcs::Install, track: &str, category: &s
     crate::track::torcs::read(&file, crate::track::Ends::MayMiss)
         .map(|t| 30.0 + t.length / 4.0)
         .unwrap_or(1800.0)
-}
-
-/// The columns of the robot's trace, those of `cdbo lap --trace`.
-const TRACE_COLUMNS: usize = 17;
-
-/// The robot's trace: a header, then one row per driver step in the columns of
-/// `cdbo lap --trace`.
-pub fn read_trace(path: &Path) -> Result<Vec<TracePoint>> {
-    let text = bounded::read_text(path, &bounded::TRACE_FILE)?;
-    let file = path.display().to_string();
-    let mut points = Vec::new();
-    for (i, line) in text.lines().enumerate().skip(1) {
-        let bad = |m: String| Error::Parse {
-            file: file.clone(),
-            line: Some(i as u32 + 1),
-            element: "row".into(),
-            message: m,
-        };
-        let v = line
-            .split(',')
-            .map(|c| {
-                c.trim()
-                    .parse::<f64>()
-                    .map_err(|_| bad(format!("{c:?} is not a number")))
-            })
-            .collect::<Result<Vec<f64>>>()?;
-        if v.len() != TRACE_COLUMNS {
-            return Err(bad(format!(
-                "expected {TRACE_COLUMNS} columns, found {}",
-                v.len()
-            )));
-        }
-        points.push(TracePoint {
-            t: v[0],
-            distance_m: v[1],
-            x: v[2],
-            speed: v[3],
-            pedal: v[4],
-            steer: v[5],
-            lateral: v[6],
-            heading_error: v[7],
-            slip_angle: v[8],
-            gear: v[9].max(0.0) as usize,
-            rpm: v[10],
-            pos_x: v[11],
-            pos_y: v[12],
-            yaw_rate: v[13],
-            wheel_speeds: [v[14], v[15], v[16]],
-        });
-    }
-    Ok(points)
 }
 
 /// Kills a process group (nothing happens if it is gone).
