@@ -126,13 +126,24 @@ pub struct ProfileTracker<'a> {
     pub flying: bool,
 }
 
-impl ProfileTracker<'_> {
+impl<'a> ProfileTracker<'a> {
     /// A tracker of k times `limit`'s profile on a track of `length` metres.
     pub fn new(limit: &Limit, length: f64, k: f64) -> ProfileTracker<'_> {
         ProfileTracker {
             profile: &limit.speed,
             length,
             k,
+            flying: limit.flying,
+        }
+    }
+
+    /// A tracker of the speeds `speed` at `limit`'s stations (a profile lowered from it,
+    /// [`lowered_where_it_fails`]) on a track of `length` metres.
+    pub fn of_speeds(limit: &Limit, speed: &'a [f64], length: f64) -> ProfileTracker<'a> {
+        ProfileTracker {
+            profile: speed,
+            length,
+            k: 1.0,
             flying: limit.flying,
         }
     }
@@ -255,22 +266,17 @@ pub const LOWERING_AFTER_M: f64 = 25.0;
 /// The profile scaled by k + [`LOWERING_HEADROOM`] (at most 1) and lowered only where its
 /// tracked lap fails: each failure at s_f lowers the scale over [s_f − 150 m, s_f + 25 m] by
 /// [`LOWERING_STEP`], never below k, until a lap completes (within [`LOWERING_LAPS`]). The
-/// scaled profile and its lap's reward; `None` if none completed or a lap failed too slow.
-pub fn lowered_where_it_fails(sim: &Simulator, profile: &Limit, k: f64) -> Option<(Limit, f64)> {
+/// lowered speeds at the profile's stations and their lap's reward; `None` if none completed
+/// or a lap failed too slow.
+pub fn lowered_where_it_fails(sim: &Simulator, profile: &Limit, k: f64) -> Option<(Vec<f64>, f64)> {
     let length = sim.track.length;
     let n = profile.speed.len() - 1;
     let mut scale = vec![lowering_from(k); n + 1];
     for _ in 0..LOWERING_LAPS {
-        let scaled = Limit {
-            speed: profile
-                .speed
-                .iter()
-                .zip(&scale)
-                .map(|(v, s)| v * s)
-                .collect(),
-            ..profile.clone()
-        };
-        let lap = sim.lap(&mut ProfileTracker::new(&scaled, length, 1.0));
+        let scaled: Vec<f64> = (profile.speed.iter().zip(&scale))
+            .map(|(v, s)| v * s)
+            .collect();
+        let lap = sim.lap(&mut ProfileTracker::of_speeds(profile, &scaled, length));
         let Some(failure) = lap.failure else {
             return Some((scaled, lap.reward_mps));
         };
@@ -325,17 +331,14 @@ impl TrackedLap {
         // The fit's pedal: the uniform scale's lap, or the locally lowered one's where faster.
         let lowered =
             lowered_where_it_fails(sim, profile, k).filter(|(_, reward)| *reward > tracked_mps);
-        let (fitted_profile, fitted_k) = match &lowered {
-            Some((scaled, _)) => (scaled, 1.0),
-            None => (profile, k),
+        let length = sim.track.length;
+        let mut tracker = match &lowered {
+            Some((scaled, _)) => ProfileTracker::of_speeds(profile, scaled, length),
+            None => ProfileTracker::new(profile, length, k),
         };
         let mut traced = sim.clone();
         traced.config.trace = true;
-        let lap = traced.lap(&mut ProfileTracker::new(
-            fitted_profile,
-            sim.track.length,
-            fitted_k,
-        ));
+        let lap = traced.lap(&mut tracker);
         // A flying lap's policy is fitted to the timed lap's pedal; the run-up keeps its speed.
         let timed_from = if sim.config.flying {
             sim.track.length
@@ -498,7 +501,7 @@ mod tests {
         let (scaled, reward) = lowered_where_it_fails(&sim, &limit, k).unwrap();
         assert!(reward > uniform + 2.0, "{reward} against {uniform} m/s");
         let top = lowering_from(k);
-        let scales: Vec<f64> = (scaled.speed.iter().zip(&limit.speed))
+        let scales: Vec<f64> = (scaled.iter().zip(&limit.speed))
             .filter(|(_, v)| **v > 0.0)
             .map(|(s, v)| s / v)
             .collect();
@@ -508,7 +511,11 @@ mod tests {
             "scales outside [{k}, {top}]"
         );
         assert!(scales.iter().any(|&s| s < top - 1e-6) && scales.iter().any(|&s| s > top - eps));
-        let lap = sim.lap(&mut ProfileTracker::new(&scaled, sim.track.length, 1.0));
+        let lap = sim.lap(&mut ProfileTracker::of_speeds(
+            &limit,
+            &scaled,
+            sim.track.length,
+        ));
         assert_eq!(lap.reward_mps, reward);
         let c = ceiling_with(&sim, &crest_blind, &limit, 30).unwrap();
         assert_eq!((c.tracked_mps, c.lowered_mps), (uniform, Some(reward)));
