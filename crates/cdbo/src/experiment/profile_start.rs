@@ -164,8 +164,8 @@ pub fn braking_gently(profile: &[f64], length: f64, decel: f64) -> Vec<f64> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::start::demonstrator_up_to;
     use super::*;
-    use crate::sim::LapResult;
 
     /// Before a corner the profile falls no faster than the deceleration allows, and where the
     /// limit falls slower, or rises, it is the limit.
@@ -184,40 +184,26 @@ mod tests {
         assert_eq!(&gentle[13..], &limit[13..]);
     }
 
-    /// A demonstrator whose hold completes at `limit` or below.
-    fn hold(limit: f64, tried: &mut Vec<f64>) -> impl FnMut(f64) -> Result<Demonstration> {
-        move |k| {
-            tried.push(k);
-            let completed = k <= limit;
-            let lap = LapResult {
-                completed,
-                lap_time_s: completed.then_some(100.0 / k),
-                reward_mps: if completed { k } else { 0.0 },
-                failure: None,
-                simulated_s: 1.0,
-                standing_lap_s: None,
-                trace: Vec::new(),
-            };
-            Ok((lap, vec![(0.0, k)]))
-        }
-    }
-
     /// The whole profile is tried first; below it the bisection keeps the largest k that
     /// completed, to 1/64; where none does, nothing is chosen.
     #[test]
     fn the_search_keeps_the_largest_completing_scale() {
         let mut tried = Vec::new();
-        let (k, demo) = largest_completing(hold(2.0, &mut tried)).unwrap().unwrap();
+        let (k, demo) = largest_completing(demonstrator_up_to(2.0, &mut tried))
+            .unwrap()
+            .unwrap();
         assert_eq!((k, tried.len()), (1.0, 1));
         assert!(demo.0.completed);
         let mut tried = Vec::new();
-        let (k, demo) = largest_completing(hold(0.7, &mut tried)).unwrap().unwrap();
+        let (k, demo) = largest_completing(demonstrator_up_to(0.7, &mut tried))
+            .unwrap()
+            .unwrap();
         assert_eq!(tried.len(), 1 + BISECTIONS);
         assert!(k <= 0.7 && k > 0.7 - 1.0 / 64.0, "{k}");
         assert_eq!(demo.0.reward_mps, k);
         let mut tried = Vec::new();
         assert!(
-            largest_completing(hold(0.001, &mut tried))
+            largest_completing(demonstrator_up_to(0.001, &mut tried))
                 .unwrap()
                 .is_none()
         );

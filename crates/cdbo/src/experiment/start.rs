@@ -348,33 +348,38 @@ impl Evaluator for DrivenOnce<'_> {
     }
 }
 
+/// A demonstrator for tests: its lap at v (a speed or a profile's scale) completes at a
+/// reward of v while v ≤ `limit`, and leaves the road at x = 0.17 above it; each v is pushed
+/// onto `asked`.
+#[cfg(test)]
+pub(super) fn demonstrator_up_to(
+    limit: f64,
+    asked: &mut Vec<f64>,
+) -> impl FnMut(f64) -> Result<Demonstration> + '_ {
+    move |v| {
+        asked.push(v);
+        let completed = v <= limit;
+        let lap = LapResult {
+            completed,
+            lap_time_s: completed.then_some(100.0 / v),
+            reward_mps: if completed { v } else { 0.0 },
+            failure: (!completed).then_some(Failure {
+                reason: crate::sim::FailureReason::OffTrack,
+                x: 0.17,
+                distance_m: 10.0,
+                time_s: 1.0,
+            }),
+            simulated_s: 1.0,
+            standing_lap_s: None,
+            trace: Vec::new(),
+        };
+        Ok((lap, vec![(0.0, v)]))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sim::FailureReason;
-
-    /// A demonstrator that completes at `limit` m/s or slower.
-    fn demonstrator(limit: f64, speeds: &mut Vec<f64>) -> impl FnMut(f64) -> Result<Demonstration> {
-        move |v| {
-            speeds.push(v);
-            let completed = v <= limit;
-            let lap = LapResult {
-                completed,
-                lap_time_s: completed.then_some(100.0 / v),
-                reward_mps: if completed { v } else { 0.0 },
-                failure: (!completed).then_some(Failure {
-                    reason: FailureReason::OffTrack,
-                    x: 0.17,
-                    distance_m: 10.0,
-                    time_s: 1.0,
-                }),
-                simulated_s: 1.0,
-                standing_lap_s: None,
-                trace: Vec::new(),
-            };
-            Ok((lap, vec![(0.0, v)]))
-        }
-    }
 
     /// A venue whose lap fails at `at` for `reason` while the pedal at `probe` is outside `ok`.
     struct Gate {
@@ -441,7 +446,7 @@ mod tests {
         let mut asked = Vec::new();
         let mut demonstrate = |v: f64| {
             asked.push(v);
-            demonstrator(f64::INFINITY, &mut Vec::new())(v)
+            demonstrator_up_to(f64::INFINITY, &mut Vec::new())(v)
         };
         let start = complete_start(
             venue,
@@ -527,11 +532,13 @@ mod tests {
     #[test]
     fn the_search_finds_the_fastest_speed_that_completes() {
         let mut speeds = Vec::new();
-        let (demo, choice) = demonstration(15.0, false, demonstrator(20.0, &mut speeds)).unwrap();
+        let (demo, choice) =
+            demonstration(15.0, false, demonstrator_up_to(20.0, &mut speeds)).unwrap();
         assert!(demo.0.completed && choice.is_none());
         assert_eq!(speeds, vec![15.0]);
         let mut speeds = Vec::new();
-        let (demo, choice) = demonstration(15.0, false, demonstrator(10.0, &mut speeds)).unwrap();
+        let (demo, choice) =
+            demonstration(15.0, false, demonstrator_up_to(10.0, &mut speeds)).unwrap();
         let choice = choice.unwrap();
         // 15 and 12 fail, 9.6 completes; 10.8 fails, 10.2 fails, 9.9 completes.
         assert_eq!(speeds.len(), 6, "{speeds:?}");
@@ -540,7 +547,8 @@ mod tests {
         assert_eq!(choice.laps, 6);
         assert!(choice.sentence("Monza").contains("off_track at 17 %"));
         let mut speeds = Vec::new();
-        let (demo, choice) = demonstration(15.0, true, demonstrator(10.0, &mut speeds)).unwrap();
+        let (demo, choice) =
+            demonstration(15.0, true, demonstrator_up_to(10.0, &mut speeds)).unwrap();
         assert!(!demo.0.completed && choice.is_none() && speeds == vec![15.0]);
     }
 }
