@@ -49,33 +49,67 @@ pub struct TracePoint {
 pub const HEADER: &str = "t_s,distance_m,x,speed_mps,pedal,steer_rad,lateral_m,heading_error_rad,slip_angle_rad,gear,rpm,pos_x_m,pos_y_m,yaw_rate_rad_s,wheel_speed_front_mps,wheel_speed_rear_left_mps,wheel_speed_rear_right_mps";
 
 /// The number of columns in [`HEADER`].
-const COLUMNS: usize = 17;
+pub const COLUMNS: usize = 17;
 
-/// Writes `trace` under [`HEADER`], each value to the precision the robot writes it.
+/// Each column's decimals as written, those of the robot's `fprintf`.
+const DECIMALS: [usize; COLUMNS] = [3, 3, 6, 4, 4, 5, 4, 5, 5, 0, 0, 3, 3, 5, 4, 4, 4];
+
+impl TracePoint {
+    /// The point's values in [`HEADER`]'s columns.
+    pub fn values(&self) -> [f64; COLUMNS] {
+        let [front, rear_left, rear_right] = self.wheel_speeds;
+        [
+            self.t,
+            self.distance_m,
+            self.x,
+            self.speed,
+            self.pedal,
+            self.steer,
+            self.lateral,
+            self.heading_error,
+            self.slip_angle,
+            self.gear as f64,
+            self.rpm,
+            self.pos_x,
+            self.pos_y,
+            self.yaw_rate,
+            front,
+            rear_left,
+            rear_right,
+        ]
+    }
+
+    /// The point of [`HEADER`]'s columns' values (a gear below 1 read as neutral, 0).
+    fn of_values(v: [f64; COLUMNS]) -> TracePoint {
+        TracePoint {
+            t: v[0],
+            distance_m: v[1],
+            x: v[2],
+            speed: v[3],
+            pedal: v[4],
+            steer: v[5],
+            lateral: v[6],
+            heading_error: v[7],
+            slip_angle: v[8],
+            gear: v[9].max(0.0) as usize,
+            rpm: v[10],
+            pos_x: v[11],
+            pos_y: v[12],
+            yaw_rate: v[13],
+            wheel_speeds: [v[14], v[15], v[16]],
+        }
+    }
+}
+
+/// Writes `trace` under [`HEADER`], each value to the decimals the robot writes it with.
 pub fn write(w: &mut impl Write, trace: &[TracePoint]) -> std::io::Result<()> {
     writeln!(w, "{HEADER}")?;
     for p in trace {
-        writeln!(
-            w,
-            "{:.3},{:.3},{:.6},{:.4},{:.4},{:.5},{:.4},{:.5},{:.5},{},{:.0},{:.3},{:.3},{:.5},{:.4},{:.4},{:.4}",
-            p.t,
-            p.distance_m,
-            p.x,
-            p.speed,
-            p.pedal,
-            p.steer,
-            p.lateral,
-            p.heading_error,
-            p.slip_angle,
-            p.gear,
-            p.rpm,
-            p.pos_x,
-            p.pos_y,
-            p.yaw_rate,
-            p.wheel_speeds[0],
-            p.wheel_speeds[1],
-            p.wheel_speeds[2]
-        )?;
+        for (k, v) in p.values().iter().enumerate() {
+            let comma = if k == 0 { "" } else { "," };
+            write!(w, "{comma}{v:.*}", DECIMALS[k])?;
+        }
+        writeln!(w)?;
     }
     Ok(())
 }
@@ -126,23 +160,7 @@ pub fn parse(text: &str, file: &str) -> Result<Vec<TracePoint>> {
                 .filter(|x| x.is_finite())
                 .ok_or_else(|| bad(names[k], format!("{cell:?} is not a finite number")))?;
         }
-        points.push(TracePoint {
-            t: v[0],
-            distance_m: v[1],
-            x: v[2],
-            speed: v[3],
-            pedal: v[4],
-            steer: v[5],
-            lateral: v[6],
-            heading_error: v[7],
-            slip_angle: v[8],
-            gear: v[9].max(0.0) as usize,
-            rpm: v[10],
-            pos_x: v[11],
-            pos_y: v[12],
-            yaw_rate: v[13],
-            wheel_speeds: [v[14], v[15], v[16]],
-        });
+        points.push(TracePoint::of_values(v));
     }
     Ok(points)
 }
