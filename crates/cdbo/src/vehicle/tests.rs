@@ -353,3 +353,37 @@ fn the_downforce_table_follows_the_car() {
         Car::spirit_300().downforce(1.0)
     );
 }
+
+/// Over a crest of radius R the road's push per unit of weight, n = cos φ·cos β − v²/(g·R),
+/// reaches 0 at v² = g·R·cos φ·cos β, the speed at which a body on a curve of radius R loses
+/// contact: a car without downforce, sliding sideways at 0.5 m/s on the crest's top, feels
+/// its tyres' side force at 0.99 times that speed and none at 1.01 times it (its wheels carry
+/// no load), while on a level road it feels the same force at both speeds.
+#[test]
+fn over_a_crest_the_wheels_lose_their_load_at_the_closed_form_speed() {
+    let mut car = Car::spirit_300();
+    car.clift = [0.0; 2];
+    car.wings = [crate::car::Wing::default(); 2];
+    car.ride = None;
+    let v = Vehicle::new(&car);
+    let r = 100.0;
+    let mut crest = level();
+    crest.vertical_curvature = -1.0 / r;
+    let take_off = (G * r * crest.cos_pitch * crest.cos_banking).sqrt();
+    // The change of the sideways speed over one step, sliding at 0.5 m/s and rolling freely.
+    let side = |frame: &Frame, speed: f64| {
+        let mut s = v.at_rest(0.0, 0.0, 0.0);
+        (s.vx, s.vy) = (speed, 0.5);
+        v.set_wheel_speeds(&mut s, [speed; 3]);
+        v.step(&mut s, &v.controls(0.0, 0.0, 0.0), frame, 0.004);
+        s.vy - 0.5
+    };
+    for k in [0.99, 1.01] {
+        assert!(
+            side(&level(), k * take_off) < -0.01,
+            "level road at {k} × {take_off} m/s"
+        );
+    }
+    assert!(side(&crest, 0.99 * take_off) < -1e-4);
+    assert_eq!(side(&crest, 1.01 * take_off), 0.0);
+}
