@@ -32,7 +32,10 @@ pub struct CircuitsArgs {
     /// (PI steering, centre line). Default: the README's.
     #[arg(long, value_delimiter = ',', default_values_t = Stack::RECOMMENDED)]
     stacks: Vec<Stack>,
-    /// Seeds 0..N of each stack on each circuit.
+    /// Seed of each stack's first race on each circuit.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Races of each stack on each circuit, one a seed from --seed on (--seed, --seed + 1, …).
     #[arg(long, default_value_t = 1, value_parser = super::value::seeds)]
     seeds: u64,
     /// Laps per race.
@@ -163,12 +166,22 @@ struct Report {
     car: String,
     laps: usize,
     kernels: usize,
+    /// The first seed.
+    seed: u64,
     seeds: u64,
     runs: Vec<Run>,
     rows: Vec<Row>,
 }
 
 pub fn circuits(args: &CircuitsArgs, data: &DataPath) -> CliResult {
+    let last_seed = args.seed.checked_add(args.seeds - 1).ok_or_else(|| {
+        format!(
+            "--seed {} with --seeds {}: the last seed would pass {}",
+            args.seed,
+            args.seeds,
+            u64::MAX
+        )
+    })?;
     let files = circuit_files(&args.tracks, data)?;
     let car = cdbo::car::catalog::find(&args.car, data)?;
     let mut circuits = Vec::new();
@@ -179,7 +192,7 @@ pub fn circuits(args: &CircuitsArgs, data: &DataPath) -> CliResult {
     let mut races = Vec::new();
     for (i, _) in circuits.iter().enumerate() {
         for &stack in &args.stacks {
-            for seed in 0..args.seeds {
+            for seed in args.seed..=last_seed {
                 races.push((i, stack, seed));
             }
         }
@@ -212,6 +225,7 @@ pub fn circuits(args: &CircuitsArgs, data: &DataPath) -> CliResult {
         car: car.name.clone(),
         laps: args.laps,
         kernels: args.kernels,
+        seed: args.seed,
         seeds: args.seeds,
         runs,
         rows,
@@ -408,14 +422,19 @@ fn mean(values: &[f64]) -> f64 {
 /// The table: a row per circuit and stack, then each stack over every circuit, then the
 /// races that did not start with why.
 fn markdown(report: &Report, stacks: &[Stack]) -> String {
+    let last = report.seed + (report.seeds - 1);
+    let seeds = if last == report.seed {
+        format!("seed {last}")
+    } else {
+        format!("seeds {}–{last}", report.seed)
+    };
     let mut out = format!(
-        "{} circuits, {}, {} laps, {} kernels, seeds 0..{}: best lap as % of the centre-line \
+        "{} circuits, {}, {} laps, {} kernels, {seeds}: best lap as % of the centre-line \
          limit (mean over seeds, lowest)\n\n",
         report.rows.len() / stacks.len().max(1),
         report.car,
         report.laps,
         report.kernels,
-        report.seeds
     );
     out += "| circuit | stack | started | first lap completed (latest) | best / limit | lowest | failed laps (max) | wall (s) |\n";
     out += "| --- | --- | --- | --- | --- | --- | --- | --- |\n";

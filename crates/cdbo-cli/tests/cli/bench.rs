@@ -28,6 +28,8 @@ fn every_circuit_of_a_folder_is_raced_with_each_stack_as_race_races_it() {
         "fast-safe,pattern-search",
         "--laps",
         "12",
+        "--seed",
+        "3",
         "--jobs",
         "2",
         "--json",
@@ -73,10 +75,13 @@ fn every_circuit_of_a_folder_is_raced_with_each_stack_as_race_races_it() {
             stack,
             "--laps",
             "12",
+            "--seed",
+            "3",
             "--json",
             "--out",
             out.to_str().unwrap(),
         ]);
+        assert_eq!(run["seed"], 3, "{run}");
         assert_eq!(run["best_mps"], summary["best_reward_mps"], "{run}");
         assert_eq!(run["failed_laps"], summary["failed_laps"], "{run}");
     }
