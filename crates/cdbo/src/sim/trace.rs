@@ -79,7 +79,7 @@ impl TracePoint {
         ]
     }
 
-    /// The point of [`HEADER`]'s columns' values (a gear below 1 read as neutral, 0).
+    /// The point of [`HEADER`]'s columns' values (a reverse gear, below 0, read as 0).
     fn of_values(v: [f64; COLUMNS]) -> TracePoint {
         TracePoint {
             t: v[0],
@@ -120,8 +120,8 @@ pub fn read(path: &Path) -> Result<Vec<TracePoint>> {
     parse(&text, &path.display().to_string())
 }
 
-/// Parses a trace: [`HEADER`], then rows of 17 finite numbers (a gear below 1 read as
-/// neutral, 0). `file` names it in errors, each with its line and column.
+/// Parses a trace: [`HEADER`], then rows of 17 finite numbers (a reverse gear, below 0, read
+/// as 0). `file` names it in errors, each with its line and column.
 pub fn parse(text: &str, file: &str) -> Result<Vec<TracePoint>> {
     let mut lines = text.lines();
     let header = lines.next().unwrap_or_default().trim();
