@@ -174,14 +174,7 @@ struct Report {
 }
 
 pub fn circuits(args: &CircuitsArgs, data: &DataPath) -> CliResult {
-    let last_seed = args.seed.checked_add(args.seeds - 1).ok_or_else(|| {
-        format!(
-            "--seed {} with --seeds {}: the last seed would pass {}",
-            args.seed,
-            args.seeds,
-            u64::MAX
-        )
-    })?;
+    let last_seed = super::last_seed(args.seed, args.seeds)?;
     let files = circuit_files(&args.tracks, data)?;
     let car = cdbo::car::catalog::find(&args.car, data)?;
     let mut circuits = Vec::new();

@@ -215,6 +215,16 @@ pub fn print_json<T: serde::Serialize>(value: &T) -> CliResult {
 
 /// Value parsers for numeric flags: clap reports a bad value as one line naming the flag, the
 /// value and the bound, and exits with status 2 before the command allocates anything.
+/// The last of `seeds` seeds from `seed` on (`--seed` and `--seeds`), or why there is none.
+pub fn last_seed(seed: u64, seeds: u64) -> Result<u64, String> {
+    seed.checked_add(seeds.saturating_sub(1)).ok_or_else(|| {
+        format!(
+            "--seed {seed} with --seeds {seeds}: the last seed would pass {}",
+            u64::MAX
+        )
+    })
+}
+
 pub mod value {
     use cdbo::sizes::{self, Size};
 

@@ -167,14 +167,7 @@ struct Report {
 }
 
 pub fn run(args: &TransferArgs, data: &DataPath) -> CliResult {
-    let last_seed = args.seed.checked_add(args.seeds - 1).ok_or_else(|| {
-        format!(
-            "--seed {} with --seeds {}: the last seed would pass {}",
-            args.seed,
-            args.seeds,
-            u64::MAX
-        )
-    })?;
+    let last_seed = super::last_seed(args.seed, args.seeds)?;
     // The stack: the preset's, or the flags' (clap refuses both).
     let method = args.preset.map_or(args.method, Preset::method);
     let steering = args.preset.map_or(args.steering, Preset::steering);
