@@ -407,15 +407,43 @@ fn race_with(
     if start.is_some() {
         spec = spec.start_completed();
     }
-    let optimizer = spec
+    let mut optimizer = spec
         .policy(lengthscale)?
         .track_length(limit.track_length)?
         .optimizer_after(
             first,
             &start.as_ref().map(Start::departures).unwrap_or_default(),
         )?;
-    let mut source = InMemory::new(optimizer, config.laps - start_failed);
-    let (lap, mut start_s) = remembered;
+    let (mut lap, mut start_s) = remembered;
+    // The start's completed lap is the method's first where the method asks for the start
+    // first; otherwise (CMA-ES samples around it) it is the race's own lap, recorded and
+    // counted in the best, and the method has one lap fewer.
+    let mut recorded = start_failed;
+    let asks_start = match &lap {
+        Some((weights, _)) => optimizer.ask()? == *weights,
+        None => true,
+    };
+    if !asks_start && let Some((weights, outcome)) = lap.take() {
+        let reward = outcome.reward()?;
+        let record = LapRecord {
+            lap: start_failed + 1,
+            reward_mps: reward,
+            best_mps: reward,
+            lap_time_s: match outcome {
+                Outcome::Lap { time_s, .. } => Some(time_s),
+                _ => None,
+            },
+            failure: None,
+            x_fail: None,
+            optimizer_s: 0.0,
+            simulator_s: std::mem::take(&mut start_s),
+        };
+        progress(&record);
+        laps.push(record);
+        best = (weights, reward);
+        recorded += 1;
+    }
+    let mut source = InMemory::new(optimizer, config.laps.saturating_sub(recorded));
     let mut evaluator = DrivenOnce::new(evaluator, lap);
     run(&mut source, &mut evaluator, &mut |event| {
         let Event::Told {
@@ -431,7 +459,7 @@ fn race_with(
             best = (trial.weights.clone(), reward);
         }
         let record = LapRecord {
-            lap: start_failed + trial.id as usize,
+            lap: recorded + trial.id as usize,
             reward_mps: reward,
             best_mps: best.1,
             lap_time_s: match outcome {
