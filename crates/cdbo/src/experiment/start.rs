@@ -19,8 +19,9 @@
 //! overshot, and where lowering does not help it is fitted again to a slower demonstration,
 //! the repairs made so far kept, until its lap completes ([`complete_start`]). These laps are
 //! the race's first laps and count among its failed ones; the method then starts from the
-//! policy whose lap completed (its first lap, which it does not drive again), and the safe
-//! pattern search remembers those too fast ([`Start::departures`],
+//! policy whose lap completed (its first lap, which it does not drive again; where a method
+//! does not ask for its start first, as CMA-ES does not, that lap is recorded before its own),
+//! and the safe pattern search remembers those too fast ([`Start::departures`],
 //! [`crate::learner::safe_search::SafeSearch::after_failures`]).
 
 use serde::{Deserialize, Serialize};
