@@ -76,6 +76,25 @@ def test_a_python_loop_over_optimizer_and_env_is_the_librarys_race(method, knob)
     assert cdbo.Simulator("ridgeway").lap(result.best).reward == result.best_reward
 
 
+def test_cmaes_race_drives_the_start_then_the_loops_laps():
+    """CMA-ES samples around w0 rather than asking for it: the race's first lap is the start's,
+    counted in its best, and its laps 2 to N are the loop's first N - 1."""
+    laps = 20
+    result = cdbo.race("ridgeway", method="cmaes", kernels=20, laps=laps, seed=5)
+    env = cdbo.RaceEnv("ridgeway", kernels=20)
+    opt = env.optimizer("cmaes", seed=5)
+    rewards = []
+    for _ in range(laps - 1):
+        w = opt.ask()
+        lap = env.lap(w)
+        opt.tell(w, lap)
+        rewards.append(float(lap))
+    raced = [lap["reward"] for lap in result.laps]
+    assert raced[0] == float(env.lap(env.w0)) > 0.0
+    assert raced[1:] == rewards
+    assert result.best_reward == max(raced)
+
+
 def test_the_readmes_loop_tells_the_whole_lap_and_is_the_librarys_race():
     """`opt.tell(w, env.lap(w))`, as the README writes it, passes each failure's place and
     reason: the pattern search, which repairs there, asks what `cdbo.race` asks."""
