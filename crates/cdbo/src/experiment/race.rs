@@ -371,7 +371,7 @@ fn race_with(
     let mut best = (initial.weights(), 0.0);
     for (i, (outcome, seconds)) in start.iter().flat_map(|s| &s.laps).enumerate() {
         if matches!(outcome, Outcome::Failed { .. }) {
-            let record = start_record(i + 1, outcome, *seconds);
+            let record = lap_record(i + 1, outcome, (0.0, 0.0), (0.0, *seconds));
             progress(&record);
             laps.push(record);
         }
@@ -425,19 +425,8 @@ fn race_with(
     };
     if !asks_start && let Some((weights, outcome)) = lap.take() {
         let reward = outcome.reward()?;
-        let record = LapRecord {
-            lap: start_failed + 1,
-            reward_mps: reward,
-            best_mps: reward,
-            lap_time_s: match outcome {
-                Outcome::Lap { time_s, .. } => Some(time_s),
-                _ => None,
-            },
-            failure: None,
-            x_fail: None,
-            optimizer_s: 0.0,
-            simulator_s: std::mem::take(&mut start_s),
-        };
+        let seconds = (0.0, std::mem::take(&mut start_s));
+        let record = lap_record(start_failed + 1, &outcome, (reward, reward), seconds);
         progress(&record);
         laps.push(record);
         best = (weights, reward);
@@ -458,22 +447,16 @@ fn race_with(
         if reward > best.1 {
             best = (trial.weights.clone(), reward);
         }
-        let record = LapRecord {
-            lap: recorded + trial.id as usize,
-            reward_mps: reward,
-            best_mps: best.1,
-            lap_time_s: match outcome {
-                Outcome::Lap { time_s, .. } => Some(*time_s),
-                _ => None,
-            },
-            failure: match outcome {
-                Outcome::Failed { reason, .. } => Some(failure_reason(reason.as_deref())),
-                _ => None,
-            },
-            x_fail: outcome.failed_at(),
-            optimizer_s: timing.ask_s + timing.tell_s,
-            simulator_s: timing.evaluate_s + std::mem::take(&mut start_s),
-        };
+        let seconds = (
+            timing.ask_s + timing.tell_s,
+            timing.evaluate_s + std::mem::take(&mut start_s),
+        );
+        let record = lap_record(
+            recorded + trial.id as usize,
+            outcome,
+            (reward, best.1),
+            seconds,
+        );
         progress(&record);
         laps.push(record);
     })?;
@@ -492,21 +475,29 @@ fn race_with(
     })
 }
 
-/// The record of the `lap`-th lap of the first policy, failed as `outcome` says, driven in
-/// `seconds`.
-fn start_record(lap: usize, outcome: &Outcome, seconds: f64) -> LapRecord {
+/// The record of the race's `lap`-th lap: its `outcome`, its reward and the best so far
+/// (m/s), and the seconds the optimiser and the simulator took for it.
+fn lap_record(
+    lap: usize,
+    outcome: &Outcome,
+    (reward_mps, best_mps): (f64, f64),
+    (optimizer_s, simulator_s): (f64, f64),
+) -> LapRecord {
     LapRecord {
         lap,
-        reward_mps: 0.0,
-        best_mps: 0.0,
-        lap_time_s: None,
+        reward_mps,
+        best_mps,
+        lap_time_s: match outcome {
+            Outcome::Lap { time_s, .. } => Some(*time_s),
+            _ => None,
+        },
         failure: match outcome {
             Outcome::Failed { reason, .. } => Some(failure_reason(reason.as_deref())),
             _ => None,
         },
         x_fail: outcome.failed_at(),
-        optimizer_s: 0.0,
-        simulator_s: seconds,
+        optimizer_s,
+        simulator_s,
     }
 }
 
