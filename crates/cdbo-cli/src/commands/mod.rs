@@ -213,8 +213,6 @@ pub fn print_json<T: serde::Serialize>(value: &T) -> CliResult {
     Ok(())
 }
 
-/// Value parsers for numeric flags: clap reports a bad value as one line naming the flag, the
-/// value and the bound, and exits with status 2 before the command allocates anything.
 /// The last of `seeds` seeds from `seed` on (`--seed` and `--seeds`), or why there is none.
 pub fn last_seed(seed: u64, seeds: u64) -> Result<u64, String> {
     seed.checked_add(seeds.saturating_sub(1)).ok_or_else(|| {
@@ -225,6 +223,8 @@ pub fn last_seed(seed: u64, seeds: u64) -> Result<u64, String> {
     })
 }
 
+/// Value parsers for numeric flags: clap reports a bad value as one line naming the flag, the
+/// value and the bound, and exits with status 2 before the command allocates anything.
 pub mod value {
     use cdbo::sizes::{self, Size};
 
