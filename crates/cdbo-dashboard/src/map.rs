@@ -100,6 +100,7 @@ mod tests {
             policy: Policy {
                 pedal,
                 line: Some(line),
+                target: None,
             },
             ..paper.clone()
         };

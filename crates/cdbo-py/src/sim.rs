@@ -442,6 +442,7 @@ impl PySimulator {
         let policy = Policy {
             pedal: policy.policy.clone(),
             line: line.map(|l| l.policy.clone()),
+            target: None,
         };
         let lap = py.detach(|| {
             if trace {

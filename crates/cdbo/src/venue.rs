@@ -13,7 +13,7 @@ use crate::error::Result;
 use crate::evaluator::Evaluator;
 use crate::evaluator::simulator::SimEvaluator;
 use crate::line::RacingLine;
-use crate::policy::{Policy, PolicyShape};
+use crate::policy::{Policy, PolicyShape, SpeedTarget};
 use crate::sim::lap::{GAME_OFF_TRACK_MARGIN, Reserve};
 use crate::sim::{LapConfig, LapResult, Simulator};
 use crate::torcs::evaluator::{TorcsEvaluator, drive, with_pedal, with_policy};
@@ -208,12 +208,18 @@ impl Venue {
     }
 
     /// The evaluator of policy weights of shape `shape` here (a pedal and, if the shape has
-    /// one, a line).
-    pub fn evaluator(&self, shape: PolicyShape) -> Result<Box<dyn Evaluator + Send>> {
+    /// one, a line), the pedal's action asking for `target`'s speeds if given
+    /// ([`crate::policy::target`]).
+    pub fn evaluator(
+        &self,
+        shape: PolicyShape,
+        target: Option<SpeedTarget>,
+    ) -> Result<Box<dyn Evaluator + Send>> {
         Ok(match self {
             Venue::Simulator(sim) => Box::new(SimEvaluator {
                 sim: sim.as_ref().clone(),
                 shape,
+                target,
             }),
             Venue::Game {
                 game,
@@ -224,6 +230,7 @@ impl Venue {
                 request: request.as_ref().clone(),
                 track: track.clone(),
                 shape,
+                target,
             }),
         })
     }

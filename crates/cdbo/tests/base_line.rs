@@ -133,6 +133,7 @@ fn a_learned_line_drawn_never_leaves_the_road_less_the_margin() {
             )
             .unwrap(),
         ),
+        target: None,
     };
     let mut sim = cdbo::sim::Simulator::new(track.clone(), &car);
     for base in [BaseLine::Centre, BaseLine::MinCurvature] {

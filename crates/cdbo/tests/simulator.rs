@@ -409,6 +409,7 @@ fn a_policys_line_moves_the_car_within_the_road() {
         let policy = Policy {
             pedal: pedal.clone(),
             line: Some(RkhsPolicy::fit(&flat, 10, 1.0 / 9.0, 1e-9).unwrap()),
+            target: None,
         };
         let lap = sim.lap(&mut policy.driver());
         assert!(lap.completed, "d = {d}: {:?}", lap.failure);

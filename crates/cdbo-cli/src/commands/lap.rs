@@ -186,7 +186,7 @@ fn run_torcs(args: &LapArgs, data: &DataPath) -> CliResult {
         }
         (_, _, Some(path)) if path.is_dir() || path.extension().is_some_and(|e| e == "json") => {
             let raced = super::policy::read_raced_policy(path)?;
-            let pedal = GamePedal::Rkhs(raced.policy.pedal.clone());
+            let pedal = cdbo::torcs::evaluator::game_pedal(&raced.policy);
             policy = Some(raced);
             pedal
         }

@@ -128,6 +128,7 @@ pub fn run(args: &OptimizeArgs, simulator: Simulator, data: &DataPath) -> CliRes
                 request,
                 track: Arc::new(track),
                 shape: study.config().shape()?,
+                target: None,
             })
         }
         (None, Some(template)) => Box::new(CommandEvaluator {

@@ -53,7 +53,7 @@ pub fn run(args: &ServeSimArgs, data: &DataPath, simulator: Simulator) -> CliRes
         Some(m) => pedal.with_line(Block::paper(m)?),
         None => pedal,
     };
-    let evaluator = venue.evaluator(shape)?;
+    let evaluator = venue.evaluator(shape, None)?;
     serve(args, &track, &limit, &demo, (shape, base_line), evaluator)
 }
 

@@ -2,7 +2,7 @@
 
 use super::{Evaluator, Outcome};
 use crate::error::Result;
-use crate::policy::PolicyShape;
+use crate::policy::{PolicyShape, SpeedTarget};
 use crate::sim::Simulator;
 
 /// Laps of the simulator with policies of one shape (each action's kernels and length-scale).
@@ -12,11 +12,13 @@ pub struct SimEvaluator {
     pub sim: Simulator,
     /// The shape of the policies' weights.
     pub shape: PolicyShape,
+    /// The speed their pedal's action asks for ([`crate::policy::target`]); none: the pedal.
+    pub target: Option<SpeedTarget>,
 }
 
 impl Evaluator for SimEvaluator {
     fn evaluate(&mut self, _trial: i64, weights: &[f64]) -> Result<Outcome> {
-        let policy = self.shape.policy(weights)?;
+        let policy = self.shape.policy(weights)?.targeting(self.target.clone());
         let lap = self.sim.lap(&mut policy.driver());
         Ok(Outcome::of_lap(&lap, self.sim.track.length))
     }
@@ -42,6 +44,7 @@ mod tests {
         let mut e = SimEvaluator {
             sim: sim.clone(),
             shape: PolicyShape::pedal(Block::new(8, policy.lengthscale).unwrap()),
+            target: None,
         };
         let lap = sim.lap(&mut policy.pedal());
         let outcome = e.evaluate(1, &policy.weights).unwrap();

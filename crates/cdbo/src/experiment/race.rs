@@ -12,7 +12,7 @@ use crate::limit::{Limit, limit_lap};
 use crate::line::RacingLine;
 use crate::method::{Method, Spec};
 use crate::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
-use crate::policy::{Block, Policy, PolicyShape, RkhsPolicy};
+use crate::policy::{Block, Policy, PolicyShape, RkhsPolicy, SpeedTarget};
 use crate::sim::{FailureReason, LapResult};
 use crate::study::run::{Event, InMemory, run};
 use crate::track::Track;
@@ -207,6 +207,16 @@ pub struct RaceOutcome {
 }
 
 impl RaceOutcome {
+    /// This outcome with its policies asking for `target`'s speeds (the race's evaluator
+    /// drove them so).
+    fn targeting(self, target: Option<SpeedTarget>) -> RaceOutcome {
+        RaceOutcome {
+            initial: self.initial.targeting(target.clone()),
+            best: self.best.targeting(target),
+            ..self
+        }
+    }
+
     /// The time (s) of the first lap that reached the best reward, if one completed.
     pub fn best_lap_time_s(&self) -> Option<f64> {
         self.laps
@@ -236,13 +246,9 @@ pub fn race(
         }
         None => venue,
     };
-    let mut evaluator = if config.flying {
-        venue.clone().flying().evaluator(config.shape()?)?
-    } else {
-        venue.evaluator(config.shape()?)?
-    };
     // The safe pattern search starts near the limit (its budget of failed laps cannot pay
-    // for the climb from 15 m/s on a long circuit); a speed asked for is held as asked.
+    // for the climb from 15 m/s on a long circuit) and learns a target speed; a speed asked
+    // for is held as asked.
     let profiled = config.method == Method::SafePatternSearch
         && !config.fixed_demo_speed
         && config.warm_start.is_none();
@@ -251,34 +257,57 @@ pub fn race(
         Some(p) => p.choose(venue)?,
         None => None,
     };
+    let evaluator = |target: Option<SpeedTarget>| match config.flying {
+        true => venue.clone().flying().evaluator(config.shape()?, target),
+        false => venue.evaluator(config.shape()?, target),
+    };
     let mut outcome = match (chosen, &profile) {
-        (Some((demo, choice)), Some(profile)) => {
+        (Some(((lap, pairs), choice)), Some(profile)) => {
+            // The demonstration is a = 0 of a target at its scale; a slower one, a lower a.
+            let target = SpeedTarget::new(
+                profile.speed.clone(),
+                track.length,
+                choice.k,
+                crate::policy::target::SPAN,
+            )?;
+            let at = |k: f64, pairs: Vec<(f64, f64)>| {
+                let a = target.action_holding(k);
+                pairs.into_iter().map(|(x, _)| (x, a)).collect::<Vec<_>>()
+            };
+            let pairs = at(choice.k, pairs);
             let mut outcome = race_with(
                 &track.name,
-                (demo, choice.speed_mps),
+                ((lap, pairs), choice.speed_mps),
                 limit,
                 config,
-                (evaluator.as_mut(), &mut |v| profile.demonstrate(venue, v)),
+                (evaluator(Some(target.clone()))?.as_mut(), &mut |v| {
+                    let (lap, pairs) = profile.demonstrate(venue, v)?;
+                    Ok((lap, at(v / profile.reference_mps, pairs)))
+                }),
                 progress,
             )?;
             outcome.profile_choice = Some(choice);
-            outcome
+            outcome.targeting(Some(target))
         }
         _ => {
             let (demo, choice) = demonstration(config.demo_speed, config.fixed_demo_speed, |v| {
                 venue.demonstrate(v)
             })?;
             let speed = choice.as_ref().map_or(config.demo_speed, |c| c.chosen_mps);
+            // A warm start asking for a speed goes on asking for it.
+            let target = config.warm_start.as_ref().and_then(|p| p.target.clone());
             let mut outcome = race_with(
                 &track.name,
                 (demo, speed),
                 limit,
                 config,
-                (evaluator.as_mut(), &mut |v| venue.demonstrate(v)),
+                (evaluator(target.clone())?.as_mut(), &mut |v| {
+                    venue.demonstrate(v)
+                }),
                 progress,
             )?;
             outcome.demo_choice = choice;
-            outcome
+            outcome.targeting(target)
         }
     };
     outcome.line = line;
@@ -342,6 +371,7 @@ fn race_with(
                 Some(line) => Some(RkhsPolicy::new(vec![0.0; line.kernels], line.lengthscale)?),
                 None => None,
             },
+            target: None,
         },
     };
     // The first policy driven, and repaired where it fails, until its lap completes; a warm

@@ -11,12 +11,17 @@
 //! R^(M_a + M_d) ([`PolicyShape::policy`] splits it, [`Policy::weights`] joins it). A
 //! one-action policy's file is the paper's `{"lengthscale": l, "weights": [...]}`; a line
 //! adds `"line": {"lengthscale": l_d, "weights": [...]}`.
+//!
+//! A policy may carry a [`SpeedTarget`]: its pedal's action then sets the speed to hold,
+//! v*(x) = (k₀ + s·a(x))·v_g(x), rather than the pedal ([`super::target`]); its file adds
+//! `"target": {"profile": [...], "length": L, "scale": k₀, "span": s}`.
 
 use std::ops::Range;
 
 use serde::{Deserialize, Serialize};
 
 use super::rkhs::{RkhsPedal, RkhsPolicy, check_shape, default_lengthscale};
+use super::target::{SpeedTarget, TargetHold};
 use crate::drive::{Observation, Pedal};
 use crate::error::{Error, Result};
 
@@ -101,6 +106,7 @@ impl PolicyShape {
                 Some(block) => Some(RkhsPolicy::new(line.to_vec(), block.lengthscale)?),
                 None => None,
             },
+            target: None,
         })
     }
 }
@@ -114,12 +120,20 @@ pub struct Policy {
     /// The line: d(x) = w_dᵀφ_d(x) metres left of the centre line; none: the centre line.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub line: Option<RkhsPolicy>,
+    /// The speed the pedal's action asks for ([`super::target`]); none: the action is the
+    /// pedal, open loop.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub target: Option<SpeedTarget>,
 }
 
 impl From<RkhsPolicy> for Policy {
     /// The paper's pedal-only policy.
     fn from(pedal: RkhsPolicy) -> Policy {
-        Policy { pedal, line: None }
+        Policy {
+            pedal,
+            line: None,
+            target: None,
+        }
     }
 }
 
@@ -143,12 +157,33 @@ impl Policy {
         Ok(Policy {
             pedal: checked(self.pedal, "policy")?,
             line: self.line.map(|l| checked(l, "line")).transpose()?,
+            target: self
+                .target
+                .map(|t| {
+                    t.checked()
+                        .map_err(|e| Error::parse(file, "target", e.to_string()))
+                })
+                .transpose()?,
         })
     }
 
-    /// The paper's pedal-only policy this is, if it has no line.
+    /// The paper's pedal-only policy this is, if it has no line and its action is the pedal.
     pub fn pedal_only(&self) -> Option<&RkhsPolicy> {
-        self.line.is_none().then_some(&self.pedal)
+        (self.line.is_none() && self.target.is_none()).then_some(&self.pedal)
+    }
+
+    /// This policy with its action asking for `target`'s speeds (none: the pedal, open
+    /// loop).
+    pub fn targeting(self, target: Option<SpeedTarget>) -> Policy {
+        Policy { target, ..self }
+    }
+
+    /// The hold of the speeds its target asks for, if it has one.
+    pub fn target_hold(&self) -> Option<TargetHold> {
+        self.target.as_ref().map(|t| TargetHold {
+            speeds: t.speeds(&self.pedal),
+            length: t.length,
+        })
     }
 
     /// Its shape: each action's kernels and length-scale.
@@ -174,11 +209,13 @@ impl Policy {
         self.line.as_ref().map_or(0.0, |l| l.raw(x))
     }
 
-    /// The policy prepared for driving: a(x) and d(x) in O(1) per driver step.
+    /// The policy prepared for driving: a(x) and d(x) in O(1) per driver step, or with a
+    /// target the hold of its speeds.
     pub fn driver(&self) -> PolicyDriver {
         PolicyDriver {
             pedal: self.pedal.pedal(),
             line: self.line.as_ref().map(RkhsPolicy::pedal),
+            hold: self.target_hold(),
         }
     }
 
@@ -193,16 +230,20 @@ impl Policy {
 }
 
 /// A [`Policy`] prepared for driving: each block's wᵀφ(x) from two exponentials
-/// ([`RkhsPedal`]).
+/// ([`RkhsPedal`]), and with a target the hold of its speeds.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PolicyDriver {
     pedal: RkhsPedal,
     line: Option<RkhsPedal>,
+    hold: Option<TargetHold>,
 }
 
 impl Pedal for PolicyDriver {
     fn pedal(&mut self, obs: &Observation) -> f64 {
-        self.pedal.action(obs.x)
+        match &mut self.hold {
+            Some(hold) => hold.pedal(obs),
+            None => self.pedal.action(obs.x),
+        }
     }
 
     fn line(&self, x: f64) -> f64 {
@@ -220,6 +261,7 @@ mod tests {
         Policy {
             pedal,
             line: Some(line),
+            target: None,
         }
     }
 

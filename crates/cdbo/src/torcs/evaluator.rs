@@ -8,7 +8,7 @@ use super::{Game, GamePedal, LapRequest};
 use crate::drive::Pedal;
 use crate::error::Result;
 use crate::evaluator::{Evaluator, Outcome};
-use crate::policy::{Policy, PolicyShape};
+use crate::policy::{Policy, PolicyShape, SpeedTarget};
 use crate::sim::lap::{Failure, FailureReason, LapResult};
 use crate::track::Track;
 
@@ -26,11 +26,13 @@ pub struct TorcsEvaluator {
     pub track: Arc<Track>,
     /// The policies' shape.
     pub shape: PolicyShape,
+    /// The speed their pedal's action asks for ([`crate::policy::target`]); none: the pedal.
+    pub target: Option<SpeedTarget>,
 }
 
 impl Evaluator for TorcsEvaluator {
     fn evaluate(&mut self, _trial: i64, weights: &[f64]) -> Result<Outcome> {
-        let policy = self.shape.policy(weights)?;
+        let policy = self.shape.policy(weights)?.targeting(self.target.clone());
         lap_outcome(
             &self.game,
             &with_policy(&self.request, &self.track, &policy),
@@ -102,6 +104,24 @@ pub fn with_pedal(
 
 /// `req` driving `policy`: its pedal, and its line on the base line ([`with_pedal`]).
 pub fn with_policy(req: &LapRequest, track: &Track, policy: &Policy) -> LapRequest {
-    let pedal = GamePedal::Rkhs(policy.pedal.clone());
-    with_pedal(req, track, pedal, &policy.driver(), policy.line.is_some())
+    with_pedal(
+        req,
+        track,
+        game_pedal(policy),
+        &policy.driver(),
+        policy.line.is_some(),
+    )
+}
+
+/// The robot's pedal for `policy`: its RKHS pedal, or with a target the profile hold of the
+/// speeds it asks for ([`crate::policy::target`]), the same arithmetic as cdbo's.
+pub fn game_pedal(policy: &Policy) -> GamePedal {
+    match policy.target_hold() {
+        Some(hold) => GamePedal::Profile {
+            k: 1.0,
+            length: hold.length,
+            speed: hold.speeds,
+        },
+        None => GamePedal::Rkhs(policy.pedal.clone()),
+    }
 }

@@ -85,6 +85,7 @@ mod tests {
         let policy = Policy {
             pedal: RkhsPolicy::new(vec![0.5; 6], 0.2).unwrap(),
             line: Some(line),
+            target: None,
         };
         let driver = policy.driver();
         let table = LineTable::held(&track, half_car, None, &driver);

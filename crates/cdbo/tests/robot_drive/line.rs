@@ -59,6 +59,7 @@ fn the_robots_line_is_the_rust_one_on_recorded_laps() {
     let policy = Policy {
         pedal: RkhsPolicy::new(vec![0.0; 6], 0.2).unwrap(),
         line: Some(RkhsPolicy::new(vec![1.0, -1.5, 2.0, -1.0, 0.5, 1.0], 0.2).unwrap()),
+        target: None,
     };
     let driver = || SwingingDemo {
         hold: SpeedHold::new(15.0),
