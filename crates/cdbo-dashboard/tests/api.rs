@@ -119,6 +119,7 @@ fn run_record(method: &str, repeat: usize, rewards: &[f64]) -> RunRecord {
         line_kernels: None,
         base_line: Default::default(),
         steering: Default::default(),
+        target: None,
         laps,
         wall_s: 1.0,
     }

@@ -80,6 +80,21 @@ impl PyRaceResult {
         }
     }
 
+    /// The speed the best policy's action asks for, v*(x) = (scale + span·a(x))·profile(x),
+    /// as a dict (`profile` in m/s at stations spaced evenly over the lap, `length` in m,
+    /// `scale`, `span`): the safe pattern search's profile start learns it
+    /// (`cdbo::policy::target`); `Simulator.lap(best, target=...)` drives it again. None: the
+    /// action is the pedal.
+    #[getter]
+    fn best_target<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        self.outcome
+            .best
+            .target
+            .as_ref()
+            .map(|t| crate::sim::target_dict(py, t))
+            .transpose()
+    }
+
     /// The best policy's learned line d(x) (a `Policy` whose raw sum wᵀφ(x) is the offset in
     /// metres from `base_line`, before the road's bounds), or None without one.
     #[getter]

@@ -12,7 +12,7 @@ use cdbo::limit::{Limit, limit_lap};
 use cdbo::line::BaseLine;
 use cdbo::optimizers::FailedLap;
 use cdbo::policy::rkhs::{DEFAULT_RIDGE, default_lengthscale};
-use cdbo::policy::{Policy, RkhsPolicy};
+use cdbo::policy::{Policy, RkhsPolicy, SpeedTarget};
 use cdbo::sim::lap::checked_off_track_margin;
 use cdbo::sim::{LapResult, Simulator};
 use cdbo::track::Track;
@@ -430,19 +430,22 @@ impl PySimulator {
 
     /// One lap with `policy`; `line`, a second `Policy`, is a learned line d(x): its raw sum
     /// wᵀφ(x) (m, positive left) is the offset from the simulator's base line, clamped to the
-    /// road less half the car's width; `trace=True` records every driver step.
-    #[pyo3(signature = (policy, *, line = None, trace = false))]
+    /// road less half the car's width; `target`, a dict as `RaceResult.best_target`, makes the
+    /// policy's action ask for the speed (k₀ + s·a(x))·v_g(x) rather than be the pedal;
+    /// `trace=True` records every driver step.
+    #[pyo3(signature = (policy, *, line = None, target = None, trace = false))]
     fn lap(
         &self,
         py: Python<'_>,
         policy: PyRef<'_, PyPolicy>,
         line: Option<PyRef<'_, PyPolicy>>,
+        target: Option<&Bound<'_, PyDict>>,
         trace: bool,
     ) -> PyResult<PyLapResult> {
         let policy = Policy {
             pedal: policy.policy.clone(),
             line: line.map(|l| l.policy.clone()),
-            target: None,
+            target: target.map(target_from).transpose()?,
         };
         let lap = py.detach(|| {
             if trace {
@@ -481,12 +484,16 @@ impl PySimulator {
 
     /// The recommended learner's demonstration, as `cdbo race --method safe-pattern-search`
     /// drives it: a hold of a share of the limit's speed profile on the laps' line (the profile
-    /// start), its lap and (x, a) pairs as two arrays and the speed it holds (m/s); None
-    /// where no share of the profile completes.
+    /// start). Returns its lap, its (x, a) pairs as two arrays, a in the units of the policy
+    /// that learns from it (the action asking for the demonstrated speed, 0), the speed it
+    /// holds (m/s) and the target the policy's action asks for (a dict as
+    /// `RaceResult.best_target`, for `lap(policy, target=...)`); None where no share of the
+    /// profile completes.
+    #[allow(clippy::type_complexity)]
     fn demonstrate_profile<'py>(
         &self,
         py: Python<'py>,
-    ) -> PyResult<Option<(PyLapResult, Array<'py>, Array<'py>, f64)>> {
+    ) -> PyResult<Option<(PyLapResult, Array<'py>, Array<'py>, f64, Bound<'py, PyDict>)>> {
         let venue = cdbo::venue::Venue::Simulator(Box::new(self.sim.clone()));
         let demonstrator = cdbo::experiment::profile_start::ProfileDemonstrator::new(
             &self.sim.track,
@@ -497,12 +504,15 @@ impl PySimulator {
         let Some(((lap, pairs), choice)) = chosen else {
             return Ok(None);
         };
-        let (x, a) = pairs.into_iter().unzip();
+        let target = demonstrator.target(&self.sim.track, choice.k).py()?;
+        let a = target.action_holding(choice.k);
+        let (x, a) = pairs.into_iter().map(|(x, _)| (x, a)).unzip();
         Ok(Some((
             PyLapResult::new(py, lap, false)?,
             array(py, x),
             array(py, a),
             choice.speed_mps,
+            target_dict(py, &target)?,
         )))
     }
 
@@ -576,4 +586,38 @@ pub fn limit(
     Ok(PyLimit {
         limit: py.detach(|| limit_lap(&track, &car)),
     })
+}
+
+/// A speed target as a dict: `profile` (m/s at stations spaced evenly over the lap), `length`
+/// (m), `scale` k₀ and `span` s.
+pub fn target_dict<'py>(py: Python<'py>, t: &SpeedTarget) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("profile", t.profile.clone())?;
+    d.set_item("length", t.length)?;
+    d.set_item("scale", t.scale)?;
+    d.set_item("span", t.span)?;
+    Ok(d)
+}
+
+/// The speed target of a dict as [`target_dict`] writes it; a missing or mistyped key raises
+/// `ValueError` naming it.
+pub fn target_from(d: &Bound<'_, PyDict>) -> PyResult<SpeedTarget> {
+    use pyo3::exceptions::PyValueError;
+    let item = |key: &str| {
+        d.get_item(key)?
+            .ok_or_else(|| PyValueError::new_err(format!("target: no \"{key}\"")))
+    };
+    fn bad(key: &'static str) -> impl Fn(PyErr) -> PyErr {
+        move |e| PyValueError::new_err(format!("target[\"{key}\"]: {e}"))
+    }
+    let number = |key: &'static str| item(key)?.extract::<f64>().map_err(bad(key));
+    SpeedTarget::new(
+        item("profile")?
+            .extract::<Vec<f64>>()
+            .map_err(bad("profile"))?,
+        number("length")?,
+        number("scale")?,
+        number("span")?,
+    )
+    .py()
 }

@@ -98,3 +98,19 @@ def test_an_environment_of_the_preset_is_the_races_preset():
     with pytest.raises(ValueError, match="not both.*steering="):
         cdbo.RaceEnv("ridgeway", kernels=20, preset="fast-safe", steering="pi")
     assert cdbo.RaceEnv("ridgeway", kernels=20).optimizer().method == "cdbo"
+
+
+def test_the_presets_best_policy_asks_for_a_speed_and_drives_again_with_it():
+    result = cdbo.race("ridgeway", kernels=20, laps=20, preset="fast-safe")
+    target = result.best_target
+    assert set(target) == {"profile", "length", "scale", "span"}
+    assert target["span"] == 0.25 and 0 < target["scale"] <= 1
+    sim = cdbo.Simulator("ridgeway", line="min-curvature", steering="tracker")
+    assert sim.lap(result.best, target=target).reward == result.best_reward
+    # Without its target the same weights are an open-loop pedal: another lap.
+    assert sim.lap(result.best).reward != result.best_reward
+    assert cdbo.race("ridgeway", laps=2).best_target is None
+    with pytest.raises(ValueError, match='target: no "span"'):
+        sim.lap(result.best, target={k: v for k, v in target.items() if k != "span"})
+    with pytest.raises(ValueError, match="scale"):
+        sim.lap(result.best, target={**target, "scale": -1.0})

@@ -45,7 +45,7 @@
 //!     .track_length(sim.track.length)?
 //!     .optimizer(w0.weights.clone())?;
 //! let shape = PolicyShape::pedal(Block::new(kernels, w0.lengthscale)?);
-//! let mut laps = SimEvaluator { sim, shape };
+//! let mut laps = SimEvaluator { sim, shape, target: None };
 //! for trial in 1..=20 {
 //!     let weights = optimizer.ask()?;
 //!     let outcome = laps.evaluate(trial, &weights)?;

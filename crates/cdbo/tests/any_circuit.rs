@@ -39,15 +39,19 @@ fn chicane() -> Track {
 /// A race of `laps` laps on the chicane as a policy learns there (the car's centre a metre
 /// inside the road's edge).
 fn race_chicane(method: Method, laps: usize, max_failed_laps: Option<usize>) -> RaceOutcome {
-    let car = Car::spirit_300();
-    let track = chicane();
-    let venue = Venue::simulator(track.clone(), &car).for_learning(None);
-    let config = RaceConfig {
+    race_chicane_with(RaceConfig {
         method,
         laps,
         max_failed_laps,
         ..RaceConfig::default()
-    };
+    })
+}
+
+/// A race on the chicane with `config`, as a policy learns there.
+fn race_chicane_with(config: RaceConfig) -> RaceOutcome {
+    let car = Car::spirit_300();
+    let track = chicane();
+    let venue = Venue::simulator(track.clone(), &car).for_learning(None);
     race(&venue, &track, &car, &config, |_| {}).unwrap()
 }
 
@@ -92,9 +96,15 @@ fn a_chicane_the_papers_demonstration_leaves_still_races() {
 }
 
 /// Where π(w₀) fails, a budget of failed laps caps them from the first lap for every kind of
-/// method: the start's failed laps are counted, and each run still completes laps.
+/// method: the start's failed laps are counted, and each run still completes laps. (The safe
+/// pattern search is held to the same demonstration as the others; from its own profile start
+/// π(w₀) is the demonstration, whose lap completed.)
 #[test]
 fn the_budget_is_a_cap_where_the_first_policy_fails() {
+    let demo = race_chicane(Method::Cdbo, 1, None)
+        .demo_choice
+        .expect("a slower demonstration")
+        .chosen_mps;
     for method in [
         Method::Cdbo,
         Method::Cmaes,
@@ -102,7 +112,14 @@ fn the_budget_is_a_cap_where_the_first_policy_fails() {
         Method::PatternSearch,
         Method::SafePatternSearch,
     ] {
-        let outcome = race_chicane(method, 40, Some(5));
+        let outcome = race_chicane_with(RaceConfig {
+            method,
+            laps: 40,
+            max_failed_laps: Some(5),
+            demo_speed: demo,
+            fixed_demo_speed: method == Method::SafePatternSearch,
+            ..RaceConfig::default()
+        });
         assert!(outcome.start_failed_laps > 0, "{method}: π(w₀) completed");
         let failed = outcome.laps.iter().filter(|l| l.failure.is_some()).count();
         assert!(failed <= 5, "{method}: {failed} laps failed");
@@ -142,4 +159,37 @@ fn every_race_records_its_starts_completed_lap() {
         assert_eq!(outcome.best_reward_mps, best, "{method}");
         assert!(best >= completed.reward_mps, "{method}");
     }
+}
+
+/// The safe pattern search's profile start: π(w₀) is the demonstration's hold (w₀ = 0, the
+/// action asking for the demonstrated scale), so the race's first lap completes at the
+/// demonstration's reward; the best policy carries the target it asks for.
+#[test]
+fn the_profile_starts_first_lap_is_its_demonstration() {
+    let outcome = race_chicane(Method::SafePatternSearch, 20, None);
+    let choice = outcome.profile_choice.expect("the profile start");
+    assert_eq!(outcome.start_failed_laps, 0);
+    assert!(outcome.initial.pedal.weights.iter().all(|w| *w == 0.0));
+    let first = &outcome.laps[0];
+    assert!(first.failure.is_none(), "{first:?}");
+    let rel = (first.reward_mps - outcome.demo.reward_mps).abs() / outcome.demo.reward_mps;
+    assert!(
+        rel < 1e-3,
+        "{} against {}",
+        first.reward_mps,
+        outcome.demo.reward_mps
+    );
+    let target = outcome.best.target.as_ref().expect("a target");
+    assert_eq!(target.scale, choice.k);
+    assert!(outcome.best_reward_mps >= first.reward_mps);
+    // The best policy, driven again with its target, laps at the best reward.
+    let car = Car::spirit_300();
+    let track = chicane();
+    let line = outcome.line.clone();
+    let mut venue = Venue::simulator(track, &car).for_learning(None);
+    if let Some(l) = line {
+        venue = venue.on_line(l);
+    }
+    let lap = venue.drive(&outcome.best).unwrap();
+    assert_eq!(lap.reward_mps, outcome.best_reward_mps);
 }

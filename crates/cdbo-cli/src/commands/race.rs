@@ -522,10 +522,21 @@ fn write_plots(
         ],
     };
     let xs = (0..=500).map(|i| i as f64 / 500.0);
+    // With a target the action asks for a speed: (k₀ + s·a)·v_g.
+    let (title, y_label) = match &o.best.target {
+        Some(t) => (
+            "Policies: the speed asked for along the lap".into(),
+            format!("a (speed ({:.2} + {:.2}·a) × the profile)", t.scale, t.span),
+        ),
+        None => (
+            "Policies: throttle (+) / brake (−) along the lap".into(),
+            "a".into(),
+        ),
+    };
     let policies = LineChart {
-        title: "Policies: throttle (+) / brake (−) along the lap".into(),
+        title,
         x_label: "x (fraction of the lap)".into(),
-        y_label: "a".into(),
+        y_label,
         series: vec![
             (
                 "demonstration".into(),

@@ -147,6 +147,16 @@ impl InitialPolicy {
             ),
             (None, Some(w)) => {
                 let raced = read_raced_policy(w)?;
+                // A study's laps are driven by its pedal, open loop (a real car's among them).
+                if raced.policy.target.is_some() {
+                    return Err(format!(
+                        "{}: a policy whose action asks for a target speed (learned from the \
+                         profile start); a study learns an open-loop pedal: start it from a \
+                         demonstration (--demo) or a policy without a \"target\"",
+                        w.display()
+                    )
+                    .into());
+                }
                 // A policy drives the line it was raced on; a warm start is a pedal-only
                 // policy, as a race's.
                 let study_line = LineSetting::of(base_line, line_kernels).label();

@@ -525,6 +525,52 @@ fn a_race_warm_starts_from_a_policy_file() {
     let _ = std::fs::remove_dir_all(&out);
 }
 
+/// The recommended stack's policy asks for a speed: its file carries the target, a lap of it
+/// replays the best lap, a race warm-started from it goes on asking for that speed (its first
+/// lap the best again), and a study, whose pedal is open loop, refuses it.
+#[test]
+fn the_recommended_stacks_policy_carries_its_target_speed() {
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("cdbo-cli-target-{}", std::process::id()));
+    let (learn, warm) = (out.join("learn"), out.join("warm"));
+    let common = ["race", "--preset", "fast-safe", "--kernels", "20", "--json"];
+    let run = |more: &[&str]| json(&[&common[..], more].concat());
+    let learned = run(&["--laps", "20", "--out", learn.to_str().unwrap()]);
+    let best = learned["best_reward_mps"].as_f64().unwrap();
+    let policy = learn.join("best_policy.json");
+    let file: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&policy).unwrap()).unwrap();
+    assert_eq!(file["target"]["span"].as_f64(), Some(0.25), "{file}");
+    assert!(file["target"]["profile"].as_array().unwrap().len() > 100);
+    let policy = policy.to_str().unwrap();
+    let again = json(&["lap", "--policy", policy, "--json"]);
+    assert_eq!(again["reward_mps"].as_f64(), Some(best));
+    let v = run(&[
+        "--laps",
+        "3",
+        "--warm-start",
+        policy,
+        "--out",
+        warm.to_str().unwrap(),
+    ]);
+    assert_eq!(v["first_lap_reward_mps"].as_f64(), Some(best));
+    fails_with(
+        &[
+            "study",
+            "create",
+            "warm",
+            "--storage",
+            out.join("warm.cdbo.db").to_str().unwrap(),
+            "--kernels",
+            "20",
+            "--warm-start",
+            policy,
+        ],
+        &[policy, "target speed", "open-loop pedal"],
+    );
+    let _ = std::fs::remove_dir_all(&out);
+}
+
 /// A `.csv` circuit with a road of width 0, a centre line that crosses itself, or fewer than
 /// 10 points is refused by `race` in one line naming the file, and no run folder is made.
 #[test]

@@ -125,11 +125,14 @@ class RaceEnv(_Base):
         )
         # The recommended learner starts from the profile start, as `cdbo race` does, unless a
         # demonstration speed is given; every other method from the paper's 15 m/s.
+        # From the profile start the policy's action asks for a speed (``target``, as
+        # ``RaceResult.best_target``), as the race's does; otherwise it is the pedal.
         profile = None
+        self.target = None
         if demo_speed is None and self.method == "safe-pattern-search":
             profile = self.simulator.demonstrate_profile()
         if profile is not None:
-            demo, x, a, demo_speed = profile
+            demo, x, a, demo_speed, self.target = profile
         else:
             demo_speed = 15.0 if demo_speed is None else demo_speed
             demo, x, a = self.simulator.demonstrate(demo_speed)
@@ -190,7 +193,7 @@ class RaceEnv(_Base):
             raise ValueError(f"the action has {w.size} weights; this race's have {self.w0.size}")
         policy = Policy(w[: self.kernels], self.lengthscale)
         line = Policy(w[self.kernels :], self.line_lengthscale) if self.line_kernels else None
-        lap = self.simulator.lap(policy, line=line)
+        lap = self.simulator.lap(policy, line=line, target=self.target)
         self.last = lap
         info = {
             "completed": lap.completed,

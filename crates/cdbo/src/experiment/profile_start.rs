@@ -1,6 +1,6 @@
 //! The profile start of the safe pattern search: a demonstration that holds a share of the
-//! limit's speed profile on the line the race drives, braking gently enough that the policy's
-//! kernels can fit its pedal.
+//! limit's speed profile on the line the race drives, and a policy that learns the speed to
+//! hold from it ([`crate::policy::target`]).
 //!
 //! The paper's demonstrator holds 15 m/s: on a 5 km circuit whose limit lap averages 32–42 m/s
 //! the learner then has to climb from under half the limit within its budget of failed laps,
@@ -10,16 +10,16 @@
 //! - **The profile.** v_g(s), the crest-aware QSS limit's speeds on the raced line
 //!   ([`crate::ceiling::profile`]) braking at no more than [`DECEL`]: v_g(sᵢ) =
 //!   min(v_lim(sᵢ), √(v_g(sᵢ₊₁)² + 2·[`DECEL`]·h)) from the finish back, h the stations'
-//!   spacing. A profile hold ([`crate::drive::profile::ProfileHold`]) of the limit itself
-//!   brakes at full pedal for a second before each corner; the policy's M kernels, 120–200 m
-//!   apart on a 5 km circuit, smooth that into a lift, and the fitted pedal reaches the corner
-//!   several m/s too fast. Braking at [`DECEL`] spreads each brake over 100–300 m, which the
-//!   kernels follow.
-//! - **The scale.** The largest k in (0, 1] whose hold of k·v_g completes is found by
-//!   [`BISECTIONS`] halvings (each a lap of the demonstrator, not counted among the race's
-//!   laps, as the paper's demonstration is not); the race demonstrates at [`SCALE`]·k, and
-//!   w₀ is that pedal's ridge fit, repaired until its lap completes
-//!   ([`super::start::complete_start`]; a slower demonstration there is a smaller k).
+//!   spacing. Braking at [`DECEL`] spreads each brake over 100–300 m, which the policy's M
+//!   kernels, 120–200 m apart on a 5 km circuit, can shape.
+//! - **The scale.** The largest k in (0, 1] whose hold of k·v_g
+//!   ([`crate::drive::profile::ProfileHold`]) completes is found by [`BISECTIONS`] halvings
+//!   (each a lap of the demonstrator, not counted among the race's laps, as the paper's
+//!   demonstration is not); the race demonstrates at k₀ = [`SCALE`]·k.
+//! - **The policy.** Its action asks for the speed (k₀ + s·a(x))·v_g(x)
+//!   ([`SpeedTarget`], s = [`SPAN`]), so w₀ = 0 is the
+//!   demonstration itself, repaired where its lap fails ([`super::start::complete_start`]; a
+//!   slower demonstration there is a smaller k, a lower a).
 //!
 //! A demonstration's speed, as the start reports and slows it, is k times the profile's
 //! reward (the crest-aware limit's L/T).
@@ -33,6 +33,7 @@
 use crate::car::Car;
 use crate::error::Result;
 use crate::line::RacingLine;
+use crate::policy::target::{SPAN, SpeedTarget};
 use crate::track::Track;
 use crate::venue::Venue;
 
@@ -69,13 +70,14 @@ pub struct ProfileChoice {
 }
 
 impl ProfileChoice {
-    /// One line saying what was demonstrated.
+    /// One line saying what was demonstrated and what the policy learns.
     pub fn sentence(&self) -> String {
         format!(
             "demonstrating with a hold of {:.2} times the limit's speed profile on the line \
              (braking at {DECEL} m/s²; {SCALE} of the largest scale that completed, {:.3}, in \
-             a search of {} laps)",
-            self.k, self.largest_k, self.laps
+             a search of {} laps); the policy learns the speed to hold, {:.2} ± {SPAN} times \
+             the profile",
+            self.k, self.largest_k, self.laps, self.k
         )
     }
 }
@@ -88,6 +90,12 @@ impl ProfileDemonstrator {
             speed: braking_gently(&limit.speed, track.length, DECEL),
             reference_mps: limit.reward_mps,
         }
+    }
+
+    /// The target a policy learning from this demonstrator's hold at scale `k` asks for on
+    /// `track`: (k + s·a(x))·v_g(x), s = [`SPAN`].
+    pub fn target(&self, track: &Track, k: f64) -> Result<SpeedTarget> {
+        SpeedTarget::new(self.speed.clone(), track.length, k, SPAN)
     }
 
     /// The demonstration on `venue` said to hold `speed` m/s: the hold of k·v_g, k =

@@ -264,12 +264,7 @@ pub fn race(
     let mut outcome = match (chosen, &profile) {
         (Some(((lap, pairs), choice)), Some(profile)) => {
             // The demonstration is a = 0 of a target at its scale; a slower one, a lower a.
-            let target = SpeedTarget::new(
-                profile.speed.clone(),
-                track.length,
-                choice.k,
-                crate::policy::target::SPAN,
-            )?;
+            let target = profile.target(track, choice.k)?;
             let at = |k: f64, pairs: Vec<(f64, f64)>| {
                 let a = target.action_holding(k);
                 pairs.into_iter().map(|(x, _)| (x, a)).collect::<Vec<_>>()

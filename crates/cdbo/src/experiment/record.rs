@@ -15,7 +15,7 @@ use crate::drive::steering::SteeringLaw;
 use crate::error::{Error, Result};
 use crate::line::{BaseLine, LineSetting};
 use crate::policy::RacedPolicy;
-use crate::policy::{Block, PolicyShape};
+use crate::policy::{Block, PolicyShape, SpeedTarget};
 use crate::track::Track;
 use crate::venue::Venue;
 
@@ -60,6 +60,10 @@ pub struct RunRecord {
     /// The steering the run's car drove with; absent: the paper's PI.
     #[serde(default, skip_serializing_if = "SteeringLaw::is_pi")]
     pub steering: SteeringLaw,
+    /// The speed the best policy's action asks for ([`crate::policy::target`]); absent: its
+    /// action is the pedal.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub target: Option<SpeedTarget>,
     /// Every lap.
     pub laps: Vec<LapRecord>,
     /// Wall-clock seconds of the run.
@@ -80,7 +84,9 @@ impl RunRecord {
             None => pedal,
         };
         Ok(RacedPolicy {
-            policy: shape.policy(&self.best_weights)?,
+            policy: shape
+                .policy(&self.best_weights)?
+                .targeting(self.target.clone()),
             base_line: self.base_line,
             steering: self.steering,
         })
@@ -247,6 +253,7 @@ pub fn run_at(
         line_kernels,
         base_line,
         steering: grid.steering,
+        target: outcome.best.target.clone(),
         laps: outcome.laps,
         wall_s: start.elapsed().as_secs_f64(),
     })
