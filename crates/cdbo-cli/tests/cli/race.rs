@@ -1,7 +1,7 @@
 //! `cdbo race`: its knobs, budgets, lines, steering, presets and warm starts, what it writes,
 //! and one clear error line for what it cannot take.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use crate::common::{fails_with, json, oval_file, run, scratch, shared, succeed};
 
@@ -457,9 +457,7 @@ fn the_fast_safe_preset_races_as_its_long_form() {
 /// line naming the file and both sizes, as is a study's.
 #[test]
 fn a_race_warm_starts_from_a_policy_file() {
-    let out = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("cdbo-cli-warm-{}", std::process::id()));
-    let (learn, warm) = (out.join("learn"), out.join("warm"));
+    let (out, learn, warm) = learn_then_warm("warm");
     let common = [
         "race",
         "--track",
@@ -508,20 +506,7 @@ fn a_race_warm_starts_from_a_policy_file() {
         &["race", "--kernels", "20", "--warm-start", policy],
         &[policy, "12 kernels", "20 kernels"],
     );
-    fails_with(
-        &[
-            "study",
-            "create",
-            "warm",
-            "--storage",
-            out.join("warm.cdbo.db").to_str().unwrap(),
-            "--kernels",
-            "20",
-            "--warm-start",
-            policy,
-        ],
-        &[policy, "12 kernels", "--kernels is 20"],
-    );
+    study_refuses_warm_start(&out, policy, &[policy, "12 kernels", "--kernels is 20"]);
     let _ = std::fs::remove_dir_all(&out);
 }
 
@@ -530,9 +515,7 @@ fn a_race_warm_starts_from_a_policy_file() {
 /// lap the best again), and a study, whose pedal is open loop, refuses it.
 #[test]
 fn the_recommended_stacks_policy_carries_its_target_speed() {
-    let out = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("cdbo-cli-target-{}", std::process::id()));
-    let (learn, warm) = (out.join("learn"), out.join("warm"));
+    let (out, learn, warm) = learn_then_warm("target");
     let common = ["race", "--preset", "fast-safe", "--kernels", "20", "--json"];
     let run = |more: &[&str]| json(&[&common[..], more].concat());
     let learned = run(&["--laps", "20", "--out", learn.to_str().unwrap()]);
@@ -545,30 +528,39 @@ fn the_recommended_stacks_policy_carries_its_target_speed() {
     let policy = policy.to_str().unwrap();
     let again = json(&["lap", "--policy", policy, "--json"]);
     assert_eq!(again["reward_mps"].as_f64(), Some(best));
-    let v = run(&[
-        "--laps",
-        "3",
-        "--warm-start",
-        policy,
-        "--out",
-        warm.to_str().unwrap(),
-    ]);
+    let warm = warm.to_str().unwrap();
+    let v = run(&["--laps", "3", "--warm-start", policy, "--out", warm]);
     assert_eq!(v["first_lap_reward_mps"].as_f64(), Some(best));
+    study_refuses_warm_start(&out, policy, &[policy, "target speed", "open-loop pedal"]);
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+/// A test's folder `cdbo-cli-NAME-PID` and in it the runs `learn` and `warm`.
+fn learn_then_warm(name: &str) -> (PathBuf, PathBuf, PathBuf) {
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("cdbo-cli-{name}-{}", std::process::id()));
+    let (learn, warm) = (out.join("learn"), out.join("warm"));
+    (out, learn, warm)
+}
+
+/// `study create` with 20 kernels in `out`, warm-started from `policy`, fails naming `what`.
+fn study_refuses_warm_start(out: &Path, policy: &str, what: &[&str]) {
+    let storage = out.join("warm.cdbo.db");
+    let storage = storage.to_str().unwrap();
     fails_with(
         &[
             "study",
             "create",
             "warm",
             "--storage",
-            out.join("warm.cdbo.db").to_str().unwrap(),
+            storage,
             "--kernels",
             "20",
             "--warm-start",
             policy,
         ],
-        &[policy, "target speed", "open-loop pedal"],
+        what,
     );
-    let _ = std::fs::remove_dir_all(&out);
 }
 
 /// A `.csv` circuit with a road of width 0, a centre line that crosses itself, or fewer than
