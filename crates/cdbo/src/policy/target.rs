@@ -27,6 +27,10 @@ use crate::error::{Error, Result};
 
 /// The span s: a = ±1 holds k₀ ± s times the profile.
 pub const SPAN: f64 = 0.25;
+/// The fastest speed a profile may give (m/s), past any car's.
+pub const MAX_SPEED: f64 = 1000.0;
+/// The largest scale k₀ and span s a target may have.
+pub const MAX_SCALE: f64 = 10.0;
 
 /// The speed a policy's action asks for, v*(x) = (k₀ + s·a(x))·v_g(x) (module
 /// documentation), stored with the policy (`"target"` in its file).
@@ -44,9 +48,9 @@ pub struct SpeedTarget {
 
 impl SpeedTarget {
     /// The target of scale `scale` and span `span` on `profile` over a lap of `length` m,
-    /// refused unless the profile has at least two finite speeds, none negative (a standing
-    /// start's is 0 at the line), and the numbers are
-    /// finite, the length and scale positive and the span not negative.
+    /// refused unless the profile has at least two speeds, each in [0, [`MAX_SPEED`]] m/s (a
+    /// standing start's is 0 at the line), the length is finite and positive, the scale in
+    /// (0, [`MAX_SCALE`]] and the span in [0, [`MAX_SCALE`]].
     pub fn new(profile: Vec<f64>, length: f64, scale: f64, span: f64) -> Result<SpeedTarget> {
         SpeedTarget {
             profile,
@@ -69,25 +73,37 @@ impl SpeedTarget {
         if let Some(i) = self
             .profile
             .iter()
-            .position(|v| !(v.is_finite() && *v >= 0.0))
+            .position(|v| !(0.0..=MAX_SPEED).contains(v))
         {
             return Err(Error::invalid_value(
                 format!("the target's profile speed {i}"),
                 self.profile[i],
-                "a number of m/s, not negative",
+                format!("a speed in [0, {MAX_SPEED}] m/s"),
             ));
         }
-        for (what, value, ok) in [
-            ("the target's length", self.length, self.length > 0.0),
-            ("the target's scale", self.scale, self.scale > 0.0),
-            ("the target's span", self.span, self.span >= 0.0),
+        if !(self.length.is_finite() && self.length > 0.0) {
+            return Err(Error::invalid_value(
+                "the target's length",
+                self.length,
+                "a positive number of metres",
+            ));
+        }
+        for (what, value, ok, range) in [
+            (
+                "the target's scale",
+                self.scale,
+                self.scale > 0.0 && self.scale <= MAX_SCALE,
+                format!("in (0, {MAX_SCALE}]"),
+            ),
+            (
+                "the target's span",
+                self.span,
+                (0.0..=MAX_SCALE).contains(&self.span),
+                format!("in [0, {MAX_SCALE}]"),
+            ),
         ] {
-            if !(value.is_finite() && ok) {
-                return Err(Error::invalid_value(
-                    what,
-                    value,
-                    "a finite positive number",
-                ));
+            if !ok {
+                return Err(Error::invalid_value(what, value, range));
             }
         }
         Ok(self)
@@ -201,6 +217,8 @@ mod tests {
             (vec![20.0, 30.0], 0.0, 0.6, 0.25),
             (vec![20.0, 30.0], 100.0, -0.6, 0.25),
             (vec![20.0, 30.0], 100.0, 0.6, -0.25),
+            (vec![20.0, 1e300], 100.0, 0.6, 0.25),
+            (vec![20.0, 30.0], 100.0, 0.6, f64::INFINITY),
         ] {
             let e = SpeedTarget::new(profile, length, scale, span).unwrap_err();
             assert!(e.to_string().contains("target"), "{e}");
