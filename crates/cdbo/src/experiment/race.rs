@@ -1,5 +1,7 @@
 //! Learning to race one track (paper Sec. V): drive the demonstration, fit w₀, then optimise
-//! the policy weights for a number of laps, one lap per evaluation.
+//! the policy weights for a number of laps, one lap per evaluation. The safe pattern search
+//! starts from the profile start instead ([`super::profile_start`]): its policy's action asks
+//! for a speed ([`crate::policy::target`]), and w₀ = 0 is the demonstration.
 
 use std::sync::Arc;
 
@@ -57,8 +59,9 @@ pub struct RaceConfig {
     /// The policy the race starts from instead of the demonstration's fitted w₀ (a warm start:
     /// say, a policy learned in cdbo's simulator, continued in the game). Its shape must be the
     /// race's ([`check_warm_start`]); the search box is centred on it, and the pattern search
-    /// skips its push and repairs it where its first lap fails ([`Spec::warm_started`]).
-    /// `None`: the fitted w₀, as the paper does.
+    /// skips its push and repairs it where its first lap fails ([`Spec::warm_started`]); where
+    /// its action asks for a speed ([`crate::policy::target`]) the race's policies ask for the
+    /// same. `None`: the fitted w₀, as the paper does.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub warm_start: Option<Policy>,
     /// The base line d₀(s): the line the car holds, the demonstration's included, and from
@@ -257,9 +260,13 @@ pub fn race(
         Some(p) => p.choose(venue)?,
         None => None,
     };
-    let evaluator = |target: Option<SpeedTarget>| match config.flying {
-        true => venue.clone().flying().evaluator(config.shape()?, target),
-        false => venue.evaluator(config.shape()?, target),
+    // The laps' evaluator, the pedal's action asking for `target`'s speeds if given.
+    let evaluator = |target: Option<SpeedTarget>| {
+        if config.flying {
+            venue.clone().flying().evaluator(config.shape()?, target)
+        } else {
+            venue.evaluator(config.shape()?, target)
+        }
     };
     let mut outcome = match (chosen, &profile) {
         (Some(((lap, pairs), choice)), Some(profile)) => {
