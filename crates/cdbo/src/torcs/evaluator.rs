@@ -125,3 +125,27 @@ pub fn game_pedal(policy: &Policy) -> GamePedal {
         None => GamePedal::Rkhs(policy.pedal.clone()),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::policy::RkhsPolicy;
+    use crate::policy::target::SpeedTarget;
+
+    /// The robot is handed a policy's RKHS pedal, or with a target the profile hold (scale 1)
+    /// of the speeds the target asks for: the hold cdbo's driver runs.
+    #[test]
+    fn the_robots_pedal_is_the_policys_or_its_targets_hold() {
+        let pedal = RkhsPolicy::new(vec![0.4, -0.2, 0.9], 0.5).unwrap();
+        let open = Policy::from(pedal.clone());
+        assert!(matches!(game_pedal(&open), GamePedal::Rkhs(p) if p == pedal));
+        let target = SpeedTarget::new(vec![0.0, 30.0, 20.0, 40.0], 300.0, 0.7, 0.25).unwrap();
+        let held = open.targeting(Some(target.clone()));
+        let GamePedal::Profile { k, length, speed } = game_pedal(&held) else {
+            panic!("a target's policy handed as an RKHS pedal");
+        };
+        assert_eq!((k, length), (1.0, 300.0));
+        assert_eq!(speed, target.speeds(&pedal));
+        assert_eq!(held.target_hold().unwrap().speeds, speed);
+    }
+}
